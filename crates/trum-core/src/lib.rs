@@ -1,0 +1,13 @@
+//! # trum-core
+//!
+//! Steady-state model of traveling-wave rotary ultrasonic motors (TRUMs): contact zone
+//! from preload, driving and braking zones under load, stator amplitude solved together
+//! with the contact forces, torque, losses, efficiency, temperature rise, speed
+//! fluctuation and the preload optimisation criterion. Pure Rust, no file or network I/O:
+//! parsers take strings, progress is reported through callbacks.
+//!
+//! Sources are the five papers in `shared/seeds/` (cited as seed 000 … 004 with their
+//! equation numbers). SI units everywhere; every public quantity name carries its unit.
+#![warn(missing_docs)]
+
+pub mod quad;

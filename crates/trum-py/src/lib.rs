@@ -1,0 +1,1 @@
+//! Python bindings: placeholder until the Python-module issue lands; see crates/trum-py/README.

@@ -1,0 +1,1 @@
+//! Placeholder library so the root package (cross-crate tests and benches) builds.
