@@ -10,4 +10,22 @@
 //! equation numbers). SI units everywhere; every public quantity name carries its unit.
 #![warn(missing_docs)]
 
+pub mod contact;
+pub mod effects;
+pub mod error;
+pub mod losses;
+pub mod params;
+pub mod presets;
 pub mod quad;
+pub mod solve;
+pub mod stator;
+pub mod thermal;
+
+pub use effects::{Effect, Effects};
+pub use error::{ParamError, TrumError};
+pub use params::Motor;
+pub use solve::{solve, OperatingPoint, Solution, Status};
+pub mod criterion;
+pub mod fluctuation;
+pub mod quantities;
+pub mod sweep;

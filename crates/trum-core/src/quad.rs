@@ -53,7 +53,13 @@ fn gk15<F: Fn(f64) -> f64>(f: &F, a: f64, b: f64) -> (f64, f64) {
 /// Integral of `f` over `[a, b]` to absolute tolerance `abs_tol` or relative tolerance
 /// `rel_tol`, whichever is looser. Splits adaptively; gives up refining after 2000
 /// intervals and returns the best estimate (the error estimate is returned too).
-pub fn integrate<F: Fn(f64) -> f64>(f: F, a: f64, b: f64, abs_tol: f64, rel_tol: f64) -> (f64, f64) {
+pub fn integrate<F: Fn(f64) -> f64>(
+    f: F,
+    a: f64,
+    b: f64,
+    abs_tol: f64,
+    rel_tol: f64,
+) -> (f64, f64) {
     if a == b {
         return (0.0, 0.0);
     }
@@ -65,10 +71,11 @@ pub fn integrate<F: Fn(f64) -> f64>(f: F, a: f64, b: f64, abs_tol: f64, rel_tol:
     let mut n = 1;
     while err > abs_tol.max(rel_tol * total.abs()) && n < 2000 {
         // split the interval with the largest error
-        let (idx, _) = stack
-            .iter()
-            .enumerate()
-            .fold((0, -1.0), |(bi, be), (i, s)| if s.3 > be { (i, s.3) } else { (bi, be) });
+        let (idx, _) =
+            stack.iter().enumerate().fold(
+                (0, -1.0),
+                |(bi, be), (i, s)| if s.3 > be { (i, s.3) } else { (bi, be) },
+            );
         let (lo, hi, v0, e0) = stack.swap_remove(idx);
         let mid = 0.5 * (lo + hi);
         let (v1, e1) = gk15(&f, lo, mid);

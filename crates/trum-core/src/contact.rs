@@ -1,0 +1,306 @@
+//! Stator/rotor contact in the wave frame: contact zone from preload, pressure
+//! distribution, axial force, driving (stick) points and the torque integral.
+//!
+//! Conventions (the papers are inconsistent, see docs/MODEL.md):
+//! * θ is the wave phase measured from a wave crest; k = N/R0 is the wave number, so a
+//!   circumferential length x corresponds to θ = k·x.
+//! * φ0 is the contact **half-angle in wave phase**: contact where |θ| ≤ φ0, 0 < φ0 ≤ π.
+//! * The contact angle Xc (seed 000 eq. 1-2) is the **full** contact arc in mechanical
+//!   degrees: Xc = 2·φ0/(2π)·(360°/N), which is 40·φ0/π for N = 9, so 0 ≤ Xc ≤ 40°.
+//! * The friction layer is a Winkler bed (seed 000 eq. 3, seed 001 eq. 5): pressure per
+//!   unit circumferential length p(θ) = k_f·W·(cos θ − c), k_f = E_f·b_f/h_f [N/m²].
+//!   In partial contact c = cos φ0; in full contact (the rotor touches the whole wave,
+//!   φ0 = π) the rotor sits below the trough and c < −1.
+
+use std::f64::consts::PI;
+
+/// χ(θ) = sin θ − θ·c, the integral ∫₀^θ (cos t − c) dt (seed 001 eq. 10 with c = cos φ0).
+#[inline]
+pub fn chi(theta_rad: f64, c: f64) -> f64 {
+    theta_rad.sin() - theta_rad * c
+}
+
+/// E(θ) = ∫₀^θ (cos t − c)·cos t dt = θ/2 + sin 2θ/4 − c·sin θ: the power-weighted
+/// pressure integral used by the friction-power closed forms.
+#[inline]
+pub fn e_int(theta_rad: f64, c: f64) -> f64 {
+    let (s, co) = theta_rad.sin_cos();
+    0.5 * theta_rad + 0.5 * s * co - c * s
+}
+
+/// Equivalent Winkler stiffness of the friction layer per unit circumferential length,
+/// k_f = E_f·b_f/h_f [N/m²] (seed 001 eq. 4).
+pub fn layer_stiffness_n_per_m2(
+    youngs_modulus_pa: f64,
+    contact_width_m: f64,
+    thickness_m: f64,
+) -> f64 {
+    youngs_modulus_pa * contact_width_m / thickness_m
+}
+
+/// Force scale A = 2·N·k_f·W/k [N]: the axial force is A·χ(φ0) (seed 001 eq. 5,
+/// seed 000 eq. 6 with the width integral folded into k_f).
+#[inline]
+pub fn force_scale_n(
+    wave_number: f64,
+    k_f_n_per_m2: f64,
+    amplitude_m: f64,
+    wavenumber_per_m: f64,
+) -> f64 {
+    2.0 * wave_number * k_f_n_per_m2 * amplitude_m / wavenumber_per_m
+}
+
+/// The contact zone at one preload and amplitude.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    /// Contact half-angle φ0 in wave phase [rad], in (0, π].
+    pub half_angle_rad: f64,
+    /// Offset c of the pressure profile p = k_f·W·(cos θ − c): cos φ0, or < −1 in full contact.
+    pub offset: f64,
+    /// True when the rotor touches the whole wave.
+    pub full: bool,
+}
+
+impl Contact {
+    /// χ(φ0) = sin φ0 − φ0·c: the axial force is A·χ(φ0).
+    #[inline]
+    pub fn chi0(&self) -> f64 {
+        chi(self.half_angle_rad, self.offset)
+    }
+}
+
+#[cfg(test)]
+/// g(φ) = sin φ − φ·cos φ, strictly increasing on [0, π] from 0 to π (g' = φ·sin φ).
+#[inline]
+fn g(phi: f64) -> f64 {
+    let (s, c) = phi.sin_cos();
+    s - phi * c
+}
+
+/// Contact zone from the ratio y = F_N/A of preload to force scale (seed 001 eq. 5
+/// solved for x0; seed 000 eq. 6). Valid for any y > 0: y ≥ π means full contact.
+///
+/// Inverts g(φ0) = y by safeguarded Newton iteration to 1e-14 in φ0, starting from the
+/// small-angle (g ≈ φ³/3) or near-full (g ≈ π − π·ε²/2, ε = π − φ) asymptotes.
+pub fn contact_from_ratio(y: f64) -> Contact {
+    if y >= PI {
+        // Full contact: p = k_f W (cos θ − c) over the whole wave, ∫ = −2π c / k  ⇒  c = −y/π.
+        return Contact {
+            half_angle_rad: PI,
+            offset: -y / PI,
+            full: true,
+        };
+    }
+    if y <= 0.0 {
+        return Contact {
+            half_angle_rad: 0.0,
+            offset: 1.0,
+            full: false,
+        };
+    }
+    let mut lo = 0.0;
+    let mut hi = PI;
+    let mut phi = if y < 1.5 {
+        (3.0 * y).cbrt().min(PI * 0.999)
+    } else {
+        PI - (2.0 * (PI - y) / PI).sqrt()
+    };
+    for _ in 0..60 {
+        let (s, c) = phi.sin_cos();
+        let r = s - phi * c - y;
+        if r > 0.0 {
+            hi = phi;
+        } else {
+            lo = phi;
+        }
+        let d = phi * s;
+        let mut next = if d > 0.0 {
+            phi - r / d
+        } else {
+            0.5 * (lo + hi)
+        };
+        if !(next > lo && next < hi) {
+            next = 0.5 * (lo + hi);
+        }
+        let done = (next - phi).abs() <= 1e-14 * (1.0 + phi);
+        phi = next;
+        if done || hi - lo < 1e-15 {
+            break;
+        }
+    }
+    Contact {
+        half_angle_rad: phi,
+        offset: phi.cos(),
+        full: false,
+    }
+}
+
+/// Contact angle Xc [mechanical degrees, full arc] from the half-angle φ0 in wave phase
+/// (seed 000 eq. 2 convention: Xc = 40·φ0/π for N = 9).
+#[inline]
+pub fn contact_angle_deg(half_angle_rad: f64, wave_number: f64) -> f64 {
+    half_angle_rad * 360.0 / (PI * wave_number)
+}
+
+/// Contact length 2·x0 = 2·φ0/k [m] along the circumference.
+#[inline]
+pub fn contact_length_m(half_angle_rad: f64, wavenumber_per_m: f64) -> f64 {
+    2.0 * half_angle_rad / wavenumber_per_m
+}
+
+/// Pressure per unit circumferential length p(θ) = k_f·W·(cos θ − c) inside the contact,
+/// 0 outside [N/m] (seed 000 eq. 3, seed 001 eq. 5).
+pub fn pressure_n_per_m(
+    theta_rad: f64,
+    k_f_n_per_m2: f64,
+    amplitude_m: f64,
+    contact: &Contact,
+) -> f64 {
+    if theta_rad.abs() > contact.half_angle_rad {
+        0.0
+    } else {
+        (k_f_n_per_m2 * amplitude_m * (theta_rad.cos() - contact.offset)).max(0.0)
+    }
+}
+
+/// Torque shape factor 2·χ(θs) − χ(φ0) (seed 001 eq. 11, seed 000 eq. 4-5): the drive
+/// torque is R0·μ·A·[2χ(θs) − χ(φ0)], where |θ| < θs is the driving zone.
+#[inline]
+pub fn torque_factor(stick_half_angle_rad: f64, contact: &Contact) -> f64 {
+    2.0 * chi(stick_half_angle_rad, contact.offset) - contact.chi0()
+}
+
+/// Largest stick half-angle possible with the rotor at rest: the stator surface speed
+/// v0·cos θ is positive only for |θ| < π/2.
+#[inline]
+pub fn stall_stick_half_angle_rad(contact: &Contact) -> f64 {
+    contact.half_angle_rad.min(0.5 * PI)
+}
+
+/// Solves the stick half-angle θs ∈ [0, θmax] of the torque balance
+/// R0·μ·A·[2χ(θs) − χ(φ0)] = T_load + d_r·v0·cos(θs)/R0 (seed 000 eq. 5 and Table A1's
+/// rotor damping; the rotor surface speed is v_r = v0·cos θs, seed 001 eq. 13).
+///
+/// `torque_scale_nm` = R0·μ·A, `viscous_nm_per_cos` = d_r·v0/R0. The left side increases
+/// and the right side decreases with θs, so the root is unique when it exists; returns
+/// `None` when T_load exceeds the stall torque (no root up to θmax).
+pub fn stick_half_angle_rad(
+    contact: &Contact,
+    torque_scale_nm: f64,
+    load_torque_nm: f64,
+    viscous_nm_per_cos: f64,
+    guess_rad: Option<f64>,
+) -> Option<f64> {
+    let c = contact.offset;
+    let chi0 = contact.chi0();
+    let tmax = stall_stick_half_angle_rad(contact);
+    let f = |t: f64| {
+        let (s, co) = t.sin_cos();
+        let val =
+            torque_scale_nm * (2.0 * (s - t * c) - chi0) - load_torque_nm - viscous_nm_per_cos * co;
+        let der = torque_scale_nm * 2.0 * (co - c) + viscous_nm_per_cos * s;
+        (val, der)
+    };
+    let (fmax, _) = f(tmax);
+    if fmax < 0.0 {
+        return None;
+    }
+    let (mut lo, mut hi) = (0.0, tmax);
+    // Starting point: warm start, else the small-θs/Newton-from-midpoint guess.
+    let mut t = guess_rad
+        .filter(|g| *g > 0.0 && *g < tmax)
+        .unwrap_or(0.5 * tmax);
+    for _ in 0..60 {
+        let (v, d) = f(t);
+        if v > 0.0 {
+            hi = t;
+        } else {
+            lo = t;
+        }
+        let mut next = if d > 0.0 { t - v / d } else { 0.5 * (lo + hi) };
+        if !(next > lo && next < hi) {
+            next = 0.5 * (lo + hi);
+        }
+        let done = (next - t).abs() <= 1e-14 * (1.0 + t);
+        t = next;
+        if done || hi - lo < 1e-15 {
+            break;
+        }
+    }
+    Some(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quad::integral;
+
+    #[test]
+    fn inverse_of_g_is_accurate_everywhere() {
+        for i in 1..400 {
+            let phi = PI * i as f64 / 400.0;
+            let c = contact_from_ratio(g(phi));
+            assert!(
+                (c.half_angle_rad - phi).abs() < 1e-9,
+                "phi={phi} got {}",
+                c.half_angle_rad
+            );
+        }
+        // tiny contact: small-angle asymptote g ≈ φ³/3
+        let c = contact_from_ratio(1e-9);
+        assert!((c.half_angle_rad - (3e-9f64).cbrt()).abs() / (3e-9f64).cbrt() < 1e-5);
+    }
+
+    #[test]
+    fn axial_force_closed_form_matches_quadrature() {
+        // F = N ∫_{-x0}^{x0} p dx with p = k_f W (cos kx − c)  vs  A·χ(φ0)
+        let (n, kf, w, k) = (9.0, 1.2e9, 1.5e-6, 9.0 / 0.02625);
+        for &y in &[0.01, 0.5, 1.7, 3.0, 4.5] {
+            let ct = contact_from_ratio(y);
+            let a = force_scale_n(n, kf, w, k);
+            let x0 = ct.half_angle_rad / k;
+            let q = n * integral(|x| kf * w * ((k * x).cos() - ct.offset), -x0, x0);
+            assert!(
+                (q - a * ct.chi0()).abs() < 1e-10 * q,
+                "y={y}: {q} vs {}",
+                a * ct.chi0()
+            );
+            assert!((ct.chi0() - y).abs() < 1e-10 * y.max(1.0));
+        }
+    }
+
+    #[test]
+    fn torque_factor_matches_signed_quadrature() {
+        // ∫ sgn(v0 cos θ − v_r)·(cos θ − c) dθ over the contact = 2·[2χ(θs) − χ(φ0)]
+        let ct = contact_from_ratio(1.2);
+        for &ts in &[0.1, 0.4, ct.half_angle_rad * 0.9] {
+            let vr = ts.cos();
+            let q = integral(
+                |t| (t.cos() - vr).signum() * (t.cos() - ct.offset),
+                -ct.half_angle_rad,
+                ct.half_angle_rad,
+            );
+            assert!((q - 2.0 * torque_factor(ts, &ct)).abs() < 1e-9, "{q}");
+        }
+    }
+
+    #[test]
+    fn stick_angle_solves_torque_balance_and_reports_stall() {
+        let ct = contact_from_ratio(1.0);
+        let scale = 2.0;
+        let t = stick_half_angle_rad(&ct, scale, 0.3, 0.05, None).unwrap();
+        let resid = scale * torque_factor(t, &ct) - 0.3 - 0.05 * t.cos();
+        assert!(resid.abs() < 1e-12);
+        assert!(t > 0.0 && t <= ct.half_angle_rad);
+        // stall torque with partial contact below π/2 is μ F R0 = scale·χ(φ0)
+        let stall = scale * ct.chi0();
+        assert!(stick_half_angle_rad(&ct, scale, stall * 1.001, 0.0, None).is_none());
+        assert!(stick_half_angle_rad(&ct, scale, stall * 0.999, 0.0, None).is_some());
+    }
+
+    #[test]
+    fn contact_angle_convention() {
+        assert!((contact_angle_deg(PI, 9.0) - 40.0).abs() < 1e-12);
+        assert!((contact_angle_deg(0.5 * PI, 9.0) - 20.0).abs() < 1e-12);
+    }
+}

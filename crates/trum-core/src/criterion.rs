@@ -1,0 +1,294 @@
+//! The preload optimisation criterion (seed 000 section 5). For each candidate preload:
+//! stall torque, maximum efficiency over load torque, temperature rise after a set run
+//! time (seed 000 eq. 11) and the speed fluctuation from an assembly runout
+//! ([`crate::fluctuation`]). Each indicator is scaled to [0, 1] over the candidates
+//! (1 = best: high stall torque, high efficiency, low temperature rise, low fluctuation),
+//! and the weighted mean is the score. The optimum is the best score; the optimum
+//! region is the contiguous run of candidates around it whose score is within
+//! `region_tolerance` of the best.
+//!
+//! The paper combines the four indicators graphically (its Figure 9), giving priority to
+//! speed smoothness and temperature rise; the default weights here do the same (2, 2 for
+//! fluctuation and temperature; 1, 1 for stall torque and efficiency) and are
+//! configurable.
+
+use crate::error::TrumError;
+use crate::fluctuation::fluctuation_about;
+use crate::params::Motor;
+use crate::solve::{solve_prepared, OperatingPoint, Prepared, Status};
+use crate::sweep::Axis;
+use crate::thermal;
+
+/// Settings of the criterion.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CriterionConfig {
+    /// Candidate preloads [N].
+    pub preload_n: Axis,
+    /// Drive voltage amplitude [V].
+    pub voltage_v: f64,
+    /// Drive frequency [Hz].
+    pub frequency_hz: f64,
+    /// Run time for the temperature rise [s] (seed 000 section 4.2 uses 10 s).
+    pub run_time_s: f64,
+    /// Load torque during the temperature run [N·m] (seed 000: no load).
+    pub run_torque_nm: f64,
+    /// Axial runout for the speed fluctuation [m].
+    pub runout_m: f64,
+    /// Weights of stall torque, max efficiency, temperature rise, speed fluctuation.
+    pub weights: [f64; 4],
+    /// Score tolerance of the optimum region, as a fraction of the best score.
+    pub region_tolerance: f64,
+    /// Load torques sampled per preload to find the maximum efficiency.
+    pub torque_samples: usize,
+}
+
+impl CriterionConfig {
+    /// The paper's TRUM60A setting: 150-500 N, 200 V, 43 kHz (seed 000 section 4),
+    /// 10 s no-load runs, 5 µm runout (assumed: typical axial runout of a 60 mm rotor).
+    pub fn seed000() -> CriterionConfig {
+        CriterionConfig {
+            preload_n: Axis::linspace(150.0, 500.0, 36),
+            voltage_v: 200.0,
+            frequency_hz: 43_000.0,
+            run_time_s: 10.0,
+            run_torque_nm: 0.0,
+            runout_m: 5e-6,
+            weights: [1.0, 1.0, 2.0, 2.0],
+            region_tolerance: 0.1,
+            torque_samples: 48,
+        }
+    }
+
+    fn validate(&self) -> Result<(), TrumError> {
+        let pos = [
+            ("voltage_v", self.voltage_v),
+            ("frequency_hz", self.frequency_hz),
+            ("run_time_s", self.run_time_s),
+        ];
+        for (n, v) in pos {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(TrumError::input(format!(
+                    "{n} = {v} must be a finite number > 0"
+                )));
+            }
+        }
+        for (n, v) in [
+            ("run_torque_nm", self.run_torque_nm),
+            ("runout_m", self.runout_m),
+            ("region_tolerance", self.region_tolerance),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(TrumError::input(format!(
+                    "{n} = {v} must be a finite number >= 0"
+                )));
+            }
+        }
+        if self.weights.iter().any(|w| !(w.is_finite() && *w >= 0.0))
+            || self.weights.iter().sum::<f64>() <= 0.0
+        {
+            return Err(TrumError::input(
+                "weights must be finite, >= 0 and not all zero",
+            ));
+        }
+        if self.preload_n.n < 2
+            || !(self.preload_n.start > 0.0)
+            || !(self.preload_n.stop > self.preload_n.start)
+            || !self.preload_n.stop.is_finite()
+        {
+            return Err(TrumError::input(
+                "preload_n: need at least 2 candidates with 0 < start < stop",
+            ));
+        }
+        if self.torque_samples < 4 {
+            return Err(TrumError::input("torque_samples must be >= 4"));
+        }
+        Ok(())
+    }
+}
+
+/// The indicators and score of one candidate preload.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CriterionRow {
+    /// Candidate preload [N].
+    pub preload_n: f64,
+    /// Status at no load (a clamped stator disqualifies the candidate).
+    pub status: Status,
+    /// Stall torque [N·m].
+    pub stall_torque_nm: f64,
+    /// Maximum efficiency over load torque [-].
+    pub max_efficiency: f64,
+    /// Load torque at the maximum efficiency [N·m].
+    pub torque_at_max_efficiency_nm: f64,
+    /// Temperature rise after the run time [K].
+    pub temperature_rise_k: f64,
+    /// Speed standard deviation over a revolution at no load [rev/min].
+    pub speed_std_rpm: f64,
+    /// No-load speed [rev/min].
+    pub no_load_speed_rpm: f64,
+    /// Weighted score in [0, 1] (NaN for disqualified candidates).
+    pub score: f64,
+    /// True inside the optimum region.
+    pub in_region: bool,
+}
+
+/// The criterion's table and conclusion.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CriterionResult {
+    /// One row per candidate.
+    pub rows: Vec<CriterionRow>,
+    /// Preload with the best score [N].
+    pub optimum_preload_n: f64,
+    /// Optimum region [N].
+    pub region_n: (f64, f64),
+}
+
+/// Evaluates the criterion. `progress(done, total)` is called after each candidate.
+pub fn evaluate(
+    motor: &Motor,
+    cfg: &CriterionConfig,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<CriterionResult, TrumError> {
+    cfg.validate()?;
+    let p = Prepared::new(motor);
+    let n = cfg.preload_n.n;
+    let mut rows = Vec::with_capacity(n);
+    for i in 0..n {
+        let f = cfg.preload_n.at(i);
+        let op0 = OperatingPoint::new(f, 0.0, cfg.voltage_v, cfg.frequency_hz);
+        let s0 = solve_prepared(&p, motor, &op0, None);
+        let mut row = CriterionRow {
+            preload_n: f,
+            status: s0.status,
+            stall_torque_nm: s0.stall_torque_nm,
+            max_efficiency: 0.0,
+            torque_at_max_efficiency_nm: 0.0,
+            temperature_rise_k: f64::NAN,
+            speed_std_rpm: f64::NAN,
+            no_load_speed_rpm: s0.speed_rpm,
+            score: f64::NAN,
+            in_region: false,
+        };
+        if s0.status == Status::Ok {
+            // max efficiency: sample torques up to stall, then golden-section refine.
+            let eff = |t: f64| {
+                solve_prepared(
+                    &p,
+                    motor,
+                    &OperatingPoint::new(f, t, cfg.voltage_v, cfg.frequency_hz),
+                    None,
+                )
+                .efficiency
+            };
+            let tmax = s0.stall_torque_nm;
+            let m = cfg.torque_samples;
+            let (mut bi, mut be) = (0, 0.0);
+            for j in 0..m {
+                let e = eff(tmax * j as f64 / (m - 1) as f64);
+                if e > be {
+                    bi = j;
+                    be = e;
+                }
+            }
+            let step = tmax / (m - 1) as f64;
+            let (mut a, mut b) = (
+                (bi as f64 - 1.0).max(0.0) * step,
+                ((bi + 1) as f64 * step).min(tmax),
+            );
+            let gr = 0.5 * (5f64.sqrt() - 1.0);
+            for _ in 0..40 {
+                let x1 = b - gr * (b - a);
+                let x2 = a + gr * (b - a);
+                if eff(x1) > eff(x2) {
+                    b = x2;
+                } else {
+                    a = x1;
+                }
+            }
+            let t_best = 0.5 * (a + b);
+            row.max_efficiency = eff(t_best).max(be);
+            row.torque_at_max_efficiency_nm = t_best;
+            let run = solve_prepared(
+                &p,
+                motor,
+                &OperatingPoint::new(f, cfg.run_torque_nm, cfg.voltage_v, cfg.frequency_hz),
+                None,
+            );
+            row.temperature_rise_k = thermal::temperature_rise_k(
+                run.total_loss_w(),
+                p.alpha_s,
+                p.heat_cap,
+                cfg.run_time_s,
+            );
+            row.speed_std_rpm =
+                fluctuation_about(motor, &p, &op0, &s0, cfg.runout_m, 16).speed_std_rpm;
+        }
+        rows.push(row);
+        progress(i + 1, n);
+    }
+    score(&mut rows, cfg);
+    let (bi, best) = rows
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.score.is_finite())
+        .fold((usize::MAX, f64::NEG_INFINITY), |acc, (i, r)| {
+            if r.score > acc.1 {
+                (i, r.score)
+            } else {
+                acc
+            }
+        });
+    if bi == usize::MAX {
+        return Err(TrumError::input(
+            "no candidate preload gives a running motor at this drive",
+        ));
+    }
+    let thr = best - cfg.region_tolerance * best.abs();
+    let (mut lo, mut hi) = (bi, bi);
+    while lo > 0 && rows[lo - 1].score >= thr {
+        lo -= 1;
+    }
+    while hi + 1 < rows.len() && rows[hi + 1].score >= thr {
+        hi += 1;
+    }
+    for r in rows.iter_mut().take(hi + 1).skip(lo) {
+        r.in_region = true;
+    }
+    Ok(CriterionResult {
+        optimum_preload_n: rows[bi].preload_n,
+        region_n: (rows[lo].preload_n, rows[hi].preload_n),
+        rows,
+    })
+}
+
+fn score(rows: &mut [CriterionRow], cfg: &CriterionConfig) {
+    let valid: Vec<usize> = (0..rows.len())
+        .filter(|&i| rows[i].status == Status::Ok)
+        .collect();
+    let metric = |r: &CriterionRow, k: usize| match k {
+        0 => r.stall_torque_nm,
+        1 => r.max_efficiency,
+        2 => -r.temperature_rise_k,
+        _ => -r.speed_std_rpm,
+    };
+    let mut ranges = [(f64::INFINITY, f64::NEG_INFINITY); 4];
+    for &i in &valid {
+        for (k, rg) in ranges.iter_mut().enumerate() {
+            let v = metric(&rows[i], k);
+            *rg = (rg.0.min(v), rg.1.max(v));
+        }
+    }
+    let wsum: f64 = cfg.weights.iter().sum();
+    for &i in &valid {
+        let mut s = 0.0;
+        for (k, rg) in ranges.iter().enumerate() {
+            let span = rg.1 - rg.0;
+            let x = if span > 0.0 {
+                (metric(&rows[i], k) - rg.0) / span
+            } else {
+                1.0
+            };
+            s += cfg.weights[k] * x;
+        }
+        rows[i].score = s / wsum;
+    }
+}

@@ -1,0 +1,558 @@
+//! The library of named, switchable unmodelled effects (names fixed by
+//! `shared/spec/diagnose.md`). Like PyBaMM's model options: an explicit set of named
+//! effects, each with one or two strength parameters in physical units, `none` by
+//! default, validated with errors that list the valid names.
+//!
+//! This module holds the registry and the switch; the physics of each effect lives next
+//! to the part of the model it changes and is applied by [`crate::solve`].
+
+use crate::error::ParamError;
+use crate::params::{fmt_toml_number, line_of_key, Num};
+use std::fmt;
+
+/// One strength parameter of an effect.
+#[derive(Clone, Copy, Debug)]
+pub struct EffectParam {
+    /// Parameter name with unit suffix.
+    pub name: &'static str,
+    /// Meaning and unit.
+    pub doc: &'static str,
+    /// A typical "clearly present" value (used by `trum synth` examples and docs).
+    pub typical: f64,
+    /// Smallest valid value.
+    pub min: f64,
+    /// Largest valid value.
+    pub max: f64,
+}
+
+/// Registry entry of one effect.
+#[derive(Clone, Copy, Debug)]
+pub struct EffectInfo {
+    /// The effect's fixed name.
+    pub name: &'static str,
+    /// What it changes.
+    pub summary: &'static str,
+    /// Where its physics comes from.
+    pub source: &'static str,
+    /// Its strength parameters; the first is the primary one (`NAME=STRENGTH`).
+    pub params: &'static [EffectParam],
+}
+
+/// Index of an effect in [`EFFECTS`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[allow(missing_docs)]
+pub enum Effect {
+    RadialFriction = 0,
+    PreloadStiffening = 1,
+    HertzSoftening = 2,
+    ThermalDrift = 3,
+    VoltageSag = 4,
+    Eccentricity = 5,
+    TangentialCompliance = 6,
+}
+
+/// Number of effects in the registry.
+pub const N_EFFECTS: usize = 7;
+
+/// All effects, in the order of [`Effect`].
+pub const ALL: [Effect; N_EFFECTS] = [
+    Effect::RadialFriction,
+    Effect::PreloadStiffening,
+    Effect::HertzSoftening,
+    Effect::ThermalDrift,
+    Effect::VoltageSag,
+    Effect::Eccentricity,
+    Effect::TangentialCompliance,
+];
+
+/// The registry, indexed by [`Effect`].
+pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
+    EffectInfo {
+        name: "radial_friction",
+        summary: "stator surface points also slip radially; friction acts along the total slip, \
+                  driving force drops and radial slip dissipates power",
+        source: "seed 002 (radial friction in the contact mechanism), eq. 19-21 and 27",
+        params: &[EffectParam {
+            name: "radial_velocity_ratio",
+            doc: "peak radial surface speed over peak tangential surface speed [-]",
+            typical: 0.5,
+            min: 0.0,
+            max: 3.0,
+        }],
+    },
+    EffectInfo {
+        name: "preload_stiffening",
+        summary:
+            "the pressed friction layer adds stiffness to the stator mode: resonance moves up \
+                  and amplitude changes with preload",
+        source: "seed 001 eq. 8 and 14; seed 002 section 5.3",
+        params: &[EffectParam {
+            name: "stiffness_scale",
+            doc: "multiplier of the contact stiffness of seed 001 eq. 8 added to the mode [-]",
+            typical: 1.0,
+            min: 0.0,
+            max: 20.0,
+        }],
+    },
+    EffectInfo {
+        name: "hertz_softening",
+        summary: "softening cubic restoring force at high amplitude: resonance shifts down with \
+                  amplitude, growing with preload",
+        source: "seed 003 eq. 2-4 and 10-12",
+        params: &[
+            EffectParam {
+                name: "beta_n_per_m3",
+                doc: "softening cubic stiffness coefficient at zero preload [N/m^3]",
+                typical: 2.0e19,
+                min: 0.0,
+                max: 1.0e23,
+            },
+            EffectParam {
+                name: "preload_gain_per_n",
+                doc: "relative growth of the cubic coefficient per newton of preload [1/N]",
+                typical: 0.005,
+                min: 0.0,
+                max: 1.0,
+            },
+        ],
+    },
+    EffectInfo {
+        name: "thermal_drift",
+        summary: "losses heat the stator over a run; modal stiffness and friction change with \
+                  temperature, so speed drifts",
+        source: "seed 000 eq. 11 and section 4.2",
+        params: &[
+            EffectParam {
+                name: "stiffness_coefficient_per_k",
+                doc: "relative change of modal stiffness per kelvin of temperature rise [1/K] \
+                      (negative: softening)",
+                typical: -4.0e-4,
+                min: -0.05,
+                max: 0.05,
+            },
+            EffectParam {
+                name: "friction_coefficient_per_k",
+                doc: "relative change of the friction coefficient per kelvin [1/K]",
+                typical: -2.0e-3,
+                min: -0.05,
+                max: 0.05,
+            },
+        ],
+    },
+    EffectInfo {
+        name: "voltage_sag",
+        summary: "the driver cannot hold the set voltage: the electrode voltage falls with the \
+                  load current through the driver's output impedance",
+        source: "seed 001 section 3.1",
+        params: &[EffectParam {
+            name: "source_resistance_ohm",
+            doc: "output resistance of the drive electronics per phase [ohm]",
+            typical: 150.0,
+            min: 0.0,
+            max: 1.0e5,
+        }],
+    },
+    EffectInfo {
+        name: "eccentricity",
+        summary: "assembly error makes the preload vary once per revolution; contact angle and \
+                  speed fluctuate and the mean speed shifts",
+        source: "seed 000 section 4.3 and eq. 12",
+        params: &[EffectParam {
+            name: "runout_m",
+            doc: "once-per-revolution axial runout of the rotor [m]",
+            typical: 20.0e-6,
+            min: 0.0,
+            max: 1.0e-3,
+        }],
+    },
+    EffectInfo {
+        name: "tangential_compliance",
+        summary: "shear compliance of the friction layer: partial stick inside the contact and a \
+                  smooth speed-torque curve instead of a sharp stall",
+        source: "seed 004 eq. 1-2; Storck and Wallaschek, Int. J. Non-Linear Mech. 38 (2003)",
+        params: &[EffectParam {
+            name: "shear_compliance_ratio",
+            doc: "ratio of tangential to normal compliance of the friction layer [-]",
+            typical: 1.0,
+            min: 0.0,
+            max: 50.0,
+        }],
+    },
+];
+
+impl Effect {
+    /// The effect's fixed name.
+    pub fn name(self) -> &'static str {
+        EFFECTS[self as usize].name
+    }
+    /// Registry entry.
+    pub fn info(self) -> &'static EffectInfo {
+        &EFFECTS[self as usize]
+    }
+    /// Looks up an effect by name; the error lists the valid names.
+    pub fn from_name(name: &str) -> Result<Effect, String> {
+        ALL.iter()
+            .copied()
+            .find(|e| e.name() == name)
+            .ok_or_else(|| {
+                format!(
+                    "unknown effect '{name}'; valid effects are: {}",
+                    valid_names()
+                )
+            })
+    }
+}
+
+impl fmt::Display for Effect {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Comma-separated list of valid effect names.
+pub fn valid_names() -> String {
+    EFFECTS
+        .iter()
+        .map(|e| e.name)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The set of switched-on effects with their parameters. `Effects::none()` is the
+/// baseline model. An effect whose parameters are all zero is switched on but changes
+/// nothing (tests check that it reproduces the baseline exactly).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Effects {
+    on: [bool; N_EFFECTS],
+    values: [[f64; 2]; N_EFFECTS],
+}
+
+impl Effects {
+    /// No effects: the baseline model.
+    pub fn none() -> Effects {
+        Effects::default()
+    }
+
+    /// True when no effect is switched on.
+    pub fn is_none(&self) -> bool {
+        !self.on.iter().any(|&b| b)
+    }
+
+    /// Switches an effect on with all its parameters (missing ones are 0).
+    pub fn set(&mut self, e: Effect, params: &[f64]) {
+        self.on[e as usize] = true;
+        let mut v = [0.0; 2];
+        for (slot, p) in v.iter_mut().zip(params) {
+            *slot = *p;
+        }
+        self.values[e as usize] = v;
+    }
+
+    /// Switches an effect on with its primary parameter, the others at their typical value.
+    pub fn set_strength(&mut self, e: Effect, strength: f64) {
+        let info = e.info();
+        let mut v = [0.0; 2];
+        for (i, p) in info.params.iter().enumerate() {
+            v[i] = if i == 0 { strength } else { p.typical };
+        }
+        self.set(e, &v[..info.params.len()]);
+    }
+
+    /// Switches an effect off.
+    pub fn clear(&mut self, e: Effect) {
+        self.on[e as usize] = false;
+        self.values[e as usize] = [0.0; 2];
+    }
+
+    /// True when the effect is switched on.
+    pub fn is_on(&self, e: Effect) -> bool {
+        self.on[e as usize]
+    }
+
+    /// Parameters of an effect if switched on.
+    pub fn get(&self, e: Effect) -> Option<&[f64]> {
+        self.on[e as usize].then(|| &self.values[e as usize][..e.info().params.len()])
+    }
+
+    /// Parameter `i` of an effect, 0 when the effect is off.
+    #[inline]
+    pub fn value(&self, e: Effect, i: usize) -> f64 {
+        if self.on[e as usize] {
+            self.values[e as usize][i]
+        } else {
+            0.0
+        }
+    }
+
+    /// Mutable parameter slot (for calibration of effect strengths).
+    pub fn value_mut(&mut self, e: Effect, i: usize) -> &mut f64 {
+        self.on[e as usize] = true;
+        &mut self.values[e as usize][i]
+    }
+
+    /// Switched-on effects in registry order.
+    pub fn active(&self) -> Vec<Effect> {
+        ALL.iter().copied().filter(|e| self.is_on(*e)).collect()
+    }
+
+    /// Parses `NAME=STRENGTH` or `NAME:param=value,param=value` (CLI form).
+    pub fn parse_assignment(&mut self, spec: &str) -> Result<(), String> {
+        let spec = spec.trim();
+        if spec == "none" {
+            *self = Effects::none();
+            return Ok(());
+        }
+        if let Some((name, rest)) = spec.split_once(':') {
+            let e = Effect::from_name(name.trim())?;
+            let info = e.info();
+            let mut v: Vec<f64> = info.params.iter().map(|p| p.typical).collect();
+            for kv in rest.split(',') {
+                let (k, val) = kv
+                    .split_once('=')
+                    .ok_or_else(|| format!("effect '{spec}': expected param=value"))?;
+                let idx = info
+                    .params
+                    .iter()
+                    .position(|p| p.name == k.trim())
+                    .ok_or_else(|| {
+                        format!(
+                            "effect '{}' has no parameter '{}'; its parameters are: {}",
+                            e,
+                            k.trim(),
+                            info.params
+                                .iter()
+                                .map(|p| p.name)
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        )
+                    })?;
+                v[idx] = val
+                    .trim()
+                    .parse()
+                    .map_err(|_| format!("effect '{spec}': '{}' is not a number", val.trim()))?;
+            }
+            self.set(e, &v);
+        } else {
+            let (name, val) = spec.split_once('=').ok_or_else(|| {
+                format!(
+                    "effect '{spec}': expected NAME=STRENGTH; valid effects are: {}",
+                    valid_names()
+                )
+            })?;
+            let e = Effect::from_name(name.trim())?;
+            let s: f64 = val
+                .trim()
+                .parse()
+                .map_err(|_| format!("effect '{spec}': '{}' is not a number", val.trim()))?;
+            self.set_strength(e, s);
+        }
+        self.check().map_err(|(_, m)| m)
+    }
+
+    fn check(&self) -> Result<(), (String, String)> {
+        for e in self.active() {
+            for (p, v) in e.info().params.iter().zip(self.values[e as usize]) {
+                if !v.is_finite() || v < p.min || v > p.max {
+                    return Err((
+                        format!("effects.{}.{}", e.name(), p.name),
+                        format!(
+                            "{v} is outside the valid range [{}, {}] ({})",
+                            p.min, p.max, p.doc
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Validates parameter ranges; errors name the key and, with `text`, the line.
+    pub fn validate(&self, source_name: &str, text: Option<&str>) -> Result<(), ParamError> {
+        self.check().map_err(|(key, reason)| {
+            let name = key.split('.').nth(1).unwrap_or("");
+            ParamError {
+                source_name: source_name.into(),
+                line: text.and_then(|t| line_of_key(t, "effects", name)),
+                key,
+                reason,
+            }
+        })
+    }
+
+    /// Reads the `[effects]` table of a motor file: `name = STRENGTH`,
+    /// `name = { param = value }` or a `[effects.name]` table; `name = "none"` or an
+    /// empty table switches everything off.
+    pub(crate) fn from_toml_table(
+        t: &toml::Table,
+        text: &str,
+        source_name: &str,
+    ) -> Result<Effects, ParamError> {
+        let mut fx = Effects::none();
+        for (name, val) in t {
+            let err = |reason: String, key: String| ParamError {
+                source_name: source_name.into(),
+                line: line_of_key(text, "effects", name),
+                key,
+                reason,
+            };
+            let e = Effect::from_name(name).map_err(|m| err(m, format!("effects.{name}")))?;
+            let info = e.info();
+            match val {
+                toml::Value::Integer(_) | toml::Value::Float(_) => {
+                    let v = num(val).unwrap_or(f64::NAN);
+                    fx.set_strength(e, v);
+                }
+                toml::Value::Table(tab) => {
+                    let mut v: Vec<f64> = vec![0.0; info.params.len()];
+                    let mut seen = vec![false; info.params.len()];
+                    for (k, x) in tab {
+                        let idx = info.params.iter().position(|p| p.name == k).ok_or_else(
+                            || {
+                                err(
+                                    format!(
+                                        "unknown parameter '{k}'; parameters of '{name}' are: {}",
+                                        info.params
+                                            .iter()
+                                            .map(|p| p.name)
+                                            .collect::<Vec<_>>()
+                                            .join(", ")
+                                    ),
+                                    format!("effects.{name}.{k}"),
+                                )
+                            },
+                        )?;
+                        v[idx] = num(x).ok_or_else(|| {
+                            err("expected a number".into(), format!("effects.{name}.{k}"))
+                        })?;
+                        seen[idx] = true;
+                    }
+                    if let Some(i) = seen.iter().position(|s| !s) {
+                        return Err(err(
+                            format!(
+                                "missing parameter '{}' ({})",
+                                info.params[i].name, info.params[i].doc
+                            ),
+                            format!("effects.{name}"),
+                        ));
+                    }
+                    fx.set(e, &v);
+                }
+                _ => {
+                    return Err(err(
+                        "expected a number (the strength) or a table of parameters".into(),
+                        format!("effects.{name}"),
+                    ))
+                }
+            }
+        }
+        fx.validate(source_name, Some(text))?;
+        Ok(fx)
+    }
+
+    /// `[effects]` section in TOML (empty string when none is on).
+    pub fn to_toml(&self) -> String {
+        if self.is_none() {
+            return "\n[effects]  # none switched on; see `trum effects`\n".into();
+        }
+        let mut s = String::from("\n[effects]\n");
+        for e in self.active() {
+            let parts: Vec<String> = e
+                .info()
+                .params
+                .iter()
+                .zip(self.values[e as usize])
+                .map(|(p, v)| format!("{} = {}", p.name, fmt_toml_number(v, false)))
+                .collect();
+            s.push_str(&format!("{} = {{ {} }}\n", e.name(), parts.join(", ")));
+        }
+        s
+    }
+}
+
+impl fmt::Display for Effects {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.is_none() {
+            return f.write_str("none");
+        }
+        let parts: Vec<String> = self
+            .active()
+            .into_iter()
+            .map(|e| {
+                let ps: Vec<String> = e
+                    .info()
+                    .params
+                    .iter()
+                    .zip(self.values[e as usize])
+                    .map(|(p, v)| format!("{}={}", p.name, v))
+                    .collect();
+                format!("{}({})", e.name(), ps.join(", "))
+            })
+            .collect();
+        f.write_str(&parts.join(" + "))
+    }
+}
+
+fn num(v: &toml::Value) -> Option<f64> {
+    match v {
+        toml::Value::Integer(i) => Some(*i as f64),
+        toml::Value::Float(x) => Some(*x),
+        _ => None,
+    }
+}
+
+// Keep the `Num` import meaningful for readers: effect values accept integers like other keys.
+#[allow(dead_code)]
+fn _accepts_integers(n: Num) -> f64 {
+    n.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_match_the_spec() {
+        let names: Vec<&str> = EFFECTS.iter().map(|e| e.name).collect();
+        assert_eq!(
+            names,
+            [
+                "radial_friction",
+                "preload_stiffening",
+                "hertz_softening",
+                "thermal_drift",
+                "voltage_sag",
+                "eccentricity",
+                "tangential_compliance"
+            ]
+        );
+        for (i, e) in ALL.iter().enumerate() {
+            assert_eq!(*e as usize, i);
+        }
+    }
+
+    #[test]
+    fn unknown_effect_lists_valid_names() {
+        let mut fx = Effects::none();
+        let err = fx.parse_assignment("radial=0.5").unwrap_err();
+        assert!(err.contains("unknown effect 'radial'"), "{err}");
+        assert!(err.contains("tangential_compliance"), "{err}");
+        let err = fx.parse_assignment("eccentricity=-1").unwrap_err();
+        assert!(err.contains("outside the valid range"), "{err}");
+    }
+
+    #[test]
+    fn assignment_forms() {
+        let mut fx = Effects::none();
+        fx.parse_assignment(
+            "thermal_drift:stiffness_coefficient_per_k=-1e-4,friction_coefficient_per_k=0",
+        )
+        .unwrap();
+        assert_eq!(fx.get(Effect::ThermalDrift), Some(&[-1e-4, 0.0][..]));
+        fx.parse_assignment("radial_friction=0.3").unwrap();
+        assert_eq!(fx.value(Effect::RadialFriction, 0), 0.3);
+        assert_eq!(fx.active().len(), 2);
+        assert_eq!(fx.to_string(), "radial_friction(radial_velocity_ratio=0.3) + thermal_drift(stiffness_coefficient_per_k=-0.0001, friction_coefficient_per_k=0)");
+        fx.parse_assignment("none").unwrap();
+        assert!(fx.is_none());
+    }
+}

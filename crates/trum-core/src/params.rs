@@ -1,0 +1,557 @@
+//! Motor parameters: the structs, the TOML motor file (`preset = "name"` plus overrides,
+//! unknown keys rejected, every value validated with the key and line named), and the
+//! annotated TOML writer that `trum presets show` uses.
+//!
+//! Keys carry their SI unit as a suffix (`mean_radius_m`, `modal_damping_ns_per_m`).
+//! Numbers may be written as TOML integers or floats.
+
+use crate::effects::Effects;
+use crate::error::ParamError;
+use serde::de::{self, Deserializer, Visitor};
+use serde::Deserialize;
+use std::fmt::Write as _;
+
+/// How a value is checked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Check {
+    /// finite and > 0
+    Positive,
+    /// finite and >= 0
+    NonNegative,
+    /// finite
+    Finite,
+    /// a whole number >= 1
+    PositiveInteger,
+}
+
+impl Check {
+    fn reason(self, v: f64) -> Option<String> {
+        if !v.is_finite() {
+            return Some(format!("{v} is not a finite number"));
+        }
+        match self {
+            Check::Positive if v <= 0.0 => Some(format!("{v} must be > 0")),
+            Check::NonNegative if v < 0.0 => Some(format!("{v} must be >= 0")),
+            Check::PositiveInteger if v < 1.0 || v.fract() != 0.0 || v > 1e6 => {
+                Some(format!("{v} must be a positive whole number"))
+            }
+            _ => None,
+        }
+    }
+}
+
+/// A number that may be written as a TOML integer or float.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Num(pub f64);
+
+impl<'de> Deserialize<'de> for Num {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = Num;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Num, E> {
+                Ok(Num(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Num, E> {
+                Ok(Num(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Num, E> {
+                Ok(Num(v as f64))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// Describes one key for documentation, validation and the TOML writer.
+#[derive(Clone, Copy, Debug)]
+pub struct KeyInfo {
+    /// Section name (`stator`).
+    pub section: &'static str,
+    /// Key name with unit suffix (`modal_mass_kg`).
+    pub key: &'static str,
+    /// One-line meaning with unit.
+    pub doc: &'static str,
+    pub(crate) check: Check,
+}
+
+macro_rules! section {
+    (
+        $(#[$m:meta])* $name:ident / $patch:ident = $sec:literal {
+            $( $(#[$fm:meta])* $field:ident : $check:ident = $doc:literal ),* $(,)?
+        }
+    ) => {
+        $(#[$m])*
+        #[derive(Clone, Debug, PartialEq)]
+        pub struct $name { $( $(#[$fm])* pub $field: f64, )* }
+
+        #[derive(Debug, Default, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub(crate) struct $patch { $( $field: Option<Num>, )* }
+
+        impl $name {
+            /// Keys of this section, in file order.
+            pub const KEYS: &'static [KeyInfo] = &[
+                $( KeyInfo { section: $sec, key: stringify!($field), doc: $doc, check: Check::$check }, )*
+            ];
+            fn values(&self) -> Vec<f64> { vec![ $( self.$field, )* ] }
+            fn apply(&mut self, p: &$patch) { $( if let Some(v) = p.$field { self.$field = v.0; } )* }
+            fn from_patch(p: &$patch) -> Result<Self, &'static str> {
+                Ok(Self { $( $field: p.$field.ok_or(stringify!($field))?.0, )* })
+            }
+            /// Mutable access by key name (for overrides from the CLI, Python and calibration).
+            pub fn get_mut(&mut self, key: &str) -> Option<&mut f64> {
+                match key { $( stringify!($field) => Some(&mut self.$field), )* _ => None }
+            }
+        }
+    };
+}
+
+section! {
+    /// Ring geometry and kinematics (seed 000 Table A1, seed 001 Table 1).
+    Geometry / GeometryPatch = "geometry" {
+        /// N: number of traveling waves around the ring (9 for the TRUM-60 family).
+        wave_number: PositiveInteger = "number of traveling waves N around the ring [-]",
+        /// R0: mean radius of the stator/rotor contact ring [m].
+        mean_radius_m: Positive = "mean radius R0 of the contact ring [m]",
+        /// b_f: radial width of the contact (friction layer) [m].
+        contact_width_m: Positive = "radial width b_f of the friction-layer contact [m]",
+        /// h0: distance from the stator tooth surface to the neutral plane [m] (seed 001 eq. 12).
+        neutral_plane_distance_m: Positive = "distance h0 from tooth surface to neutral plane [m]",
+    }
+}
+
+section! {
+    /// Friction layer bonded to the rotor (seed 001 eq. 4).
+    FrictionLayer / FrictionLayerPatch = "friction_layer" {
+        /// E_f: Young's modulus of the friction layer [Pa].
+        youngs_modulus_pa: Positive = "Young's modulus E_f of the friction layer [Pa]",
+        /// h_f: thickness of the friction layer [m].
+        thickness_m: Positive = "thickness h_f of the friction layer [m]",
+        /// μ: Coulomb friction coefficient stator/friction layer [-].
+        friction_coefficient: Positive = "Coulomb friction coefficient mu [-]",
+    }
+}
+
+section! {
+    /// Modal model of the stator: one traveling wave = two degenerate standing modes
+    /// (seed 001 eq. 6; seed 000 Appendix A).
+    Stator / StatorPatch = "stator" {
+        /// m: modal mass of each standing mode, mode shape normalised to 1 at the contact surface [kg].
+        modal_mass_kg: Positive = "modal mass m of each standing mode [kg]",
+        /// f_r: resonance frequency of the free stator (no contact) [Hz].
+        resonance_frequency_hz: Positive = "resonance frequency f_r of the free stator [Hz]",
+        /// c: modal damping of each standing mode [N·s/m].
+        modal_damping_ns_per_m: Positive = "modal damping c of each standing mode [N s/m]",
+        /// Θ: electromechanical force factor, modal force per volt [N/V].
+        force_factor_n_per_v: Positive = "force factor Theta, modal force per phase volt [N/V]",
+    }
+}
+
+section! {
+    /// Electrical side of the piezoceramic (seed 000 eq. 7, seed 001 eq. 1 and 15).
+    Electrical / ElectricalPatch = "electrical" {
+        /// C0: clamped capacitance of one phase [F].
+        clamped_capacitance_f: NonNegative = "clamped capacitance C0 of one phase [F]",
+        /// tan δ: dielectric loss tangent [-].
+        dielectric_loss_tangent: NonNegative = "dielectric loss tangent tan(delta) [-]",
+        /// K_WV: feedback (isolated) electrode voltage amplitude per metre of wave amplitude [V/m].
+        feedback_gain_v_per_m: NonNegative = "feedback-electrode volts per metre of amplitude K_WV [V/m]",
+    }
+}
+
+section! {
+    /// Rotor (seed 000 Table A1).
+    Rotor / RotorPatch = "rotor" {
+        /// d_r: viscous (bearing/air) rotor damping torque per angular speed [N·m·s].
+        viscous_damping_nms: NonNegative = "rotor viscous damping d_r [N m s]",
+        /// J_r: rotor moment of inertia [kg·m²].
+        inertia_kg_m2: Positive = "rotor moment of inertia J_r [kg m^2]",
+        /// m_r: rotor mass [kg].
+        mass_kg: Positive = "rotor mass m_r [kg]",
+    }
+}
+
+section! {
+    /// Lumped thermal model of the motor (seed 000 eq. 11).
+    Thermal / ThermalPatch = "thermal" {
+        /// α: convective heat-transfer coefficient [W/(m²·K)].
+        heat_transfer_coefficient_w_per_m2k: Positive = "convective heat-transfer coefficient alpha [W/(m^2 K)]",
+        /// S: motor surface area exchanging heat [m²].
+        surface_area_m2: Positive = "motor surface area S [m^2]",
+        /// C_usm: heat capacity of the motor [J/K].
+        heat_capacity_j_per_k: Positive = "heat capacity C_usm of the motor [J/K]",
+        /// T_air: ambient temperature [°C].
+        ambient_c: Finite = "ambient temperature T_air [degC]",
+    }
+}
+
+section! {
+    /// Assembly of the preload path (seed 000 section 4.3).
+    Assembly / AssemblyPatch = "assembly" {
+        /// k_sp: axial stiffness of the preload spring (disc spring or gasket) [N/m].
+        axial_spring_stiffness_n_per_m: Positive = "axial stiffness of the preload spring [N/m]",
+    }
+}
+
+/// A complete motor definition. Build one from a preset ([`crate::presets::preset`]) or
+/// a TOML motor file ([`Motor::from_toml_str`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Motor {
+    /// Display name.
+    pub name: String,
+    /// The preset this motor started from, if any.
+    pub preset: Option<String>,
+    /// Ring geometry.
+    pub geometry: Geometry,
+    /// Friction layer.
+    pub friction_layer: FrictionLayer,
+    /// Stator modal model.
+    pub stator: Stator,
+    /// Electrical parameters.
+    pub electrical: Electrical,
+    /// Rotor.
+    pub rotor: Rotor,
+    /// Thermal model.
+    pub thermal: Thermal,
+    /// Preload path and assembly errors.
+    pub assembly: Assembly,
+    /// Switched-on unmodelled effects (none by default).
+    pub effects: Effects,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MotorFile {
+    name: Option<String>,
+    preset: Option<String>,
+    geometry: Option<GeometryPatch>,
+    friction_layer: Option<FrictionLayerPatch>,
+    stator: Option<StatorPatch>,
+    electrical: Option<ElectricalPatch>,
+    rotor: Option<RotorPatch>,
+    thermal: Option<ThermalPatch>,
+    assembly: Option<AssemblyPatch>,
+    effects: Option<toml::Table>,
+}
+
+/// 1-based line of `key` inside `[section]` (or a dotted/inline form) in TOML text.
+/// Used only to point error messages at the right line; `None` when not found.
+pub(crate) fn line_of_key(text: &str, section: &str, key: &str) -> Option<usize> {
+    let mut current = String::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.trim();
+        if let Some(h) = line.strip_prefix('[') {
+            current = h
+                .trim_end_matches(']')
+                .trim()
+                .trim_end_matches(']')
+                .trim()
+                .to_string();
+            if !section.is_empty() && current == format!("{section}.{key}") {
+                return Some(i + 1);
+            }
+            continue;
+        }
+        let lhs = line.split('=').next().unwrap_or("").trim();
+        let full = if current.is_empty() {
+            lhs.to_string()
+        } else {
+            format!("{current}.{lhs}")
+        };
+        let want = if section.is_empty() {
+            key.to_string()
+        } else {
+            format!("{section}.{key}")
+        };
+        if full == want || (current.is_empty() && lhs == want) {
+            return Some(i + 1);
+        }
+    }
+    None
+}
+
+/// 1-based line number of a byte offset.
+pub(crate) fn line_of_offset(text: &str, offset: usize) -> usize {
+    text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+impl Motor {
+    /// All keys of the numeric sections, in file order.
+    pub fn all_keys() -> Vec<KeyInfo> {
+        [
+            Geometry::KEYS,
+            FrictionLayer::KEYS,
+            Stator::KEYS,
+            Electrical::KEYS,
+            Rotor::KEYS,
+            Thermal::KEYS,
+            Assembly::KEYS,
+        ]
+        .concat()
+    }
+
+    fn values(&self) -> Vec<f64> {
+        [
+            self.geometry.values(),
+            self.friction_layer.values(),
+            self.stator.values(),
+            self.electrical.values(),
+            self.rotor.values(),
+            self.thermal.values(),
+            self.assembly.values(),
+        ]
+        .concat()
+    }
+
+    /// Mutable access to a numeric parameter by dotted key (`stator.modal_mass_kg`).
+    pub fn param_mut(&mut self, dotted: &str) -> Option<&mut f64> {
+        let (sec, key) = dotted.split_once('.')?;
+        match sec {
+            "geometry" => self.geometry.get_mut(key),
+            "friction_layer" => self.friction_layer.get_mut(key),
+            "stator" => self.stator.get_mut(key),
+            "electrical" => self.electrical.get_mut(key),
+            "rotor" => self.rotor.get_mut(key),
+            "thermal" => self.thermal.get_mut(key),
+            "assembly" => self.assembly.get_mut(key),
+            _ => None,
+        }
+    }
+
+    /// Value of a numeric parameter by dotted key.
+    pub fn param(&self, dotted: &str) -> Option<f64> {
+        self.clone().param_mut(dotted).map(|v| *v)
+    }
+
+    /// Sets a numeric parameter by dotted key and validates it.
+    pub fn set_param(
+        &mut self,
+        dotted: &str,
+        value: f64,
+        source_name: &str,
+    ) -> Result<(), ParamError> {
+        let valid = Self::all_keys()
+            .iter()
+            .map(|k| format!("{}.{}", k.section, k.key))
+            .collect::<Vec<_>>();
+        let slot = self.param_mut(dotted).ok_or_else(|| ParamError {
+            source_name: source_name.into(),
+            line: None,
+            key: dotted.into(),
+            reason: format!("unknown parameter; valid keys are: {}", valid.join(", ")),
+        })?;
+        *slot = value;
+        self.validate(source_name, None)
+    }
+
+    /// Checks every value (finite, sign, integrality, and the physical consistency checks
+    /// the model needs). `text` lets errors point at a line of the TOML source.
+    pub fn validate(&self, source_name: &str, text: Option<&str>) -> Result<(), ParamError> {
+        for (info, v) in Self::all_keys().iter().zip(self.values()) {
+            if let Some(reason) = info.check.reason(v) {
+                return Err(ParamError {
+                    source_name: source_name.into(),
+                    line: text.and_then(|t| line_of_key(t, info.section, info.key)),
+                    key: format!("{}.{}", info.section, info.key),
+                    reason,
+                });
+            }
+        }
+        // The friction layer must be thinner than the neutral-plane distance is irrelevant;
+        // but the contact model needs a contact radius larger than the wave's width scale.
+        let k = self.geometry.wave_number / self.geometry.mean_radius_m;
+        if k * self.geometry.contact_width_m > 2.0 * std::f64::consts::PI {
+            return Err(ParamError {
+                source_name: source_name.into(),
+                line: text.and_then(|t| line_of_key(t, "geometry", "contact_width_m")),
+                key: "geometry.contact_width_m".into(),
+                reason: "contact width exceeds one wavelength; check units (metres)".into(),
+            });
+        }
+        self.effects.validate(source_name, text)
+    }
+
+    /// Reads a TOML motor file. `source_name` is used in error messages (the file name).
+    ///
+    /// With `preset = "name"` every other key is an override; without it every key of
+    /// every section is required. Unknown keys and sections are errors.
+    pub fn from_toml_str(text: &str, source_name: &str) -> Result<Motor, ParamError> {
+        let file: MotorFile = toml::from_str(text).map_err(|e| {
+            let line = e.span().map(|s| line_of_offset(text, s.start));
+            let token = e
+                .span()
+                .map(|s| text.get(s.clone()).unwrap_or("").trim().to_string())
+                .unwrap_or_default();
+            let msg = e.message().trim().to_string();
+            let msg = msg
+                .replace("unknown field", "unknown key")
+                .replace("field", "key");
+            ParamError {
+                source_name: source_name.into(),
+                line,
+                key: if token.len() < 64
+                    && !token.contains('\n')
+                    && !token.is_empty()
+                    && msg.starts_with("unknown")
+                {
+                    token
+                } else {
+                    String::new()
+                },
+                reason: msg,
+            }
+        })?;
+        let mut motor = match &file.preset {
+            Some(p) => crate::presets::preset(p).map_err(|mut e| {
+                e.source_name = source_name.into();
+                e.line = line_of_key(text, "", "preset");
+                e.key = "preset".into();
+                e
+            })?,
+            None => Self::from_complete_file(&file, text, source_name)?,
+        };
+        macro_rules! apply {
+            ($($sec:ident),*) => { $( if let Some(p) = &file.$sec { motor.$sec.apply(p); } )* };
+        }
+        apply!(
+            geometry,
+            friction_layer,
+            stator,
+            electrical,
+            rotor,
+            thermal,
+            assembly
+        );
+        if let Some(name) = &file.name {
+            motor.name = name.clone();
+        } else if file.preset.is_none() {
+            motor.name = source_name.to_string();
+        }
+        motor.preset = file.preset.clone();
+        if let Some(t) = &file.effects {
+            motor.effects = Effects::from_toml_table(t, text, source_name)?;
+        }
+        motor.validate(source_name, Some(text))?;
+        Ok(motor)
+    }
+
+    fn from_complete_file(
+        file: &MotorFile,
+        text: &str,
+        source_name: &str,
+    ) -> Result<Motor, ParamError> {
+        let missing = |sec: &str, key: &str| ParamError {
+            source_name: source_name.into(),
+            line: None,
+            key: if key.is_empty() {
+                sec.to_string()
+            } else {
+                format!("{sec}.{key}")
+            },
+            reason: if key.is_empty() {
+                "missing section (without `preset = \"...\"` every section and key is required)"
+                    .into()
+            } else {
+                "missing key (without `preset = \"...\"` every key is required)".into()
+            },
+        };
+        let _ = text;
+        macro_rules! build {
+            ($sec:ident, $ty:ident) => {
+                match &file.$sec {
+                    None => return Err(missing(stringify!($sec), "")),
+                    Some(p) => $ty::from_patch(p).map_err(|k| missing(stringify!($sec), k))?,
+                }
+            };
+        }
+        Ok(Motor {
+            name: String::new(),
+            preset: None,
+            geometry: build!(geometry, Geometry),
+            friction_layer: build!(friction_layer, FrictionLayer),
+            stator: build!(stator, Stator),
+            electrical: build!(electrical, Electrical),
+            rotor: build!(rotor, Rotor),
+            thermal: build!(thermal, Thermal),
+            assembly: build!(assembly, Assembly),
+            effects: Effects::none(),
+        })
+    }
+
+    /// Writes the motor as a complete, commented TOML motor file that
+    /// [`Motor::from_toml_str`] reads back to an identical `Motor`. `notes` maps a dotted
+    /// key to its provenance (paper value, assumed, calibrated) and is written as comments.
+    pub fn to_toml_annotated(
+        &self,
+        header: &str,
+        notes: &dyn Fn(&str) -> Option<String>,
+    ) -> String {
+        let mut s = String::new();
+        for l in header.lines() {
+            let _ = writeln!(s, "# {l}").map(|_| ());
+            if l.is_empty() {
+                s.pop();
+                s.pop();
+                s.push('\n');
+            }
+        }
+        let _ = writeln!(s, "name = {}", toml_string(&self.name));
+        let mut section = "";
+        for (info, v) in Self::all_keys().iter().zip(self.values()) {
+            if info.section != section {
+                section = info.section;
+                let _ = writeln!(s, "\n[{section}]");
+            }
+            let dotted = format!("{}.{}", info.section, info.key);
+            let val = fmt_toml_number(v, info.check == Check::PositiveInteger);
+            let note = notes(&dotted)
+                .map(|n| format!(" ({n})"))
+                .unwrap_or_default();
+            let _ = writeln!(s, "{} = {}  # {}{}", info.key, val, info.doc, note);
+        }
+        s.push_str(&self.effects.to_toml());
+        s
+    }
+
+    /// Plain TOML (no provenance notes).
+    pub fn to_toml(&self) -> String {
+        self.to_toml_annotated(&format!("trum motor file: {}", self.name), &|_| None)
+    }
+}
+
+/// A TOML float or integer literal that reads back bit-identical.
+pub(crate) fn fmt_toml_number(v: f64, integer: bool) -> String {
+    if integer && v.fract() == 0.0 && v.abs() < 1e15 {
+        return format!("{}", v as i64);
+    }
+    // `{:?}` gives the shortest representation that round-trips; make sure it reads as a float.
+    let s = format!("{v:?}");
+    if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
+        s
+    } else {
+        format!("{s}.0")
+    }
+}
+
+pub(crate) fn toml_string(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04X}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}

@@ -1,0 +1,595 @@
+//! The steady state of one operating point: stator amplitude, contact and stick angles,
+//! torque, speed, every loss, efficiency, current and feedback voltage, solved together.
+//!
+//! Unknown: the wave amplitude W. For a trial W the contact zone follows from the
+//! preload ([`crate::contact::contact_from_ratio`]), the stick angle from the torque
+//! balance ([`crate::contact::stick_half_angle_rad`]), and then the friction forces'
+//! equivalent damping gives a new amplitude W' = Θ·V/|Z(W)| ([`crate::stator`]). The
+//! steady state is the fixed point W = W'. Because W' is bounded by Θ·V/(ω·c) and grows
+//! with W, iterating from that bound descends monotonically onto the largest fixed point
+//! (the running branch); secant/regula-falsi steps inside the bracket make it converge
+//! in a handful of evaluations.
+
+use crate::contact::{self, Contact};
+use crate::effects::Effect;
+use crate::params::Motor;
+use crate::stator;
+use std::f64::consts::PI;
+
+/// Convert rad/s to rev/min.
+pub const RAD_S_TO_RPM: f64 = 60.0 / (2.0 * PI);
+
+/// One operating point. All fields SI.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OperatingPoint {
+    /// Axial preload pressing the rotor on the stator [N], > 0.
+    pub preload_n: f64,
+    /// Load torque on the rotor [N·m], ≥ 0.
+    pub torque_nm: f64,
+    /// Drive voltage amplitude per phase, zero-to-peak [V], > 0.
+    pub voltage_v: f64,
+    /// Drive frequency [Hz], > 0.
+    pub frequency_hz: f64,
+    /// Time since the drive was switched on [s], ≥ 0 (only `thermal_drift` uses it).
+    pub elapsed_s: f64,
+}
+
+impl OperatingPoint {
+    /// A steady operating point (elapsed time 0).
+    pub fn new(preload_n: f64, torque_nm: f64, voltage_v: f64, frequency_hz: f64) -> Self {
+        OperatingPoint {
+            preload_n,
+            torque_nm,
+            voltage_v,
+            frequency_hz,
+            elapsed_s: 0.0,
+        }
+    }
+
+    /// Why the point is invalid, if it is.
+    pub fn invalid_reason(&self) -> Option<String> {
+        let checks = [
+            ("preload_n", self.preload_n, true),
+            ("voltage_v", self.voltage_v, true),
+            ("frequency_hz", self.frequency_hz, true),
+            ("torque_nm", self.torque_nm, false),
+            ("elapsed_s", self.elapsed_s, false),
+        ];
+        for (name, v, strict) in checks {
+            if !v.is_finite() {
+                return Some(format!("{name} = {v} is not a finite number"));
+            }
+            if strict && v <= 0.0 {
+                return Some(format!("{name} = {v} must be > 0"));
+            }
+            if !strict && v < 0.0 {
+                return Some(format!("{name} = {v} must be >= 0"));
+            }
+        }
+        None
+    }
+}
+
+/// Whether the model has a physical solution at the point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Status {
+    /// Converged, rotor turning.
+    Ok,
+    /// The load torque is at or above the stall (blocking) torque: the rotor is at rest.
+    /// All quantities are valid (speed and output power are zero).
+    Stall,
+    /// The friction forces clamp the stator: no vibrating steady state exists at this
+    /// drive (amplitude zero). Valid, with zero amplitude, speed and output.
+    Clamped,
+    /// The iteration did not converge; numbers are the last iterate and must not be used.
+    NoConvergence,
+    /// The operating point itself is invalid (non-finite, non-positive preload, ...).
+    InvalidInput,
+}
+
+impl Status {
+    /// The word written in status columns.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Stall => "stall",
+            Status::Clamped => "clamped",
+            Status::NoConvergence => "no_convergence",
+            Status::InvalidInput => "invalid_input",
+        }
+    }
+    /// True when the numbers describe a physical steady state.
+    pub fn is_valid(self) -> bool {
+        matches!(self, Status::Ok | Status::Stall | Status::Clamped)
+    }
+}
+
+impl std::fmt::Display for Status {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Every quantity of one steady operating point (SI, unit in each name).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Solution {
+    /// Whether the numbers are a physical steady state.
+    pub status: Status,
+    /// True when the rotor touches the whole wave.
+    pub full_contact: bool,
+    /// Amplitude evaluations the solver used.
+    pub iterations: u32,
+    /// Wave amplitude W at the contact surface [m].
+    pub amplitude_m: f64,
+    /// Contact half-angle φ0 in wave phase [rad].
+    pub contact_half_angle_rad: f64,
+    /// Contact angle Xc, full arc in mechanical degrees (0-40° for N = 9).
+    pub contact_angle_deg: f64,
+    /// Contact length 2·x0 per wave [m].
+    pub contact_length_m: f64,
+    /// Stick (equal-speed) half-angle θs in wave phase [rad].
+    pub stick_half_angle_rad: f64,
+    /// Driving angle Xs, full arc in mechanical degrees.
+    pub driving_angle_deg: f64,
+    /// Proportion of the driving zone in the contact zone, θs/φ0 [-].
+    pub driving_ratio: f64,
+    /// Rotor speed [rad/s].
+    pub speed_rad_s: f64,
+    /// Rotor speed [rev/min].
+    pub speed_rpm: f64,
+    /// Peak tangential speed of the stator surface at the crest [m/s].
+    pub crest_speed_m_s: f64,
+    /// Load torque [N·m].
+    pub torque_nm: f64,
+    /// Stall (blocking) torque at this preload and drive [N·m].
+    pub stall_torque_nm: f64,
+    /// Axial contact force [N] (equals the preload at equilibrium).
+    pub axial_force_n: f64,
+    /// Electrical input power, both phases [W].
+    pub input_power_w: f64,
+    /// Mechanical output power T_load·Ω [W].
+    pub output_power_w: f64,
+    /// Dielectric loss of the piezoceramic, both phases [W].
+    pub dielectric_loss_w: f64,
+    /// Structural damping loss of the stator [W].
+    pub damping_loss_w: f64,
+    /// Friction loss in the contact interface [W].
+    pub friction_loss_w: f64,
+    /// Of which radial slip (nonzero only with `radial_friction`) [W].
+    pub radial_friction_loss_w: f64,
+    /// Rotor viscous loss d_r·Ω² [W].
+    pub rotor_loss_w: f64,
+    /// Output power / input power, in [0, 1].
+    pub efficiency: f64,
+    /// Feedback-electrode voltage amplitude [V].
+    pub feedback_v: f64,
+    /// Drive current amplitude per phase [A].
+    pub current_a: f64,
+    /// Voltage at the electrodes, zero-to-peak [V] (below the set voltage with `voltage_sag`).
+    pub electrode_voltage_v: f64,
+    /// Phase lag ψ of the wave behind the drive [rad].
+    pub phase_lag_rad: f64,
+    /// Effective modal stiffness including effects [N/m].
+    pub modal_stiffness_n_per_m: f64,
+    /// Steady-state temperature rise of the motor over ambient [K] (seed 000 eq. 11, t → ∞).
+    pub temperature_rise_k: f64,
+    /// Temperature rise at the point's elapsed time [K] (seed 000 eq. 11).
+    pub temperature_rise_at_elapsed_k: f64,
+    /// Standard deviation of speed over a revolution [rev/min] (nonzero with `eccentricity`).
+    pub speed_std_rpm: f64,
+}
+
+impl Solution {
+    /// Sum of all losses [W].
+    pub fn total_loss_w(&self) -> f64 {
+        self.dielectric_loss_w + self.damping_loss_w + self.friction_loss_w + self.rotor_loss_w
+    }
+
+    fn invalid(status: Status) -> Solution {
+        let n = f64::NAN;
+        Solution {
+            status,
+            full_contact: false,
+            iterations: 0,
+            amplitude_m: n,
+            contact_half_angle_rad: n,
+            contact_angle_deg: n,
+            contact_length_m: n,
+            stick_half_angle_rad: n,
+            driving_angle_deg: n,
+            driving_ratio: n,
+            speed_rad_s: n,
+            speed_rpm: n,
+            crest_speed_m_s: n,
+            torque_nm: n,
+            stall_torque_nm: n,
+            axial_force_n: n,
+            input_power_w: n,
+            output_power_w: n,
+            dielectric_loss_w: n,
+            damping_loss_w: n,
+            friction_loss_w: n,
+            radial_friction_loss_w: n,
+            rotor_loss_w: n,
+            efficiency: n,
+            feedback_v: n,
+            current_a: n,
+            electrode_voltage_v: n,
+            phase_lag_rad: n,
+            modal_stiffness_n_per_m: n,
+            temperature_rise_k: n,
+            temperature_rise_at_elapsed_k: n,
+            speed_std_rpm: n,
+        }
+    }
+}
+
+/// Motor constants the solver needs, computed once per motor.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    pub(crate) n: f64,
+    pub(crate) r0: f64,
+    pub(crate) k: f64,
+    pub(crate) kf: f64,
+    pub(crate) h0: f64,
+    pub(crate) mu: f64,
+    pub(crate) m: f64,
+    pub(crate) ks: f64,
+    pub(crate) c: f64,
+    pub(crate) theta: f64,
+    pub(crate) c0: f64,
+    pub(crate) tan_d: f64,
+    pub(crate) kfb: f64,
+    pub(crate) dr: f64,
+    pub(crate) alpha_s: f64,
+    pub(crate) heat_cap: f64,
+    pub(crate) stiffening: f64,
+    pub(crate) beta: f64,
+    pub(crate) beta_gain: f64,
+}
+
+impl Prepared {
+    /// Precomputes the constants of `motor`.
+    pub fn new(motor: &Motor) -> Prepared {
+        let g = &motor.geometry;
+        let fl = &motor.friction_layer;
+        let st = &motor.stator;
+        let fx = &motor.effects;
+        Prepared {
+            n: g.wave_number,
+            r0: g.mean_radius_m,
+            k: g.wave_number / g.mean_radius_m,
+            kf: contact::layer_stiffness_n_per_m2(
+                fl.youngs_modulus_pa,
+                g.contact_width_m,
+                fl.thickness_m,
+            ),
+            h0: g.neutral_plane_distance_m,
+            mu: fl.friction_coefficient,
+            m: st.modal_mass_kg,
+            ks: stator::modal_stiffness_n_per_m(st.modal_mass_kg, st.resonance_frequency_hz),
+            c: st.modal_damping_ns_per_m,
+            theta: st.force_factor_n_per_v,
+            c0: motor.electrical.clamped_capacitance_f,
+            tan_d: motor.electrical.dielectric_loss_tangent,
+            kfb: motor.electrical.feedback_gain_v_per_m,
+            dr: motor.rotor.viscous_damping_nms,
+            alpha_s: motor.thermal.heat_transfer_coefficient_w_per_m2k
+                * motor.thermal.surface_area_m2,
+            heat_cap: motor.thermal.heat_capacity_j_per_k,
+            stiffening: fx.value(Effect::PreloadStiffening, 0),
+            beta: fx.value(Effect::HertzSoftening, 0),
+            beta_gain: fx.value(Effect::HertzSoftening, 1),
+        }
+    }
+}
+
+/// Everything that follows from one trial amplitude.
+#[derive(Clone, Copy, Debug)]
+struct Trial {
+    w: f64,
+    contact: Contact,
+    ts: f64,
+    stalled: bool,
+    a: f64,
+    v0: f64,
+    z: (f64, f64),
+    k_eff: f64,
+    /// Θ·V/|Z|: the amplitude this trial implies.
+    w_next: f64,
+}
+
+/// Per-point inputs after effects that act on the drive (voltage sag, thermal state).
+#[derive(Clone, Copy, Debug)]
+struct Drive {
+    f_n: f64,
+    t_load: f64,
+    v: f64,
+    omega: f64,
+    mu: f64,
+    ks: f64,
+}
+
+fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>) -> Trial {
+    let a = contact::force_scale_n(p.n, p.kf, w, p.k);
+    let ct = contact::contact_from_ratio(d.f_n / a);
+    let v0 = stator::crest_surface_speed_m_s(p.k, p.h0, d.omega, w);
+    let tscale = p.r0 * d.mu * a;
+    let visc = p.dr * v0 / p.r0;
+    let (ts, stalled) = match contact::stick_half_angle_rad(&ct, tscale, d.t_load, visc, ts_guess) {
+        Some(t) => (t, false),
+        None => (contact::stall_stick_half_angle_rad(&ct), true),
+    };
+    // Friction damping: power taken from the wave over (ω W)², per unit ω: c_t·ω = 2Nμk_f·h0·[2E(θs) − E(φ0)].
+    let pf = 2.0 * contact::e_int(ts, ct.offset) - contact::e_int(ct.half_angle_rad, ct.offset);
+    let ct_omega = 2.0 * p.n * d.mu * p.kf * p.h0 * pf;
+    let mut k_eff = d.ks;
+    if p.stiffening != 0.0 {
+        // seed 001 eq. 8: k_s' = (2 n k_f / k)·[sin(kx0) − kx0·cos(kx0)] = A·χ(φ0)/W.
+        k_eff += p.stiffening * a * ct.chi0() / w;
+    }
+    if p.beta != 0.0 {
+        // seed 003: softening cubic term, harmonic balance ⇒ k − (3/4)·β·W².
+        k_eff -= 0.75 * p.beta * (1.0 + p.beta_gain * d.f_n) * w * w;
+    }
+    let z = (k_eff - p.m * d.omega * d.omega, d.omega * p.c + ct_omega);
+    let w_next = p.theta * d.v / (z.0 * z.0 + z.1 * z.1).sqrt();
+    Trial {
+        w,
+        contact: ct,
+        ts,
+        stalled,
+        a,
+        v0,
+        z,
+        k_eff,
+        w_next,
+    }
+}
+
+/// Solves one operating point from scratch. Never panics; an invalid or unsolvable point
+/// is reported in [`Solution::status`].
+pub fn solve(motor: &Motor, op: &OperatingPoint) -> Solution {
+    solve_prepared(&Prepared::new(motor), motor, op, None)
+}
+
+/// Solves one operating point, optionally warm-started from a neighbouring solution
+/// (sweeps use this; the result does not depend on the guess beyond the tolerance).
+pub fn solve_prepared(
+    p: &Prepared,
+    motor: &Motor,
+    op: &OperatingPoint,
+    guess: Option<&Solution>,
+) -> Solution {
+    if op.invalid_reason().is_some() {
+        return Solution::invalid(Status::InvalidInput);
+    }
+    let d = Drive {
+        f_n: op.preload_n,
+        t_load: op.torque_nm,
+        v: op.voltage_v,
+        omega: stator::angular_frequency(op.frequency_hz),
+        mu: p.mu,
+        ks: p.ks,
+    };
+    let _ = motor;
+    solve_drive(p, &d, op, guess)
+}
+
+fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
+    const RTOL: f64 = 1e-12;
+    // Upper bound: |Z| ≥ ω·c, so W' ≤ Θ·V/(ω·c). Softening could in principle exceed it;
+    // the bracket is then grown below.
+    let w_hi0 = p.theta * d.v / (d.omega * p.c);
+    let mut evals = 0u32;
+    let mut ts_guess = guess
+        .map(|g| g.stick_half_angle_rad)
+        .filter(|t| t.is_finite());
+    let mut eval = |w: f64, ts_guess: &mut Option<f64>| {
+        evals += 1;
+        let t = trial(p, d, w, *ts_guess);
+        *ts_guess = Some(t.ts);
+        t
+    };
+    // Upper bracket: r(W) = W − W' ≥ 0.
+    let mut hi = eval(w_hi0, &mut ts_guess);
+    let mut grow = 0;
+    while hi.w < hi.w_next && grow < 60 {
+        hi = eval(hi.w_next * 1.5, &mut ts_guess);
+        grow += 1;
+    }
+    let mut lo: Option<Trial> = None;
+    // Start: warm guess if it lies inside the bracket, else one fixed-point step from the top.
+    let start = guess
+        .map(|g| g.amplitude_m)
+        .filter(|w| w.is_finite() && *w > 0.0 && *w < hi.w)
+        .unwrap_or(hi.w_next);
+    let mut cur = eval(start, &mut ts_guess);
+    let mut prev: Option<Trial> = None;
+    let mut converged = false;
+    let mut side_lo = 0; // Illinois bookkeeping
+    let mut side_hi = 0;
+    for _ in 0..200 {
+        let r = cur.w - cur.w_next;
+        if r.abs() <= RTOL * cur.w.max(1e-300) {
+            converged = true;
+            break;
+        }
+        if r > 0.0 {
+            hi = cur;
+            side_hi += 1;
+            side_lo = 0;
+        } else {
+            lo = Some(cur);
+            side_lo += 1;
+            side_hi = 0;
+        }
+        if cur.w < 1e-9 * w_hi0 && r > 0.0 && lo.is_none() {
+            // Descending towards zero with W' < W: the only fixed point is W = 0 (clamped).
+            break;
+        }
+        let next = match lo {
+            Some(l) => {
+                // Regula falsi (Illinois) inside [lo, hi].
+                let mut rl = l.w - l.w_next;
+                let mut rh = hi.w - hi.w_next;
+                if side_lo >= 2 {
+                    rh *= 0.5;
+                }
+                if side_hi >= 2 {
+                    rl *= 0.5;
+                }
+                let x = l.w - rl * (hi.w - l.w) / (rh - rl);
+                if x > l.w && x < hi.w {
+                    x
+                } else {
+                    0.5 * (l.w + hi.w)
+                }
+            }
+            None => {
+                // Secant from the previous iterate if it moves down; else a fixed-point step.
+                let fp = cur.w_next;
+                match prev {
+                    Some(pv) => {
+                        let rp = pv.w - pv.w_next;
+                        let x = cur.w - r * (cur.w - pv.w) / (r - rp);
+                        if x.is_finite() && x > 0.0 && x < cur.w {
+                            x
+                        } else {
+                            fp
+                        }
+                    }
+                    None => fp,
+                }
+            }
+        };
+        prev = Some(cur);
+        cur = eval(next, &mut ts_guess);
+    }
+    if !converged {
+        if cur.w < 1e-9 * w_hi0 {
+            return finish(p, d, op, &clamped_trial(p, d), Status::Clamped, evals);
+        }
+        let mut s = finish(p, d, op, &cur, Status::NoConvergence, evals);
+        s.status = Status::NoConvergence;
+        return s;
+    }
+    // Use the trial consistent with the converged amplitude for every output.
+    let t = cur;
+    let status = if t.stalled { Status::Stall } else { Status::Ok };
+    finish(p, d, op, &t, status, evals)
+}
+
+fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {
+    Trial {
+        w: 0.0,
+        contact: Contact {
+            half_angle_rad: PI,
+            offset: f64::NEG_INFINITY,
+            full: true,
+        },
+        ts: 0.5 * PI,
+        stalled: true,
+        a: 0.0,
+        v0: 0.0,
+        z: (p.ks - p.m * d.omega * d.omega, f64::INFINITY),
+        k_eff: d.ks,
+        w_next: 0.0,
+    }
+}
+
+fn finish(
+    p: &Prepared,
+    d: &Drive,
+    op: &OperatingPoint,
+    t: &Trial,
+    status: Status,
+    evals: u32,
+) -> Solution {
+    let w = t.w;
+    let ct = &t.contact;
+    let clamped = status == Status::Clamped;
+    let speed = if t.stalled {
+        0.0
+    } else {
+        t.v0 * t.ts.cos() / p.r0
+    };
+    let vr = speed * p.r0;
+    let stall_torque = if clamped {
+        0.0
+    } else {
+        p.r0 * d.mu * t.a * contact::torque_factor(contact::stall_stick_half_angle_rad(ct), ct)
+    };
+    // Friction loss = ∫ μ p |v_s − v_r| dx: closed form of crate::losses::friction_loss_coulomb_w.
+    let friction = if clamped {
+        0.0
+    } else {
+        crate::losses::friction_loss_coulomb_w(p.n, d.mu, p.kf, w, p.k, t.v0, vr, t.ts, ct)
+    };
+    let omega = d.omega;
+    let damping = p.c * omega * omega * w * w;
+    let dielectric = crate::losses::dielectric_loss_w(omega, p.c0, p.tan_d, d.v);
+    let rotor = p.dr * speed * speed;
+    let output = if t.stalled { 0.0 } else { op.torque_nm * speed };
+    let (ire, iim) = if clamped {
+        (d.v * omega * p.c0 * p.tan_d, d.v * omega * p.c0)
+    } else {
+        stator::phase_current_a(d.v, omega, p.c0, p.tan_d, p.theta, t.z)
+    };
+    let input = d.v * ire;
+    let losses = dielectric + damping + friction + rotor;
+    let efficiency = if input > 0.0 {
+        (output / input).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let rise_ss = losses / p.alpha_s;
+    let rise_t = rise_ss * (1.0 - (-p.alpha_s * op.elapsed_s / p.heat_cap).exp());
+    let xc = contact::contact_angle_deg(ct.half_angle_rad, p.n);
+    Solution {
+        status,
+        full_contact: ct.full,
+        iterations: evals,
+        amplitude_m: w,
+        contact_half_angle_rad: ct.half_angle_rad,
+        contact_angle_deg: xc,
+        contact_length_m: contact::contact_length_m(ct.half_angle_rad, p.k),
+        stick_half_angle_rad: t.ts,
+        driving_angle_deg: contact::contact_angle_deg(t.ts, p.n),
+        driving_ratio: if ct.half_angle_rad > 0.0 {
+            t.ts / ct.half_angle_rad
+        } else {
+            0.0
+        },
+        speed_rad_s: speed,
+        speed_rpm: speed * RAD_S_TO_RPM,
+        crest_speed_m_s: t.v0,
+        torque_nm: op.torque_nm,
+        stall_torque_nm: stall_torque,
+        axial_force_n: if clamped {
+            op.preload_n
+        } else {
+            t.a * ct.chi0()
+        },
+        input_power_w: input,
+        output_power_w: output,
+        dielectric_loss_w: dielectric,
+        damping_loss_w: damping,
+        friction_loss_w: friction,
+        radial_friction_loss_w: 0.0,
+        rotor_loss_w: rotor,
+        efficiency,
+        feedback_v: stator::feedback_voltage_v(p.kfb, w),
+        current_a: ire.hypot(iim),
+        electrode_voltage_v: d.v,
+        phase_lag_rad: if clamped {
+            0.5 * PI
+        } else {
+            t.z.1.atan2(t.z.0)
+        },
+        modal_stiffness_n_per_m: t.k_eff,
+        temperature_rise_k: rise_ss,
+        temperature_rise_at_elapsed_k: rise_t,
+        speed_std_rpm: 0.0,
+    }
+}

@@ -1,0 +1,202 @@
+//! Grids of operating points for maps. The grid is enumerated lazily (index → point), so
+//! a 10^8-point map never exists in memory; chunks are solved with warm starts along the
+//! fastest-varying axis. Parallelism and writing live in the CLI and Python layers.
+
+use crate::error::TrumError;
+use crate::params::Motor;
+use crate::solve::{solve_prepared, OperatingPoint, Prepared, Solution};
+
+/// The swept input axes, in nesting order (the last varies fastest).
+pub const AXES: [&str; 4] = ["preload_n", "voltage_v", "frequency_hz", "torque_nm"];
+
+/// One axis: `n` points from `start` to `stop` inclusive (n = 1: just `start`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Axis {
+    /// First value.
+    pub start: f64,
+    /// Last value.
+    pub stop: f64,
+    /// Number of points, ≥ 1.
+    pub n: usize,
+}
+
+impl Axis {
+    /// A single value.
+    pub fn fixed(v: f64) -> Axis {
+        Axis {
+            start: v,
+            stop: v,
+            n: 1,
+        }
+    }
+    /// `n` evenly spaced values.
+    pub fn linspace(start: f64, stop: f64, n: usize) -> Axis {
+        Axis { start, stop, n }
+    }
+    /// Value `i`.
+    #[inline]
+    pub fn at(&self, i: usize) -> f64 {
+        if self.n <= 1 {
+            self.start
+        } else {
+            self.start + (self.stop - self.start) * (i as f64) / ((self.n - 1) as f64)
+        }
+    }
+}
+
+/// A full-factorial grid over preload × voltage × frequency × torque.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid {
+    /// Preload axis [N].
+    pub preload_n: Axis,
+    /// Voltage axis [V].
+    pub voltage_v: Axis,
+    /// Frequency axis [Hz].
+    pub frequency_hz: Axis,
+    /// Load torque axis [N·m].
+    pub torque_nm: Axis,
+}
+
+impl Grid {
+    /// Checks the axes: at least one point each, finite values, and the operating-point
+    /// ranges (preload, voltage, frequency > 0; torque ≥ 0). Errors name the axis.
+    pub fn validate(&self) -> Result<(), TrumError> {
+        for (name, ax) in AXES.iter().zip(self.axes()) {
+            if ax.n == 0 {
+                return Err(TrumError::input(format!(
+                    "{name}: an axis needs at least one point"
+                )));
+            }
+            for v in [ax.start, ax.stop] {
+                if !v.is_finite() {
+                    return Err(TrumError::input(format!(
+                        "{name}: {v} is not a finite number"
+                    )));
+                }
+                let ok = if *name == "torque_nm" {
+                    v >= 0.0
+                } else {
+                    v > 0.0
+                };
+                if !ok {
+                    let rule = if *name == "torque_nm" { ">= 0" } else { "> 0" };
+                    return Err(TrumError::input(format!("{name}: {v} must be {rule}")));
+                }
+            }
+        }
+        if self.len_checked().is_none() {
+            return Err(TrumError::input(
+                "the grid has more points than fit in 64 bits",
+            ));
+        }
+        Ok(())
+    }
+
+    fn axes(&self) -> [Axis; 4] {
+        [
+            self.preload_n,
+            self.voltage_v,
+            self.frequency_hz,
+            self.torque_nm,
+        ]
+    }
+
+    fn len_checked(&self) -> Option<u64> {
+        self.axes()
+            .iter()
+            .try_fold(1u64, |acc, a| acc.checked_mul(a.n as u64))
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> u64 {
+        self.len_checked().unwrap_or(u64::MAX)
+    }
+
+    /// True when the grid has no points.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The operating point with flat index `i` (torque fastest, preload slowest).
+    pub fn point(&self, i: u64) -> OperatingPoint {
+        let nt = self.torque_nm.n as u64;
+        let nf = self.frequency_hz.n as u64;
+        let nv = self.voltage_v.n as u64;
+        let it = i % nt;
+        let r = i / nt;
+        let ifr = r % nf;
+        let r = r / nf;
+        let iv = r % nv;
+        let ip = r / nv;
+        OperatingPoint::new(
+            self.preload_n.at(ip as usize),
+            self.torque_nm.at(it as usize),
+            self.voltage_v.at(iv as usize),
+            self.frequency_hz.at(ifr as usize),
+        )
+    }
+}
+
+/// Solves the points `range` of `grid` in order, warm-starting each from the previous
+/// one, and hands every (index, point, solution) to `sink`. Pure; the caller decides how
+/// chunks are spread over threads.
+pub fn solve_range<F>(
+    motor: &Motor,
+    prepared: &Prepared,
+    grid: &Grid,
+    range: std::ops::Range<u64>,
+    mut sink: F,
+) where
+    F: FnMut(u64, &OperatingPoint, &Solution),
+{
+    let mut prev: Option<Solution> = None;
+    for i in range {
+        let op = grid.point(i);
+        let s = solve_prepared(
+            prepared,
+            motor,
+            &op,
+            prev.as_ref().filter(|p| p.status.is_valid()),
+        );
+        sink(i, &op, &s);
+        prev = Some(s);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn index_order_is_torque_fastest() {
+        let g = Grid {
+            preload_n: Axis::linspace(100.0, 300.0, 3),
+            voltage_v: Axis::fixed(200.0),
+            frequency_hz: Axis::linspace(42e3, 43e3, 2),
+            torque_nm: Axis::linspace(0.0, 0.5, 6),
+        };
+        assert_eq!(g.len(), 36);
+        let p = g.point(0);
+        assert_eq!(
+            (p.preload_n, p.frequency_hz, p.torque_nm),
+            (100.0, 42e3, 0.0)
+        );
+        let p = g.point(7);
+        assert_eq!(
+            (p.preload_n, p.frequency_hz, p.torque_nm),
+            (100.0, 43e3, 0.1)
+        );
+        let p = g.point(35);
+        assert_eq!(
+            (p.preload_n, p.frequency_hz, p.torque_nm),
+            (300.0, 43e3, 0.5)
+        );
+        assert!(g.validate().is_ok());
+        let mut bad = g;
+        bad.preload_n.start = 0.0;
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("preload_n: 0 must be > 0"));
+    }
+}
