@@ -1,8 +1,7 @@
 use trum_core::*;
 fn main() {
     let m = presets::preset("trum60a").unwrap();
-    let r =
-        criterion::evaluate(&m, &criterion::CriterionConfig::seed000(), &mut |_, _| {}).unwrap();
+    let r = criterion::evaluate(&m, &criterion::CriterionConfig::seed000(), &mut |_, _| {}).unwrap();
     for row in &r.rows {
         println!(
             "{:5.0} {:?} Tst={:.2} eta={:.3} dT={:.2} std={:.3} v0={:.1} score={:.3} {}",

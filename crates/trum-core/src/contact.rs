@@ -30,23 +30,14 @@ pub fn e_int(theta_rad: f64, c: f64) -> f64 {
 
 /// Equivalent Winkler stiffness of the friction layer per unit circumferential length,
 /// k_f = E_f·b_f/h_f [N/m²] (seed 001 eq. 4).
-pub fn layer_stiffness_n_per_m2(
-    youngs_modulus_pa: f64,
-    contact_width_m: f64,
-    thickness_m: f64,
-) -> f64 {
+pub fn layer_stiffness_n_per_m2(youngs_modulus_pa: f64, contact_width_m: f64, thickness_m: f64) -> f64 {
     youngs_modulus_pa * contact_width_m / thickness_m
 }
 
 /// Force scale A = 2·N·k_f·W/k [N]: the axial force is A·χ(φ0) (seed 001 eq. 5,
 /// seed 000 eq. 6 with the width integral folded into k_f).
 #[inline]
-pub fn force_scale_n(
-    wave_number: f64,
-    k_f_n_per_m2: f64,
-    amplitude_m: f64,
-    wavenumber_per_m: f64,
-) -> f64 {
+pub fn force_scale_n(wave_number: f64, k_f_n_per_m2: f64, amplitude_m: f64, wavenumber_per_m: f64) -> f64 {
     2.0 * wave_number * k_f_n_per_m2 * amplitude_m / wavenumber_per_m
 }
 
@@ -85,26 +76,14 @@ fn g(phi: f64) -> f64 {
 pub fn contact_from_ratio(y: f64) -> Contact {
     if y >= PI {
         // Full contact: p = k_f W (cos θ − c) over the whole wave, ∫ = −2π c / k  ⇒  c = −y/π.
-        return Contact {
-            half_angle_rad: PI,
-            offset: -y / PI,
-            full: true,
-        };
+        return Contact { half_angle_rad: PI, offset: -y / PI, full: true };
     }
     if y <= 0.0 {
-        return Contact {
-            half_angle_rad: 0.0,
-            offset: 1.0,
-            full: false,
-        };
+        return Contact { half_angle_rad: 0.0, offset: 1.0, full: false };
     }
     let mut lo = 0.0;
     let mut hi = PI;
-    let mut phi = if y < 1.5 {
-        (3.0 * y).cbrt().min(PI * 0.999)
-    } else {
-        PI - (2.0 * (PI - y) / PI).sqrt()
-    };
+    let mut phi = if y < 1.5 { (3.0 * y).cbrt().min(PI * 0.999) } else { PI - (2.0 * (PI - y) / PI).sqrt() };
     for _ in 0..60 {
         let (s, c) = phi.sin_cos();
         let r = s - phi * c - y;
@@ -114,11 +93,7 @@ pub fn contact_from_ratio(y: f64) -> Contact {
             lo = phi;
         }
         let d = phi * s;
-        let mut next = if d > 0.0 {
-            phi - r / d
-        } else {
-            0.5 * (lo + hi)
-        };
+        let mut next = if d > 0.0 { phi - r / d } else { 0.5 * (lo + hi) };
         if !(next > lo && next < hi) {
             next = 0.5 * (lo + hi);
         }
@@ -128,11 +103,7 @@ pub fn contact_from_ratio(y: f64) -> Contact {
             break;
         }
     }
-    Contact {
-        half_angle_rad: phi,
-        offset: phi.cos(),
-        full: false,
-    }
+    Contact { half_angle_rad: phi, offset: phi.cos(), full: false }
 }
 
 /// Contact angle Xc [mechanical degrees, full arc] from the half-angle φ0 in wave phase
@@ -150,12 +121,7 @@ pub fn contact_length_m(half_angle_rad: f64, wavenumber_per_m: f64) -> f64 {
 
 /// Pressure per unit circumferential length p(θ) = k_f·W·(cos θ − c) inside the contact,
 /// 0 outside [N/m] (seed 000 eq. 3, seed 001 eq. 5).
-pub fn pressure_n_per_m(
-    theta_rad: f64,
-    k_f_n_per_m2: f64,
-    amplitude_m: f64,
-    contact: &Contact,
-) -> f64 {
+pub fn pressure_n_per_m(theta_rad: f64, k_f_n_per_m2: f64, amplitude_m: f64, contact: &Contact) -> f64 {
     if theta_rad.abs() > contact.half_angle_rad {
         0.0
     } else {
@@ -196,8 +162,7 @@ pub fn stick_half_angle_rad(
     let tmax = stall_stick_half_angle_rad(contact);
     let f = |t: f64| {
         let (s, co) = t.sin_cos();
-        let val =
-            torque_scale_nm * (2.0 * (s - t * c) - chi0) - load_torque_nm - viscous_nm_per_cos * co;
+        let val = torque_scale_nm * (2.0 * (s - t * c) - chi0) - load_torque_nm - viscous_nm_per_cos * co;
         let der = torque_scale_nm * 2.0 * (co - c) + viscous_nm_per_cos * s;
         (val, der)
     };
@@ -207,9 +172,7 @@ pub fn stick_half_angle_rad(
     }
     let (mut lo, mut hi) = (0.0, tmax);
     // Starting point: warm start, else the small-θs/Newton-from-midpoint guess.
-    let mut t = guess_rad
-        .filter(|g| *g > 0.0 && *g < tmax)
-        .unwrap_or(0.5 * tmax);
+    let mut t = guess_rad.filter(|g| *g > 0.0 && *g < tmax).unwrap_or(0.5 * tmax);
     for _ in 0..60 {
         let (v, d) = f(t);
         if v > 0.0 {
@@ -240,11 +203,7 @@ mod tests {
         for i in 1..400 {
             let phi = PI * i as f64 / 400.0;
             let c = contact_from_ratio(g(phi));
-            assert!(
-                (c.half_angle_rad - phi).abs() < 1e-9,
-                "phi={phi} got {}",
-                c.half_angle_rad
-            );
+            assert!((c.half_angle_rad - phi).abs() < 1e-9, "phi={phi} got {}", c.half_angle_rad);
         }
         // tiny contact: small-angle asymptote g ≈ φ³/3
         let c = contact_from_ratio(1e-9);
@@ -260,11 +219,7 @@ mod tests {
             let a = force_scale_n(n, kf, w, k);
             let x0 = ct.half_angle_rad / k;
             let q = n * integral(|x| kf * w * ((k * x).cos() - ct.offset), -x0, x0);
-            assert!(
-                (q - a * ct.chi0()).abs() < 1e-10 * q,
-                "y={y}: {q} vs {}",
-                a * ct.chi0()
-            );
+            assert!((q - a * ct.chi0()).abs() < 1e-10 * q, "y={y}: {q} vs {}", a * ct.chi0());
             assert!((ct.chi0() - y).abs() < 1e-10 * y.max(1.0));
         }
     }
@@ -275,11 +230,8 @@ mod tests {
         let ct = contact_from_ratio(1.2);
         for &ts in &[0.1, 0.4, ct.half_angle_rad * 0.9] {
             let vr = ts.cos();
-            let q = integral(
-                |t| (t.cos() - vr).signum() * (t.cos() - ct.offset),
-                -ct.half_angle_rad,
-                ct.half_angle_rad,
-            );
+            let q =
+                integral(|t| (t.cos() - vr).signum() * (t.cos() - ct.offset), -ct.half_angle_rad, ct.half_angle_rad);
             assert!((q - 2.0 * torque_factor(ts, &ct)).abs() < 1e-9, "{q}");
         }
     }

@@ -60,16 +60,10 @@ impl CriterionConfig {
     }
 
     fn validate(&self) -> Result<(), TrumError> {
-        let pos = [
-            ("voltage_v", self.voltage_v),
-            ("frequency_hz", self.frequency_hz),
-            ("run_time_s", self.run_time_s),
-        ];
+        let pos = [("voltage_v", self.voltage_v), ("frequency_hz", self.frequency_hz), ("run_time_s", self.run_time_s)];
         for (n, v) in pos {
             if !(v.is_finite() && v > 0.0) {
-                return Err(TrumError::input(format!(
-                    "{n} = {v} must be a finite number > 0"
-                )));
+                return Err(TrumError::input(format!("{n} = {v} must be a finite number > 0")));
             }
         }
         for (n, v) in [
@@ -78,26 +72,18 @@ impl CriterionConfig {
             ("region_tolerance", self.region_tolerance),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(TrumError::input(format!(
-                    "{n} = {v} must be a finite number >= 0"
-                )));
+                return Err(TrumError::input(format!("{n} = {v} must be a finite number >= 0")));
             }
         }
-        if self.weights.iter().any(|w| !(w.is_finite() && *w >= 0.0))
-            || self.weights.iter().sum::<f64>() <= 0.0
-        {
-            return Err(TrumError::input(
-                "weights must be finite, >= 0 and not all zero",
-            ));
+        if self.weights.iter().any(|w| !(w.is_finite() && *w >= 0.0)) || self.weights.iter().sum::<f64>() <= 0.0 {
+            return Err(TrumError::input("weights must be finite, >= 0 and not all zero"));
         }
         if self.preload_n.n < 2
             || !(self.preload_n.start > 0.0)
             || !(self.preload_n.stop > self.preload_n.start)
             || !self.preload_n.stop.is_finite()
         {
-            return Err(TrumError::input(
-                "preload_n: need at least 2 candidates with 0 < start < stop",
-            ));
+            return Err(TrumError::input("preload_n: need at least 2 candidates with 0 < start < stop"));
         }
         if self.torque_samples < 4 {
             return Err(TrumError::input("torque_samples must be >= 4"));
@@ -171,13 +157,7 @@ pub fn evaluate(
         if s0.status == Status::Ok {
             // max efficiency: sample torques up to stall, then golden-section refine.
             let eff = |t: f64| {
-                solve_prepared(
-                    &p,
-                    motor,
-                    &OperatingPoint::new(f, t, cfg.voltage_v, cfg.frequency_hz),
-                    None,
-                )
-                .efficiency
+                solve_prepared(&p, motor, &OperatingPoint::new(f, t, cfg.voltage_v, cfg.frequency_hz), None).efficiency
             };
             let tmax = s0.stall_torque_nm;
             let m = cfg.torque_samples;
@@ -190,10 +170,7 @@ pub fn evaluate(
                 }
             }
             let step = tmax / (m - 1) as f64;
-            let (mut a, mut b) = (
-                (bi as f64 - 1.0).max(0.0) * step,
-                ((bi + 1) as f64 * step).min(tmax),
-            );
+            let (mut a, mut b) = ((bi as f64 - 1.0).max(0.0) * step, ((bi + 1) as f64 * step).min(tmax));
             let gr = 0.5 * (5f64.sqrt() - 1.0);
             for _ in 0..40 {
                 let x1 = b - gr * (b - a);
@@ -213,34 +190,26 @@ pub fn evaluate(
                 &OperatingPoint::new(f, cfg.run_torque_nm, cfg.voltage_v, cfg.frequency_hz),
                 None,
             );
-            row.temperature_rise_k = thermal::temperature_rise_k(
-                run.total_loss_w(),
-                p.alpha_s,
-                p.heat_cap,
-                cfg.run_time_s,
-            );
-            row.speed_std_rpm =
-                fluctuation_about(motor, &p, &op0, &s0, cfg.runout_m, 16).speed_std_rpm;
+            row.temperature_rise_k =
+                thermal::temperature_rise_k(run.total_loss_w(), p.alpha_s, p.heat_cap, cfg.run_time_s);
+            row.speed_std_rpm = fluctuation_about(motor, &p, &op0, &s0, cfg.runout_m, 16).speed_std_rpm;
         }
         rows.push(row);
         progress(i + 1, n);
     }
     score(&mut rows, cfg);
-    let (bi, best) = rows
-        .iter()
-        .enumerate()
-        .filter(|(_, r)| r.score.is_finite())
-        .fold((usize::MAX, f64::NEG_INFINITY), |acc, (i, r)| {
+    let (bi, best) = rows.iter().enumerate().filter(|(_, r)| r.score.is_finite()).fold(
+        (usize::MAX, f64::NEG_INFINITY),
+        |acc, (i, r)| {
             if r.score > acc.1 {
                 (i, r.score)
             } else {
                 acc
             }
-        });
+        },
+    );
     if bi == usize::MAX {
-        return Err(TrumError::input(
-            "no candidate preload gives a running motor at this drive",
-        ));
+        return Err(TrumError::input("no candidate preload gives a running motor at this drive"));
     }
     let thr = best - cfg.region_tolerance * best.abs();
     let (mut lo, mut hi) = (bi, bi);
@@ -261,9 +230,7 @@ pub fn evaluate(
 }
 
 fn score(rows: &mut [CriterionRow], cfg: &CriterionConfig) {
-    let valid: Vec<usize> = (0..rows.len())
-        .filter(|&i| rows[i].status == Status::Ok)
-        .collect();
+    let valid: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].status == Status::Ok).collect();
     let metric = |r: &CriterionRow, k: usize| match k {
         0 => r.stall_torque_nm,
         1 => r.max_efficiency,
@@ -282,11 +249,7 @@ fn score(rows: &mut [CriterionRow], cfg: &CriterionConfig) {
         let mut s = 0.0;
         for (k, rg) in ranges.iter().enumerate() {
             let span = rg.1 - rg.0;
-            let x = if span > 0.0 {
-                (metric(&rows[i], k) - rg.0) / span
-            } else {
-                1.0
-            };
+            let x = if span > 0.0 { (metric(&rows[i], k) - rg.0) / span } else { 1.0 };
             s += cfg.weights[k] * x;
         }
         rows[i].score = s / wsum;

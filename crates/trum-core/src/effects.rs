@@ -82,8 +82,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
     },
     EffectInfo {
         name: "preload_stiffening",
-        summary:
-            "the pressed friction layer adds stiffness to the stator mode: resonance moves up \
+        summary: "the pressed friction layer adds stiffness to the stator mode: resonance moves up \
                   and amplitude changes with preload",
         source: "seed 001 eq. 8 and 14; seed 002 section 5.3",
         params: &[EffectParam {
@@ -194,12 +193,7 @@ impl Effect {
         ALL.iter()
             .copied()
             .find(|e| e.name() == name)
-            .ok_or_else(|| {
-                format!(
-                    "unknown effect '{name}'; valid effects are: {}",
-                    valid_names()
-                )
-            })
+            .ok_or_else(|| format!("unknown effect '{name}'; valid effects are: {}", valid_names()))
     }
 }
 
@@ -211,11 +205,7 @@ impl fmt::Display for Effect {
 
 /// Comma-separated list of valid effect names.
 pub fn valid_names() -> String {
-    EFFECTS
-        .iter()
-        .map(|e| e.name)
-        .collect::<Vec<_>>()
-        .join(", ")
+    EFFECTS.iter().map(|e| e.name).collect::<Vec<_>>().join(", ")
 }
 
 /// The set of switched-on effects with their parameters. `Effects::none()` is the
@@ -307,43 +297,26 @@ impl Effects {
             let info = e.info();
             let mut v: Vec<f64> = info.params.iter().map(|p| p.typical).collect();
             for kv in rest.split(',') {
-                let (k, val) = kv
-                    .split_once('=')
-                    .ok_or_else(|| format!("effect '{spec}': expected param=value"))?;
-                let idx = info
-                    .params
-                    .iter()
-                    .position(|p| p.name == k.trim())
-                    .ok_or_else(|| {
-                        format!(
-                            "effect '{}' has no parameter '{}'; its parameters are: {}",
-                            e,
-                            k.trim(),
-                            info.params
-                                .iter()
-                                .map(|p| p.name)
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        )
-                    })?;
-                v[idx] = val
-                    .trim()
-                    .parse()
-                    .map_err(|_| format!("effect '{spec}': '{}' is not a number", val.trim()))?;
+                let (k, val) = kv.split_once('=').ok_or_else(|| format!("effect '{spec}': expected param=value"))?;
+                let idx = info.params.iter().position(|p| p.name == k.trim()).ok_or_else(|| {
+                    format!(
+                        "effect '{}' has no parameter '{}'; its parameters are: {}",
+                        e,
+                        k.trim(),
+                        info.params.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
+                    )
+                })?;
+                v[idx] =
+                    val.trim().parse().map_err(|_| format!("effect '{spec}': '{}' is not a number", val.trim()))?;
             }
             self.set(e, &v);
         } else {
             let (name, val) = spec.split_once('=').ok_or_else(|| {
-                format!(
-                    "effect '{spec}': expected NAME=STRENGTH; valid effects are: {}",
-                    valid_names()
-                )
+                format!("effect '{spec}': expected NAME=STRENGTH; valid effects are: {}", valid_names())
             })?;
             let e = Effect::from_name(name.trim())?;
-            let s: f64 = val
-                .trim()
-                .parse()
-                .map_err(|_| format!("effect '{spec}': '{}' is not a number", val.trim()))?;
+            let s: f64 =
+                val.trim().parse().map_err(|_| format!("effect '{spec}': '{}' is not a number", val.trim()))?;
             self.set_strength(e, s);
         }
         self.check().map_err(|(_, m)| m)
@@ -355,10 +328,7 @@ impl Effects {
                 if !v.is_finite() || v < p.min || v > p.max {
                     return Err((
                         format!("effects.{}.{}", e.name(), p.name),
-                        format!(
-                            "{v} is outside the valid range [{}, {}] ({})",
-                            p.min, p.max, p.doc
-                        ),
+                        format!("{v} is outside the valid range [{}, {}] ({})", p.min, p.max, p.doc),
                     ));
                 }
             }
@@ -382,11 +352,7 @@ impl Effects {
     /// Reads the `[effects]` table of a motor file: `name = STRENGTH`,
     /// `name = { param = value }` or a `[effects.name]` table; `name = "none"` or an
     /// empty table switches everything off.
-    pub(crate) fn from_toml_table(
-        t: &toml::Table,
-        text: &str,
-        source_name: &str,
-    ) -> Result<Effects, ParamError> {
+    pub(crate) fn from_toml_table(t: &toml::Table, text: &str, source_name: &str) -> Result<Effects, ParamError> {
         let mut fx = Effects::none();
         for (name, val) in t {
             let err = |reason: String, key: String| ParamError {
@@ -406,32 +372,22 @@ impl Effects {
                     let mut v: Vec<f64> = vec![0.0; info.params.len()];
                     let mut seen = vec![false; info.params.len()];
                     for (k, x) in tab {
-                        let idx = info.params.iter().position(|p| p.name == k).ok_or_else(
-                            || {
-                                err(
-                                    format!(
-                                        "unknown parameter '{k}'; parameters of '{name}' are: {}",
-                                        info.params
-                                            .iter()
-                                            .map(|p| p.name)
-                                            .collect::<Vec<_>>()
-                                            .join(", ")
-                                    ),
-                                    format!("effects.{name}.{k}"),
-                                )
-                            },
-                        )?;
-                        v[idx] = num(x).ok_or_else(|| {
-                            err("expected a number".into(), format!("effects.{name}.{k}"))
+                        let idx = info.params.iter().position(|p| p.name == k).ok_or_else(|| {
+                            err(
+                                format!(
+                                    "unknown parameter '{k}'; parameters of '{name}' are: {}",
+                                    info.params.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
+                                ),
+                                format!("effects.{name}.{k}"),
+                            )
                         })?;
+                        v[idx] =
+                            num(x).ok_or_else(|| err("expected a number".into(), format!("effects.{name}.{k}")))?;
                         seen[idx] = true;
                     }
                     if let Some(i) = seen.iter().position(|s| !s) {
                         return Err(err(
-                            format!(
-                                "missing parameter '{}' ({})",
-                                info.params[i].name, info.params[i].doc
-                            ),
+                            format!("missing parameter '{}' ({})", info.params[i].name, info.params[i].doc),
                             format!("effects.{name}"),
                         ));
                     }
@@ -543,10 +499,7 @@ mod tests {
     #[test]
     fn assignment_forms() {
         let mut fx = Effects::none();
-        fx.parse_assignment(
-            "thermal_drift:stiffness_coefficient_per_k=-1e-4,friction_coefficient_per_k=0",
-        )
-        .unwrap();
+        fx.parse_assignment("thermal_drift:stiffness_coefficient_per_k=-1e-4,friction_coefficient_per_k=0").unwrap();
         assert_eq!(fx.get(Effect::ThermalDrift), Some(&[-1e-4, 0.0][..]));
         fx.parse_assignment("radial_friction=0.3").unwrap();
         assert_eq!(fx.value(Effect::RadialFriction, 0), 0.3);

@@ -17,8 +17,7 @@ use std::f64::consts::PI;
 pub fn contact_normal_stiffness_n_per_m(motor: &Motor, half_angle_rad: f64) -> f64 {
     let g = &motor.geometry;
     let fl = &motor.friction_layer;
-    let kf =
-        contact::layer_stiffness_n_per_m2(fl.youngs_modulus_pa, g.contact_width_m, fl.thickness_m);
+    let kf = contact::layer_stiffness_n_per_m2(fl.youngs_modulus_pa, g.contact_width_m, fl.thickness_m);
     2.0 * g.wave_number * kf * half_angle_rad * g.mean_radius_m / g.wave_number
 }
 
@@ -49,20 +48,11 @@ pub fn speed_fluctuation(
     samples: usize,
 ) -> Result<Fluctuation, TrumError> {
     if !(runout_m.is_finite() && runout_m >= 0.0) {
-        return Err(TrumError::input(format!(
-            "runout_m = {runout_m} must be a finite number >= 0"
-        )));
+        return Err(TrumError::input(format!("runout_m = {runout_m} must be a finite number >= 0")));
     }
     let p = Prepared::new(motor);
     let nominal = solve_prepared(&p, motor, op, None);
-    Ok(fluctuation_about(
-        motor,
-        &p,
-        op,
-        &nominal,
-        runout_m,
-        samples.max(4),
-    ))
+    Ok(fluctuation_about(motor, &p, op, &nominal, runout_m, samples.max(4)))
 }
 
 pub(crate) fn fluctuation_about(
@@ -143,11 +133,7 @@ mod tests {
         b.preload_n -= h;
         let slope = (crate::solve(&m, &a).speed_rpm - crate::solve(&m, &b).speed_rpm) / (2.0 * h);
         let expect = slope.abs() * f1.preload_ripple_n / 2f64.sqrt();
-        assert!(
-            (f1.speed_std_rpm - expect).abs() < 0.02 * expect,
-            "{} vs {expect}",
-            f1.speed_std_rpm
-        );
+        assert!((f1.speed_std_rpm - expect).abs() < 0.02 * expect, "{} vs {expect}", f1.speed_std_rpm);
         assert!(speed_fluctuation(&m, &op, -1.0, 16).is_err());
     }
 }

@@ -14,12 +14,7 @@ use crate::quad;
 /// ε_p·A/h_p = C0 and two phases of ½·ω·C0·V²·tan δ each). V is the zero-to-peak
 /// amplitude per phase. Valid for any ω, C0, V ≥ 0.
 #[inline]
-pub fn dielectric_loss_w(
-    omega_rad_s: f64,
-    capacitance_f: f64,
-    loss_tangent: f64,
-    voltage_v: f64,
-) -> f64 {
+pub fn dielectric_loss_w(omega_rad_s: f64, capacitance_f: f64, loss_tangent: f64, voltage_v: f64) -> f64 {
     omega_rad_s * capacitance_f * voltage_v * voltage_v * loss_tangent
 }
 
@@ -28,11 +23,7 @@ pub fn dielectric_loss_w(
 /// the composite beam's bending energy; [`composite_modal_damping_ns_per_m`] converts
 /// one into the other.)
 #[inline]
-pub fn stator_damping_loss_w(
-    modal_damping_ns_per_m: f64,
-    omega_rad_s: f64,
-    amplitude_m: f64,
-) -> f64 {
+pub fn stator_damping_loss_w(modal_damping_ns_per_m: f64, omega_rad_s: f64, amplitude_m: f64) -> f64 {
     modal_damping_ns_per_m * omega_rad_s * omega_rad_s * amplitude_m * amplitude_m
 }
 
@@ -53,8 +44,7 @@ pub fn friction_loss_coulomb_w(
     contact: &Contact,
 ) -> f64 {
     let c = contact.offset;
-    let pe =
-        2.0 * contact::e_int(stick_half_angle_rad, c) - contact::e_int(contact.half_angle_rad, c);
+    let pe = 2.0 * contact::e_int(stick_half_angle_rad, c) - contact::e_int(contact.half_angle_rad, c);
     let pc = contact::torque_factor(stick_half_angle_rad, contact);
     let scale = 2.0 * wave_number * mu * k_f_n_per_m2 * amplitude_m / wavenumber_per_m;
     (scale * (crest_speed_m_s * pe - rotor_surface_speed_m_s * pc)).max(0.0)
@@ -119,14 +109,7 @@ pub fn composite_modal_damping_ns_per_m(
 /// cross-section moments about it [m⁴]. Eq. 19 is printed with a 1/12 factor where the
 /// parallel-axis integral gives 1/3, and with (h−D)³ + (h_e−D)³ where the bounds of the
 /// piezo layer give (h−D)³ − (h_e−D)³; both corrected here (docs/PAPERS.md).
-pub fn composite_section(
-    b_e: f64,
-    h_e: f64,
-    b_p: f64,
-    h_p: f64,
-    e_eq: f64,
-    e_p: f64,
-) -> (f64, f64, f64) {
+pub fn composite_section(b_e: f64, h_e: f64, b_p: f64, h_p: f64, e_eq: f64, e_p: f64) -> (f64, f64, f64) {
     let d = (e_eq * h_e * h_e * b_e + 2.0 * e_p * h_p * h_e * b_p + e_p * h_p * h_p * b_p)
         / (2.0 * (e_eq * h_e * b_e + e_p * h_p * b_p));
     let h = h_e + h_p;
@@ -151,19 +134,13 @@ mod tests {
                 let vr = v0 * ts.cos();
                 let closed = friction_loss_coulomb_w(n, mu, kf, w, k, v0, vr, ts, &ct);
                 let q = friction_loss_quadrature_w(n, mu, kf, w, k, v0, vr, &ct);
-                assert!(
-                    (closed - q).abs() <= 1e-9 * q.max(1e-12),
-                    "y={y} frac={frac}: {closed} vs {q}"
-                );
+                assert!((closed - q).abs() <= 1e-9 * q.max(1e-12), "y={y} frac={frac}: {closed} vs {q}");
             }
             // rotor at rest: θs = min(φ0, π/2)
             let ts = contact::stall_stick_half_angle_rad(&ct);
             let closed = friction_loss_coulomb_w(n, mu, kf, w, k, v0, 0.0, ts, &ct);
             let q = friction_loss_quadrature_w(n, mu, kf, w, k, v0, 0.0, &ct);
-            assert!(
-                (closed - q).abs() <= 1e-9 * q,
-                "stall y={y}: {closed} vs {q}"
-            );
+            assert!((closed - q).abs() <= 1e-9 * q, "stall y={y}: {closed} vs {q}");
         }
     }
 
@@ -172,8 +149,8 @@ mod tests {
         let (be, he, bp, hp, ee, ep) = (5e-3, 4e-3, 4.5e-3, 0.5e-3, 110e9, 70e9);
         let (d, ie, ip) = composite_section(be, he, bp, hp, ee, ep);
         // first moment of modulus-weighted area about the neutral layer vanishes
-        let first = ee * be * (d * d - (he - d).powi(2)) / 2.0
-            - ep * bp * ((he + hp - d).powi(2) - (he - d).powi(2)) / 2.0;
+        let first =
+            ee * be * (d * d - (he - d).powi(2)) / 2.0 - ep * bp * ((he + hp - d).powi(2) - (he - d).powi(2)) / 2.0;
         assert!(first.abs() < 1e-9 * ee * be * he * he, "{first}");
         // moments by quadrature of y² over each layer
         let qe = crate::quad::integral(|y| be * (y - d) * (y - d), 0.0, he);

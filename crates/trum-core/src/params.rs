@@ -236,6 +236,69 @@ struct MotorFile {
     thermal: Option<ThermalPatch>,
     assembly: Option<AssemblyPatch>,
     effects: Option<toml::Table>,
+    sweep: Option<SweepPatch>,
+}
+
+/// One axis in a `[sweep]` table: a single value or `[start, stop, n]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+enum AxisSpec {
+    Value(Num),
+    Range((Num, Num, Num)),
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SweepPatch {
+    preload_n: Option<AxisSpec>,
+    voltage_v: Option<AxisSpec>,
+    frequency_hz: Option<AxisSpec>,
+    torque_nm: Option<AxisSpec>,
+}
+
+/// The `[sweep]` table of a motor file: the axes it sets (others left to the caller).
+/// Each axis is written `key = value` or `key = [start, stop, n]`.
+#[derive(Debug, Default, Clone, PartialEq)]
+pub struct SweepTable {
+    /// Preload axis [N], if set.
+    pub preload_n: Option<crate::sweep::Axis>,
+    /// Voltage axis [V], if set.
+    pub voltage_v: Option<crate::sweep::Axis>,
+    /// Frequency axis [Hz], if set.
+    pub frequency_hz: Option<crate::sweep::Axis>,
+    /// Torque axis [N·m], if set.
+    pub torque_nm: Option<crate::sweep::Axis>,
+}
+
+fn axis_from_spec(
+    spec: &Option<AxisSpec>,
+    key: &str,
+    text: &str,
+    source_name: &str,
+) -> Result<Option<crate::sweep::Axis>, ParamError> {
+    let err = |reason: String| ParamError {
+        source_name: source_name.into(),
+        line: line_of_key(text, "sweep", key),
+        key: format!("sweep.{key}"),
+        reason,
+    };
+    let axis = match spec {
+        None => return Ok(None),
+        Some(AxisSpec::Value(v)) => crate::sweep::Axis::fixed(v.0),
+        Some(AxisSpec::Range((a, b, n))) => {
+            if !(n.0.fract() == 0.0 && n.0 >= 1.0 && n.0 <= 1e12) {
+                return Err(err(format!("the point count {} must be a positive whole number", n.0)));
+            }
+            crate::sweep::Axis::linspace(a.0, b.0, n.0 as usize)
+        }
+    };
+    let strict = key != "torque_nm";
+    for v in [axis.start, axis.stop] {
+        if !v.is_finite() || (strict && v <= 0.0) || (!strict && v < 0.0) {
+            return Err(err(format!("{v} must be a finite number {}", if strict { "> 0" } else { ">= 0" })));
+        }
+    }
+    Ok(Some(axis))
 }
 
 /// 1-based line of `key` inside `[section]` (or a dotted/inline form) in TOML text.
@@ -245,28 +308,15 @@ pub(crate) fn line_of_key(text: &str, section: &str, key: &str) -> Option<usize>
     for (i, raw) in text.lines().enumerate() {
         let line = raw.trim();
         if let Some(h) = line.strip_prefix('[') {
-            current = h
-                .trim_end_matches(']')
-                .trim()
-                .trim_end_matches(']')
-                .trim()
-                .to_string();
+            current = h.trim_end_matches(']').trim().trim_end_matches(']').trim().to_string();
             if !section.is_empty() && current == format!("{section}.{key}") {
                 return Some(i + 1);
             }
             continue;
         }
         let lhs = line.split('=').next().unwrap_or("").trim();
-        let full = if current.is_empty() {
-            lhs.to_string()
-        } else {
-            format!("{current}.{lhs}")
-        };
-        let want = if section.is_empty() {
-            key.to_string()
-        } else {
-            format!("{section}.{key}")
-        };
+        let full = if current.is_empty() { lhs.to_string() } else { format!("{current}.{lhs}") };
+        let want = if section.is_empty() { key.to_string() } else { format!("{section}.{key}") };
         if full == want || (current.is_empty() && lhs == want) {
             return Some(i + 1);
         }
@@ -276,11 +326,7 @@ pub(crate) fn line_of_key(text: &str, section: &str, key: &str) -> Option<usize>
 
 /// 1-based line number of a byte offset.
 pub(crate) fn line_of_offset(text: &str, offset: usize) -> usize {
-    text.as_bytes()[..offset.min(text.len())]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
+    text.as_bytes()[..offset.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1
 }
 
 impl Motor {
@@ -332,16 +378,8 @@ impl Motor {
     }
 
     /// Sets a numeric parameter by dotted key and validates it.
-    pub fn set_param(
-        &mut self,
-        dotted: &str,
-        value: f64,
-        source_name: &str,
-    ) -> Result<(), ParamError> {
-        let valid = Self::all_keys()
-            .iter()
-            .map(|k| format!("{}.{}", k.section, k.key))
-            .collect::<Vec<_>>();
+    pub fn set_param(&mut self, dotted: &str, value: f64, source_name: &str) -> Result<(), ParamError> {
+        let valid = Self::all_keys().iter().map(|k| format!("{}.{}", k.section, k.key)).collect::<Vec<_>>();
         let slot = self.param_mut(dotted).ok_or_else(|| ParamError {
             source_name: source_name.into(),
             line: None,
@@ -379,35 +417,47 @@ impl Motor {
         self.effects.validate(source_name, text)
     }
 
+    /// Reads a TOML motor file and its optional `[sweep]` table (used by `trum map`).
+    pub fn from_toml_str_with_sweep(text: &str, source_name: &str) -> Result<(Motor, SweepTable), ParamError> {
+        let motor = Self::from_toml_str(text, source_name)?;
+        // The file parsed once already, so this cannot fail on syntax.
+        let file: MotorFile = toml::from_str(text).unwrap_or_default();
+        let sw = file.sweep.unwrap_or_default();
+        let table = SweepTable {
+            preload_n: axis_from_spec(&sw.preload_n, "preload_n", text, source_name)?,
+            voltage_v: axis_from_spec(&sw.voltage_v, "voltage_v", text, source_name)?,
+            frequency_hz: axis_from_spec(&sw.frequency_hz, "frequency_hz", text, source_name)?,
+            torque_nm: axis_from_spec(&sw.torque_nm, "torque_nm", text, source_name)?,
+        };
+        Ok((motor, table))
+    }
+
     /// Reads a TOML motor file. `source_name` is used in error messages (the file name).
+    /// A `[sweep]` table is accepted and ignored here (see [`Motor::from_toml_str_with_sweep`]).
     ///
     /// With `preset = "name"` every other key is an override; without it every key of
     /// every section is required. Unknown keys and sections are errors.
     pub fn from_toml_str(text: &str, source_name: &str) -> Result<Motor, ParamError> {
         let file: MotorFile = toml::from_str(text).map_err(|e| {
             let line = e.span().map(|s| line_of_offset(text, s.start));
-            let token = e
-                .span()
-                .map(|s| text.get(s.clone()).unwrap_or("").trim().to_string())
-                .unwrap_or_default();
+            let token = e.span().map(|s| text.get(s.clone()).unwrap_or("").trim().to_string()).unwrap_or_default();
             let msg = e.message().trim().to_string();
-            let msg = msg
-                .replace("unknown field", "unknown key")
-                .replace("field", "key");
-            ParamError {
-                source_name: source_name.into(),
-                line,
-                key: if token.len() < 64
-                    && !token.contains('\n')
-                    && !token.is_empty()
-                    && msg.starts_with("unknown")
-                {
-                    token
-                } else {
-                    String::new()
-                },
-                reason: msg,
-            }
+            let msg = msg.replace("unknown field", "unknown key").replace("field", "key");
+            let key = if token.len() < 64 && !token.contains('\n') && !token.is_empty() && msg.starts_with("unknown") {
+                // qualify the key with the section header above it
+                let start = e.span().map(|s| s.start).unwrap_or(0).min(text.len());
+                let section = text[..start]
+                    .lines()
+                    .rev()
+                    .find_map(|l| l.trim().strip_prefix('[').map(|h| h.trim_end_matches(']').trim().to_string()));
+                match section {
+                    Some(sec) if sec != token => format!("{sec}.{token}"),
+                    _ => token,
+                }
+            } else {
+                String::new()
+            };
+            ParamError { source_name: source_name.into(), line, key, reason: msg }
         })?;
         let mut motor = match &file.preset {
             Some(p) => crate::presets::preset(p).map_err(|mut e| {
@@ -421,15 +471,7 @@ impl Motor {
         macro_rules! apply {
             ($($sec:ident),*) => { $( if let Some(p) = &file.$sec { motor.$sec.apply(p); } )* };
         }
-        apply!(
-            geometry,
-            friction_layer,
-            stator,
-            electrical,
-            rotor,
-            thermal,
-            assembly
-        );
+        apply!(geometry, friction_layer, stator, electrical, rotor, thermal, assembly);
         if let Some(name) = &file.name {
             motor.name = name.clone();
         } else if file.preset.is_none() {
@@ -443,22 +485,13 @@ impl Motor {
         Ok(motor)
     }
 
-    fn from_complete_file(
-        file: &MotorFile,
-        text: &str,
-        source_name: &str,
-    ) -> Result<Motor, ParamError> {
+    fn from_complete_file(file: &MotorFile, text: &str, source_name: &str) -> Result<Motor, ParamError> {
         let missing = |sec: &str, key: &str| ParamError {
             source_name: source_name.into(),
             line: None,
-            key: if key.is_empty() {
-                sec.to_string()
-            } else {
-                format!("{sec}.{key}")
-            },
+            key: if key.is_empty() { sec.to_string() } else { format!("{sec}.{key}") },
             reason: if key.is_empty() {
-                "missing section (without `preset = \"...\"` every section and key is required)"
-                    .into()
+                "missing section (without `preset = \"...\"` every section and key is required)".into()
             } else {
                 "missing key (without `preset = \"...\"` every key is required)".into()
             },
@@ -489,11 +522,7 @@ impl Motor {
     /// Writes the motor as a complete, commented TOML motor file that
     /// [`Motor::from_toml_str`] reads back to an identical `Motor`. `notes` maps a dotted
     /// key to its provenance (paper value, assumed, calibrated) and is written as comments.
-    pub fn to_toml_annotated(
-        &self,
-        header: &str,
-        notes: &dyn Fn(&str) -> Option<String>,
-    ) -> String {
+    pub fn to_toml_annotated(&self, header: &str, notes: &dyn Fn(&str) -> Option<String>) -> String {
         let mut s = String::new();
         for l in header.lines() {
             let _ = writeln!(s, "# {l}").map(|_| ());
@@ -504,6 +533,9 @@ impl Motor {
             }
         }
         let _ = writeln!(s, "name = {}", toml_string(&self.name));
+        if let Some(p) = &self.preset {
+            let _ = writeln!(s, "preset = {}  # every value below overrides the preset's", toml_string(p));
+        }
         let mut section = "";
         for (info, v) in Self::all_keys().iter().zip(self.values()) {
             if info.section != section {
@@ -512,9 +544,7 @@ impl Motor {
             }
             let dotted = format!("{}.{}", info.section, info.key);
             let val = fmt_toml_number(v, info.check == Check::PositiveInteger);
-            let note = notes(&dotted)
-                .map(|n| format!(" ({n})"))
-                .unwrap_or_default();
+            let note = notes(&dotted).map(|n| format!(" ({n})")).unwrap_or_default();
             let _ = writeln!(s, "{} = {}  # {}{}", info.key, val, info.doc, note);
         }
         s.push_str(&self.effects.to_toml());

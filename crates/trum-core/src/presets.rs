@@ -28,10 +28,7 @@ impl Preset {
     }
     /// Provenance of one value.
     pub fn note(&self, dotted: &str) -> Option<&'static str> {
-        self.notes
-            .iter()
-            .find(|(k, _)| *k == dotted)
-            .map(|(_, v)| *v)
+        self.notes.iter().find(|(k, _)| *k == dotted).map(|(_, v)| *v)
     }
     /// The preset as a commented TOML motor file that reads back to the same motor.
     pub fn to_toml(&self) -> String {
@@ -39,8 +36,7 @@ impl Preset {
             "trum motor file: preset '{}'\n{}\nSources: {}\nEvery value is SI; the comment gives its meaning, unit and provenance.\n",
             self.name, self.summary, self.sources
         );
-        self.motor()
-            .to_toml_annotated(&header, &|k| self.note(k).map(str::to_string))
+        self.motor().to_toml_annotated(&header, &|k| self.note(k).map(str::to_string))
     }
 }
 
@@ -120,22 +116,15 @@ pub const PRESETS: &[Preset] = &[
 
 /// Looks up a preset by name; the error lists the valid names.
 pub fn find(name: &str) -> Result<&'static Preset, ParamError> {
-    PRESETS
-        .iter()
-        .find(|p| p.name == name)
-        .ok_or_else(|| ParamError {
-            source_name: "presets".into(),
-            line: None,
-            key: "preset".into(),
-            reason: format!(
-                "unknown preset '{name}'; valid presets are: {}",
-                PRESETS
-                    .iter()
-                    .map(|p| p.name)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        })
+    PRESETS.iter().find(|p| p.name == name).ok_or_else(|| ParamError {
+        source_name: "presets".into(),
+        line: None,
+        key: "preset".into(),
+        reason: format!(
+            "unknown preset '{name}'; valid presets are: {}",
+            PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
+        ),
+    })
 }
 
 /// The motor of a preset by name.
@@ -153,11 +142,7 @@ fn trum60a() -> Motor {
             contact_width_m: 3.2e-3,
             neutral_plane_distance_m: 2.0e-3,
         },
-        friction_layer: FrictionLayer {
-            youngs_modulus_pa: 1.305e8,
-            thickness_m: 0.5e-3,
-            friction_coefficient: 0.3,
-        },
+        friction_layer: FrictionLayer { youngs_modulus_pa: 1.305e8, thickness_m: 0.5e-3, friction_coefficient: 0.3 },
         stator: Stator {
             modal_mass_kg: 0.005,
             resonance_frequency_hz: 40_750.0,
@@ -169,20 +154,14 @@ fn trum60a() -> Motor {
             dielectric_loss_tangent: 3.5e-3,
             feedback_gain_v_per_m: 3.07e7,
         },
-        rotor: Rotor {
-            viscous_damping_nms: 5.0e-4,
-            inertia_kg_m2: 7.2e-6,
-            mass_kg: 0.03,
-        },
+        rotor: Rotor { viscous_damping_nms: 5.0e-4, inertia_kg_m2: 7.2e-6, mass_kg: 0.03 },
         thermal: Thermal {
             heat_transfer_coefficient_w_per_m2k: 10.0,
             surface_area_m2: 0.02366,
             heat_capacity_j_per_k: 150.0,
             ambient_c: 28.0,
         },
-        assembly: Assembly {
-            axial_spring_stiffness_n_per_m: 2.0e5,
-        },
+        assembly: Assembly { axial_spring_stiffness_n_per_m: 2.0e5 },
         effects: Effects::none(),
     }
 }
@@ -197,11 +176,7 @@ fn trum60_qut() -> Motor {
             contact_width_m: 3.2e-3,
             neutral_plane_distance_m: 4.0e-3,
         },
-        friction_layer: FrictionLayer {
-            youngs_modulus_pa: 4.3e9,
-            thickness_m: 0.5e-3,
-            friction_coefficient: 0.24,
-        },
+        friction_layer: FrictionLayer { youngs_modulus_pa: 4.3e9, thickness_m: 0.5e-3, friction_coefficient: 0.24 },
         stator: Stator {
             modal_mass_kg: 0.005,
             resonance_frequency_hz: 41_300.0,
@@ -213,20 +188,14 @@ fn trum60_qut() -> Motor {
             dielectric_loss_tangent: 3.5e-3,
             feedback_gain_v_per_m: 3.07e7,
         },
-        rotor: Rotor {
-            viscous_damping_nms: 5.0e-4,
-            inertia_kg_m2: 7.2e-6,
-            mass_kg: 0.03,
-        },
+        rotor: Rotor { viscous_damping_nms: 5.0e-4, inertia_kg_m2: 7.2e-6, mass_kg: 0.03 },
         thermal: Thermal {
             heat_transfer_coefficient_w_per_m2k: 10.0,
             surface_area_m2: 0.02366,
             heat_capacity_j_per_k: 150.0,
             ambient_c: 25.0,
         },
-        assembly: Assembly {
-            axial_spring_stiffness_n_per_m: 2.0e5,
-        },
+        assembly: Assembly { axial_spring_stiffness_n_per_m: 2.0e5 },
         effects: Effects::none(),
     }
 }
@@ -241,11 +210,7 @@ fn generic60() -> Motor {
             contact_width_m: 3.0e-3,
             neutral_plane_distance_m: 3.0e-3,
         },
-        friction_layer: FrictionLayer {
-            youngs_modulus_pa: 1.0e9,
-            thickness_m: 0.5e-3,
-            friction_coefficient: 0.25,
-        },
+        friction_layer: FrictionLayer { youngs_modulus_pa: 1.0e9, thickness_m: 0.5e-3, friction_coefficient: 0.25 },
         stator: Stator {
             modal_mass_kg: 0.01,
             resonance_frequency_hz: 40_000.0,
@@ -257,20 +222,14 @@ fn generic60() -> Motor {
             dielectric_loss_tangent: 5.0e-3,
             feedback_gain_v_per_m: 3.0e7,
         },
-        rotor: Rotor {
-            viscous_damping_nms: 2.0e-4,
-            inertia_kg_m2: 1.0e-5,
-            mass_kg: 0.04,
-        },
+        rotor: Rotor { viscous_damping_nms: 2.0e-4, inertia_kg_m2: 1.0e-5, mass_kg: 0.04 },
         thermal: Thermal {
             heat_transfer_coefficient_w_per_m2k: 10.0,
             surface_area_m2: 0.025,
             heat_capacity_j_per_k: 150.0,
             ambient_c: 25.0,
         },
-        assembly: Assembly {
-            axial_spring_stiffness_n_per_m: 2.0e5,
-        },
+        assembly: Assembly { axial_spring_stiffness_n_per_m: 2.0e5 },
         effects: Effects::none(),
     }
 }

@@ -26,12 +26,8 @@ const WGK: [f64; 8] = [
     0.209_482_141_084_727_8,
 ];
 /// Gauss 7-point weights for the odd Kronrod nodes (indices 1, 3, 5, 7).
-const WG: [f64; 4] = [
-    0.129_484_966_168_869_7,
-    0.279_705_391_489_276_7,
-    0.381_830_050_505_118_9,
-    0.417_959_183_673_469_4,
-];
+const WG: [f64; 4] =
+    [0.129_484_966_168_869_7, 0.279_705_391_489_276_7, 0.381_830_050_505_118_9, 0.417_959_183_673_469_4];
 
 fn gk15<F: Fn(f64) -> f64>(f: &F, a: f64, b: f64) -> (f64, f64) {
     let c = 0.5 * (a + b);
@@ -53,13 +49,7 @@ fn gk15<F: Fn(f64) -> f64>(f: &F, a: f64, b: f64) -> (f64, f64) {
 /// Integral of `f` over `[a, b]` to absolute tolerance `abs_tol` or relative tolerance
 /// `rel_tol`, whichever is looser. Splits adaptively; gives up refining after 2000
 /// intervals and returns the best estimate (the error estimate is returned too).
-pub fn integrate<F: Fn(f64) -> f64>(
-    f: F,
-    a: f64,
-    b: f64,
-    abs_tol: f64,
-    rel_tol: f64,
-) -> (f64, f64) {
+pub fn integrate<F: Fn(f64) -> f64>(f: F, a: f64, b: f64, abs_tol: f64, rel_tol: f64) -> (f64, f64) {
     if a == b {
         return (0.0, 0.0);
     }
@@ -72,10 +62,7 @@ pub fn integrate<F: Fn(f64) -> f64>(
     while err > abs_tol.max(rel_tol * total.abs()) && n < 2000 {
         // split the interval with the largest error
         let (idx, _) =
-            stack.iter().enumerate().fold(
-                (0, -1.0),
-                |(bi, be), (i, s)| if s.3 > be { (i, s.3) } else { (bi, be) },
-            );
+            stack.iter().enumerate().fold((0, -1.0), |(bi, be), (i, s)| if s.3 > be { (i, s.3) } else { (bi, be) });
         let (lo, hi, v0, e0) = stack.swap_remove(idx);
         let mid = 0.5 * (lo + hi);
         let (v1, e1) = gk15(&f, lo, mid);

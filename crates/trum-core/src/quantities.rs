@@ -24,12 +24,7 @@ impl std::fmt::Debug for Quantity {
 
 macro_rules! q {
     ($field:ident, $unit:literal, $doc:literal) => {
-        Quantity {
-            name: stringify!($field),
-            unit: $unit,
-            doc: $doc,
-            get: |s: &Solution| s.$field,
-        }
+        Quantity { name: stringify!($field), unit: $unit, doc: $doc, get: |s: &Solution| s.$field }
     };
 }
 
@@ -40,81 +35,29 @@ pub const QUANTITIES: &[Quantity] = &[
     q!(efficiency, "-", "output power / electrical input power"),
     q!(output_power_w, "W", "mechanical output power"),
     q!(input_power_w, "W", "electrical input power, both phases"),
-    q!(
-        stall_torque_nm,
-        "N m",
-        "stall (blocking) torque at this preload and drive"
-    ),
+    q!(stall_torque_nm, "N m", "stall (blocking) torque at this preload and drive"),
     q!(amplitude_m, "m", "wave amplitude at the contact surface"),
-    q!(
-        contact_angle_deg,
-        "deg",
-        "contact angle Xc, full arc per wave"
-    ),
-    q!(
-        driving_angle_deg,
-        "deg",
-        "driving angle Xs, full arc per wave"
-    ),
-    q!(
-        driving_ratio,
-        "-",
-        "proportion of the driving zone in the contact zone"
-    ),
-    q!(
-        contact_half_angle_rad,
-        "rad",
-        "contact half-angle phi0 in wave phase"
-    ),
-    q!(
-        stick_half_angle_rad,
-        "rad",
-        "stick half-angle theta_s in wave phase"
-    ),
+    q!(contact_angle_deg, "deg", "contact angle Xc, full arc per wave"),
+    q!(driving_angle_deg, "deg", "driving angle Xs, full arc per wave"),
+    q!(driving_ratio, "-", "proportion of the driving zone in the contact zone"),
+    q!(contact_half_angle_rad, "rad", "contact half-angle phi0 in wave phase"),
+    q!(stick_half_angle_rad, "rad", "stick half-angle theta_s in wave phase"),
     q!(contact_length_m, "m", "contact length per wave"),
-    q!(
-        crest_speed_m_s,
-        "m/s",
-        "peak tangential surface speed of the stator"
-    ),
+    q!(crest_speed_m_s, "m/s", "peak tangential surface speed of the stator"),
     q!(axial_force_n, "N", "axial contact force"),
     q!(dielectric_loss_w, "W", "dielectric loss"),
     q!(damping_loss_w, "W", "stator damping loss"),
     q!(friction_loss_w, "W", "contact friction loss"),
-    q!(
-        radial_friction_loss_w,
-        "W",
-        "radial-slip part of the friction loss"
-    ),
+    q!(radial_friction_loss_w, "W", "radial-slip part of the friction loss"),
     q!(rotor_loss_w, "W", "rotor viscous loss"),
     q!(current_a, "A", "drive current amplitude per phase"),
     q!(feedback_v, "V", "feedback electrode voltage amplitude"),
-    q!(
-        electrode_voltage_v,
-        "V",
-        "voltage at the electrodes (zero-to-peak)"
-    ),
-    q!(
-        phase_lag_rad,
-        "rad",
-        "phase lag of the wave behind the drive"
-    ),
+    q!(electrode_voltage_v, "V", "voltage at the electrodes (zero-to-peak)"),
+    q!(phase_lag_rad, "rad", "phase lag of the wave behind the drive"),
     q!(modal_stiffness_n_per_m, "N/m", "effective modal stiffness"),
-    q!(
-        temperature_rise_k,
-        "K",
-        "steady-state temperature rise over ambient"
-    ),
-    q!(
-        temperature_rise_at_elapsed_k,
-        "K",
-        "temperature rise at the point's elapsed time"
-    ),
-    q!(
-        speed_std_rpm,
-        "rpm",
-        "speed standard deviation over a revolution"
-    ),
+    q!(temperature_rise_k, "K", "steady-state temperature rise over ambient"),
+    q!(temperature_rise_at_elapsed_k, "K", "temperature rise at the point's elapsed time"),
+    q!(speed_std_rpm, "rpm", "speed standard deviation over a revolution"),
 ];
 
 /// Looks up a quantity by column name; the error lists the valid names.
@@ -122,11 +65,7 @@ pub fn find(name: &str) -> Result<&'static Quantity, String> {
     QUANTITIES.iter().find(|q| q.name == name).ok_or_else(|| {
         format!(
             "unknown quantity '{name}'; valid quantities are: {}",
-            QUANTITIES
-                .iter()
-                .map(|q| q.name)
-                .collect::<Vec<_>>()
-                .join(", ")
+            QUANTITIES.iter().map(|q| q.name).collect::<Vec<_>>().join(", ")
         )
     })
 }

@@ -37,13 +37,7 @@ pub struct OperatingPoint {
 impl OperatingPoint {
     /// A steady operating point (elapsed time 0).
     pub fn new(preload_n: f64, torque_nm: f64, voltage_v: f64, frequency_hz: f64) -> Self {
-        OperatingPoint {
-            preload_n,
-            torque_nm,
-            voltage_v,
-            frequency_hz,
-            elapsed_s: 0.0,
-        }
+        OperatingPoint { preload_n, torque_nm, voltage_v, frequency_hz, elapsed_s: 0.0 }
     }
 
     /// Why the point is invalid, if it is.
@@ -259,11 +253,7 @@ impl Prepared {
             n: g.wave_number,
             r0: g.mean_radius_m,
             k: g.wave_number / g.mean_radius_m,
-            kf: contact::layer_stiffness_n_per_m2(
-                fl.youngs_modulus_pa,
-                g.contact_width_m,
-                fl.thickness_m,
-            ),
+            kf: contact::layer_stiffness_n_per_m2(fl.youngs_modulus_pa, g.contact_width_m, fl.thickness_m),
             h0: g.neutral_plane_distance_m,
             mu: fl.friction_coefficient,
             m: st.modal_mass_kg,
@@ -274,8 +264,7 @@ impl Prepared {
             tan_d: motor.electrical.dielectric_loss_tangent,
             kfb: motor.electrical.feedback_gain_v_per_m,
             dr: motor.rotor.viscous_damping_nms,
-            alpha_s: motor.thermal.heat_transfer_coefficient_w_per_m2k
-                * motor.thermal.surface_area_m2,
+            alpha_s: motor.thermal.heat_transfer_coefficient_w_per_m2k * motor.thermal.surface_area_m2,
             heat_cap: motor.thermal.heat_capacity_j_per_k,
             stiffening: fx.value(Effect::PreloadStiffening, 0),
             beta: fx.value(Effect::HertzSoftening, 0),
@@ -334,17 +323,7 @@ fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>) -> Trial {
     }
     let z = (k_eff - p.m * d.omega * d.omega, d.omega * p.c + ct_omega);
     let w_next = p.theta * d.v / (z.0 * z.0 + z.1 * z.1).sqrt();
-    Trial {
-        w,
-        contact: ct,
-        ts,
-        stalled,
-        a,
-        v0,
-        z,
-        k_eff,
-        w_next,
-    }
+    Trial { w, contact: ct, ts, stalled, a, v0, z, k_eff, w_next }
 }
 
 /// Solves one operating point from scratch. Never panics; an invalid or unsolvable point
@@ -355,12 +334,7 @@ pub fn solve(motor: &Motor, op: &OperatingPoint) -> Solution {
 
 /// Solves one operating point, optionally warm-started from a neighbouring solution
 /// (sweeps use this; the result does not depend on the guess beyond the tolerance).
-pub fn solve_prepared(
-    p: &Prepared,
-    motor: &Motor,
-    op: &OperatingPoint,
-    guess: Option<&Solution>,
-) -> Solution {
+pub fn solve_prepared(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
     if op.invalid_reason().is_some() {
         return Solution::invalid(Status::InvalidInput);
     }
@@ -382,9 +356,7 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
     // the bracket is then grown below.
     let w_hi0 = p.theta * d.v / (d.omega * p.c);
     let mut evals = 0u32;
-    let mut ts_guess = guess
-        .map(|g| g.stick_half_angle_rad)
-        .filter(|t| t.is_finite());
+    let mut ts_guess = guess.map(|g| g.stick_half_angle_rad).filter(|t| t.is_finite());
     let mut eval = |w: f64, ts_guess: &mut Option<f64>| {
         evals += 1;
         let t = trial(p, d, w, *ts_guess);
@@ -400,10 +372,7 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
     }
     let mut lo: Option<Trial> = None;
     // Start: warm guess if it lies inside the bracket, else one fixed-point step from the top.
-    let start = guess
-        .map(|g| g.amplitude_m)
-        .filter(|w| w.is_finite() && *w > 0.0 && *w < hi.w)
-        .unwrap_or(hi.w_next);
+    let start = guess.map(|g| g.amplitude_m).filter(|w| w.is_finite() && *w > 0.0 && *w < hi.w).unwrap_or(hi.w_next);
     let mut cur = eval(start, &mut ts_guess);
     let mut prev: Option<Trial> = None;
     let mut converged = false;
@@ -483,11 +452,7 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
 fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {
     Trial {
         w: 0.0,
-        contact: Contact {
-            half_angle_rad: PI,
-            offset: f64::NEG_INFINITY,
-            full: true,
-        },
+        contact: Contact { half_angle_rad: PI, offset: f64::NEG_INFINITY, full: true },
         ts: 0.5 * PI,
         stalled: true,
         a: 0.0,
@@ -498,22 +463,11 @@ fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {
     }
 }
 
-fn finish(
-    p: &Prepared,
-    d: &Drive,
-    op: &OperatingPoint,
-    t: &Trial,
-    status: Status,
-    evals: u32,
-) -> Solution {
+fn finish(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, status: Status, evals: u32) -> Solution {
     let w = t.w;
     let ct = &t.contact;
     let clamped = status == Status::Clamped;
-    let speed = if t.stalled {
-        0.0
-    } else {
-        t.v0 * t.ts.cos() / p.r0
-    };
+    let speed = if t.stalled { 0.0 } else { t.v0 * t.ts.cos() / p.r0 };
     let vr = speed * p.r0;
     let stall_torque = if clamped {
         0.0
@@ -521,11 +475,8 @@ fn finish(
         p.r0 * d.mu * t.a * contact::torque_factor(contact::stall_stick_half_angle_rad(ct), ct)
     };
     // Friction loss = ∫ μ p |v_s − v_r| dx: closed form of crate::losses::friction_loss_coulomb_w.
-    let friction = if clamped {
-        0.0
-    } else {
-        crate::losses::friction_loss_coulomb_w(p.n, d.mu, p.kf, w, p.k, t.v0, vr, t.ts, ct)
-    };
+    let friction =
+        if clamped { 0.0 } else { crate::losses::friction_loss_coulomb_w(p.n, d.mu, p.kf, w, p.k, t.v0, vr, t.ts, ct) };
     let omega = d.omega;
     let damping = p.c * omega * omega * w * w;
     let dielectric = crate::losses::dielectric_loss_w(omega, p.c0, p.tan_d, d.v);
@@ -538,11 +489,7 @@ fn finish(
     };
     let input = d.v * ire;
     let losses = dielectric + damping + friction + rotor;
-    let efficiency = if input > 0.0 {
-        (output / input).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let efficiency = if input > 0.0 { (output / input).clamp(0.0, 1.0) } else { 0.0 };
     let rise_ss = losses / p.alpha_s;
     let rise_t = rise_ss * (1.0 - (-p.alpha_s * op.elapsed_s / p.heat_cap).exp());
     let xc = contact::contact_angle_deg(ct.half_angle_rad, p.n);
@@ -556,21 +503,13 @@ fn finish(
         contact_length_m: contact::contact_length_m(ct.half_angle_rad, p.k),
         stick_half_angle_rad: t.ts,
         driving_angle_deg: contact::contact_angle_deg(t.ts, p.n),
-        driving_ratio: if ct.half_angle_rad > 0.0 {
-            t.ts / ct.half_angle_rad
-        } else {
-            0.0
-        },
+        driving_ratio: if ct.half_angle_rad > 0.0 { t.ts / ct.half_angle_rad } else { 0.0 },
         speed_rad_s: speed,
         speed_rpm: speed * RAD_S_TO_RPM,
         crest_speed_m_s: t.v0,
         torque_nm: op.torque_nm,
         stall_torque_nm: stall_torque,
-        axial_force_n: if clamped {
-            op.preload_n
-        } else {
-            t.a * ct.chi0()
-        },
+        axial_force_n: if clamped { op.preload_n } else { t.a * ct.chi0() },
         input_power_w: input,
         output_power_w: output,
         dielectric_loss_w: dielectric,
@@ -582,11 +521,7 @@ fn finish(
         feedback_v: stator::feedback_voltage_v(p.kfb, w),
         current_a: ire.hypot(iim),
         electrode_voltage_v: d.v,
-        phase_lag_rad: if clamped {
-            0.5 * PI
-        } else {
-            t.z.1.atan2(t.z.0)
-        },
+        phase_lag_rad: if clamped { 0.5 * PI } else { t.z.1.atan2(t.z.0) },
         modal_stiffness_n_per_m: t.k_eff,
         temperature_rise_k: rise_ss,
         temperature_rise_at_elapsed_k: rise_t,

@@ -36,16 +36,8 @@ pub fn crest_surface_speed_m_s(
 
 /// Complex modal impedance Z = (k_eff − m·ω²) + i·ω·c_total [N/m]; returns (re, im).
 #[inline]
-pub fn impedance(
-    k_eff_n_per_m: f64,
-    modal_mass_kg: f64,
-    omega_rad_s: f64,
-    damping_total_ns_per_m: f64,
-) -> (f64, f64) {
-    (
-        k_eff_n_per_m - modal_mass_kg * omega_rad_s * omega_rad_s,
-        omega_rad_s * damping_total_ns_per_m,
-    )
+pub fn impedance(k_eff_n_per_m: f64, modal_mass_kg: f64, omega_rad_s: f64, damping_total_ns_per_m: f64) -> (f64, f64) {
+    (k_eff_n_per_m - modal_mass_kg * omega_rad_s * omega_rad_s, omega_rad_s * damping_total_ns_per_m)
 }
 
 /// Phase current of one phase as (in-phase, quadrature) amplitudes [A]: dielectric

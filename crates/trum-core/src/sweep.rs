@@ -23,11 +23,7 @@ pub struct Axis {
 impl Axis {
     /// A single value.
     pub fn fixed(v: f64) -> Axis {
-        Axis {
-            start: v,
-            stop: v,
-            n: 1,
-        }
+        Axis { start: v, stop: v, n: 1 }
     }
     /// `n` evenly spaced values.
     pub fn linspace(start: f64, stop: f64, n: usize) -> Axis {
@@ -63,21 +59,13 @@ impl Grid {
     pub fn validate(&self) -> Result<(), TrumError> {
         for (name, ax) in AXES.iter().zip(self.axes()) {
             if ax.n == 0 {
-                return Err(TrumError::input(format!(
-                    "{name}: an axis needs at least one point"
-                )));
+                return Err(TrumError::input(format!("{name}: an axis needs at least one point")));
             }
             for v in [ax.start, ax.stop] {
                 if !v.is_finite() {
-                    return Err(TrumError::input(format!(
-                        "{name}: {v} is not a finite number"
-                    )));
+                    return Err(TrumError::input(format!("{name}: {v} is not a finite number")));
                 }
-                let ok = if *name == "torque_nm" {
-                    v >= 0.0
-                } else {
-                    v > 0.0
-                };
+                let ok = if *name == "torque_nm" { v >= 0.0 } else { v > 0.0 };
                 if !ok {
                     let rule = if *name == "torque_nm" { ">= 0" } else { "> 0" };
                     return Err(TrumError::input(format!("{name}: {v} must be {rule}")));
@@ -85,26 +73,17 @@ impl Grid {
             }
         }
         if self.len_checked().is_none() {
-            return Err(TrumError::input(
-                "the grid has more points than fit in 64 bits",
-            ));
+            return Err(TrumError::input("the grid has more points than fit in 64 bits"));
         }
         Ok(())
     }
 
     fn axes(&self) -> [Axis; 4] {
-        [
-            self.preload_n,
-            self.voltage_v,
-            self.frequency_hz,
-            self.torque_nm,
-        ]
+        [self.preload_n, self.voltage_v, self.frequency_hz, self.torque_nm]
     }
 
     fn len_checked(&self) -> Option<u64> {
-        self.axes()
-            .iter()
-            .try_fold(1u64, |acc, a| acc.checked_mul(a.n as u64))
+        self.axes().iter().try_fold(1u64, |acc, a| acc.checked_mul(a.n as u64))
     }
 
     /// Number of points.
@@ -140,24 +119,14 @@ impl Grid {
 /// Solves the points `range` of `grid` in order, warm-starting each from the previous
 /// one, and hands every (index, point, solution) to `sink`. Pure; the caller decides how
 /// chunks are spread over threads.
-pub fn solve_range<F>(
-    motor: &Motor,
-    prepared: &Prepared,
-    grid: &Grid,
-    range: std::ops::Range<u64>,
-    mut sink: F,
-) where
+pub fn solve_range<F>(motor: &Motor, prepared: &Prepared, grid: &Grid, range: std::ops::Range<u64>, mut sink: F)
+where
     F: FnMut(u64, &OperatingPoint, &Solution),
 {
     let mut prev: Option<Solution> = None;
     for i in range {
         let op = grid.point(i);
-        let s = solve_prepared(
-            prepared,
-            motor,
-            &op,
-            prev.as_ref().filter(|p| p.status.is_valid()),
-        );
+        let s = solve_prepared(prepared, motor, &op, prev.as_ref().filter(|p| p.status.is_valid()));
         sink(i, &op, &s);
         prev = Some(s);
     }
@@ -176,27 +145,14 @@ mod tests {
         };
         assert_eq!(g.len(), 36);
         let p = g.point(0);
-        assert_eq!(
-            (p.preload_n, p.frequency_hz, p.torque_nm),
-            (100.0, 42e3, 0.0)
-        );
+        assert_eq!((p.preload_n, p.frequency_hz, p.torque_nm), (100.0, 42e3, 0.0));
         let p = g.point(7);
-        assert_eq!(
-            (p.preload_n, p.frequency_hz, p.torque_nm),
-            (100.0, 43e3, 0.1)
-        );
+        assert_eq!((p.preload_n, p.frequency_hz, p.torque_nm), (100.0, 43e3, 0.1));
         let p = g.point(35);
-        assert_eq!(
-            (p.preload_n, p.frequency_hz, p.torque_nm),
-            (300.0, 43e3, 0.5)
-        );
+        assert_eq!((p.preload_n, p.frequency_hz, p.torque_nm), (300.0, 43e3, 0.5));
         assert!(g.validate().is_ok());
         let mut bad = g;
         bad.preload_n.start = 0.0;
-        assert!(bad
-            .validate()
-            .unwrap_err()
-            .to_string()
-            .contains("preload_n: 0 must be > 0"));
+        assert!(bad.validate().unwrap_err().to_string().contains("preload_n: 0 must be > 0"));
     }
 }

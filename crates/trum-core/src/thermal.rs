@@ -6,12 +6,7 @@
 
 /// Temperature rise over ambient after `elapsed_s` of constant loss [K] (seed 000 eq. 11).
 /// Valid for loss ≥ 0, α·S > 0, C > 0, t ≥ 0; t → ∞ gives the steady rise P/(α·S).
-pub fn temperature_rise_k(
-    loss_w: f64,
-    alpha_s_w_per_k: f64,
-    heat_capacity_j_per_k: f64,
-    elapsed_s: f64,
-) -> f64 {
+pub fn temperature_rise_k(loss_w: f64, alpha_s_w_per_k: f64, heat_capacity_j_per_k: f64, elapsed_s: f64) -> f64 {
     loss_w / alpha_s_w_per_k * (1.0 - (-alpha_s_w_per_k * elapsed_s / heat_capacity_j_per_k).exp())
 }
 
