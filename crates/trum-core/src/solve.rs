@@ -279,6 +279,8 @@ struct Trial {
     w: f64,
     contact: Contact,
     ts: f64,
+    /// Rotor surface speed [m/s]: v0·cos θs, or below it when the whole contact drives.
+    vr: f64,
     stalled: bool,
     a: f64,
     v0: f64,
@@ -305,9 +307,19 @@ fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>) -> Trial {
     let v0 = stator::crest_surface_speed_m_s(p.k, p.h0, d.omega, w);
     let tscale = p.r0 * d.mu * a;
     let visc = p.dr * v0 / p.r0;
-    let (ts, stalled) = match contact::stick_half_angle_rad(&ct, tscale, d.t_load, visc, ts_guess) {
-        Some(t) => (t, false),
-        None => (contact::stall_stick_half_angle_rad(&ct), true),
+    let (ts, vr, stalled) = match contact::stick_half_angle_rad(&ct, tscale, d.t_load, visc, ts_guess) {
+        Some(t) => (t, v0 * t.cos(), false),
+        None => {
+            let tmax = contact::stall_stick_half_angle_rad(&ct);
+            // Narrow contact (φ0 < π/2): below v_r = v0·cos φ0 the whole contact drives with
+            // the constant torque R0·μ·F, and the rotor's viscous torque sets the speed.
+            let drive = tscale * contact::torque_factor(tmax, &ct);
+            if tmax < 0.5 * PI && p.dr > 0.0 && d.t_load < drive {
+                (tmax, ((drive - d.t_load) / p.dr * p.r0).min(v0 * tmax.cos()), false)
+            } else {
+                (tmax, 0.0, true)
+            }
+        }
     };
     // Friction damping: power taken from the wave over (ω W)², per unit ω: c_t·ω = 2Nμk_f·h0·[2E(θs) − E(φ0)].
     let pf = 2.0 * contact::e_int(ts, ct.offset) - contact::e_int(ct.half_angle_rad, ct.offset);
@@ -323,7 +335,7 @@ fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>) -> Trial {
     }
     let z = (k_eff - p.m * d.omega * d.omega, d.omega * p.c + ct_omega);
     let w_next = p.theta * d.v / (z.0 * z.0 + z.1 * z.1).sqrt();
-    Trial { w, contact: ct, ts, stalled, a, v0, z, k_eff, w_next }
+    Trial { w, contact: ct, ts, vr, stalled, a, v0, z, k_eff, w_next }
 }
 
 /// Solves one operating point from scratch. Never panics; an invalid or unsolvable point
@@ -454,6 +466,7 @@ fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {
         w: 0.0,
         contact: Contact { half_angle_rad: PI, offset: f64::NEG_INFINITY, full: true },
         ts: 0.5 * PI,
+        vr: 0.0,
         stalled: true,
         a: 0.0,
         v0: 0.0,
@@ -467,7 +480,7 @@ fn finish(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, status: Statu
     let w = t.w;
     let ct = &t.contact;
     let clamped = status == Status::Clamped;
-    let speed = if t.stalled { 0.0 } else { t.v0 * t.ts.cos() / p.r0 };
+    let speed = if t.stalled { 0.0 } else { t.vr / p.r0 };
     let vr = speed * p.r0;
     let stall_torque = if clamped {
         0.0
