@@ -93,7 +93,8 @@ fn light_preload_limit_is_the_free_stator() {
     let s = solve(&m, &OperatingPoint::new(1e-4, 0.0, v, f_hz));
     let w = 2.0 * PI * f_hz;
     let k = m.stator.modal_mass_kg * (2.0 * PI * m.stator.resonance_frequency_hz).powi(2);
-    let free = m.stator.force_factor_n_per_v * v / (k - m.stator.modal_mass_kg * w * w).hypot(w * m.stator.modal_damping_ns_per_m);
+    let free = m.stator.force_factor_n_per_v * v
+        / (k - m.stator.modal_mass_kg * w * w).hypot(w * m.stator.modal_damping_ns_per_m);
     assert!((s.amplitude_m - free).abs() < 1e-3 * free, "{} vs {free}", s.amplitude_m);
     assert!((s.speed_rad_s * m.geometry.mean_radius_m - s.crest_speed_m_s).abs() < 1e-3 * s.crest_speed_m_s);
     let kw = m.geometry.wave_number / m.geometry.mean_radius_m;

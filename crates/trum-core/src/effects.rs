@@ -75,7 +75,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         params: &[EffectParam {
             name: "radial_velocity_ratio",
             doc: "peak radial surface speed over peak tangential surface speed [-]",
-            typical: 0.5,
+            typical: 1.0,
             min: 0.0,
             max: 3.0,
         }],
@@ -88,9 +88,9 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         params: &[EffectParam {
             name: "stiffness_scale",
             doc: "multiplier of the contact stiffness of seed 001 eq. 8 added to the mode [-]",
-            typical: 1.0,
+            typical: 0.05,
             min: 0.0,
-            max: 20.0,
+            max: 5.0,
         }],
     },
     EffectInfo {
@@ -102,14 +102,14 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
             EffectParam {
                 name: "beta_n_per_m3",
                 doc: "softening cubic stiffness coefficient at zero preload [N/m^3]",
-                typical: 2.0e19,
+                typical: 1.0e18,
                 min: 0.0,
                 max: 1.0e23,
             },
             EffectParam {
                 name: "preload_gain_per_n",
                 doc: "relative growth of the cubic coefficient per newton of preload [1/N]",
-                typical: 0.005,
+                typical: 0.004,
                 min: 0.0,
                 max: 1.0,
             },
@@ -174,7 +174,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
             doc: "ratio of tangential to normal compliance of the friction layer [-]",
             typical: 1.0,
             min: 0.0,
-            max: 50.0,
+            max: 20.0,
         }],
     },
 ];
@@ -215,12 +215,25 @@ pub fn valid_names() -> String {
 pub struct Effects {
     on: [bool; N_EFFECTS],
     values: [[f64; 2]; N_EFFECTS],
+    truth: bool,
 }
 
 impl Effects {
     /// No effects: the baseline model.
     pub fn none() -> Effects {
         Effects::default()
+    }
+
+    /// Use the bench-truth forms of the effects (different in form from the candidate
+    /// forms that calibration and diagnosis fit; see docs/EFFECTS.md). `trum synth` uses
+    /// them by default so a diagnosis cannot pass by recognising its own formulas.
+    pub fn set_truth_forms(&mut self, on: bool) {
+        self.truth = on;
+    }
+
+    /// True when the bench-truth forms are in use.
+    pub fn truth_forms(&self) -> bool {
+        self.truth
     }
 
     /// True when no effect is switched on.
@@ -355,6 +368,21 @@ impl Effects {
     pub(crate) fn from_toml_table(t: &toml::Table, text: &str, source_name: &str) -> Result<Effects, ParamError> {
         let mut fx = Effects::none();
         for (name, val) in t {
+            if name == "form" {
+                match val.as_str() {
+                    Some("truth") => fx.truth = true,
+                    Some("candidate") => fx.truth = false,
+                    _ => {
+                        return Err(ParamError {
+                            source_name: source_name.into(),
+                            line: line_of_key(text, "effects", "form"),
+                            key: "effects.form".into(),
+                            reason: "must be \"candidate\" or \"truth\"".into(),
+                        })
+                    }
+                }
+                continue;
+            }
             let err = |reason: String, key: String| ParamError {
                 source_name: source_name.into(),
                 line: line_of_key(text, "effects", name),
@@ -411,6 +439,9 @@ impl Effects {
             return "\n[effects]  # none switched on; see `trum effects`\n".into();
         }
         let mut s = String::from("\n[effects]\n");
+        if self.truth {
+            s.push_str("form = \"truth\"\n");
+        }
         for e in self.active() {
             let parts: Vec<String> = e
                 .info()
@@ -444,7 +475,11 @@ impl fmt::Display for Effects {
                 format!("{}({})", e.name(), ps.join(", "))
             })
             .collect();
-        f.write_str(&parts.join(" + "))
+        f.write_str(&parts.join(" + "))?;
+        if self.truth {
+            f.write_str(" [truth forms]")?;
+        }
+        Ok(())
     }
 }
 

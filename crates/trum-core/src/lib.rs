@@ -27,5 +27,6 @@ pub use params::Motor;
 pub use solve::{solve, OperatingPoint, Solution, Status};
 pub mod criterion;
 pub mod fluctuation;
+pub mod interface;
 pub mod quantities;
 pub mod sweep;

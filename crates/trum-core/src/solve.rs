@@ -159,6 +159,10 @@ pub struct Solution {
     pub feedback_v: f64,
     /// Drive current amplitude per phase [A].
     pub current_a: f64,
+    /// Part of the phase current in phase with the electrode voltage [A].
+    pub current_in_phase_a: f64,
+    /// Part of the phase current in quadrature (leading) [A].
+    pub current_quadrature_a: f64,
     /// Voltage at the electrodes, zero-to-peak [V] (below the set voltage with `voltage_sag`).
     pub electrode_voltage_v: f64,
     /// Phase lag ψ of the wave behind the drive [rad].
@@ -208,6 +212,8 @@ impl Solution {
             efficiency: n,
             feedback_v: n,
             current_a: n,
+            current_in_phase_a: n,
+            current_quadrature_a: n,
             electrode_voltage_v: n,
             phase_lag_rad: n,
             modal_stiffness_n_per_m: n,
@@ -240,6 +246,12 @@ pub struct Prepared {
     pub(crate) stiffening: f64,
     pub(crate) beta: f64,
     pub(crate) beta_gain: f64,
+    pub(crate) law: crate::interface::Law,
+    pub(crate) compliance: f64,
+    pub(crate) thermal: (f64, f64),
+    pub(crate) sag_ohm: f64,
+    pub(crate) runout_m: f64,
+    pub(crate) truth: bool,
 }
 
 impl Prepared {
@@ -269,6 +281,16 @@ impl Prepared {
             stiffening: fx.value(Effect::PreloadStiffening, 0),
             beta: fx.value(Effect::HertzSoftening, 0),
             beta_gain: fx.value(Effect::HertzSoftening, 1),
+            law: crate::interface::Law {
+                radial_ratio: fx.value(Effect::RadialFriction, 0),
+                slip_scale: 0.0,
+                truth: fx.truth_forms(),
+            },
+            compliance: fx.value(Effect::TangentialCompliance, 0),
+            thermal: (fx.value(Effect::ThermalDrift, 0), fx.value(Effect::ThermalDrift, 1)),
+            sag_ohm: fx.value(Effect::VoltageSag, 0),
+            runout_m: fx.value(Effect::Eccentricity, 0),
+            truth: fx.truth_forms(),
         }
     }
 }
@@ -284,6 +306,12 @@ struct Trial {
     stalled: bool,
     a: f64,
     v0: f64,
+    /// Interface factors: torque, power taken per v0, radial power per v0 (see crate::interface).
+    tf: f64,
+    pf: f64,
+    rf: f64,
+    /// Torque factor with the rotor at rest (stall torque = R0·μ·A·tf0).
+    tf0: f64,
     z: (f64, f64),
     k_eff: f64,
     /// Θ·V/|Z|: the amplitude this trial implies.
@@ -301,41 +329,128 @@ struct Drive {
     ks: f64,
 }
 
-fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>) -> Trial {
-    let a = contact::force_scale_n(p.n, p.kf, w, p.k);
-    let ct = contact::contact_from_ratio(d.f_n / a);
-    let v0 = stator::crest_surface_speed_m_s(p.k, p.h0, d.omega, w);
-    let tscale = p.r0 * d.mu * a;
+/// Baseline 2-D Coulomb interface: closed forms (seed 001 eq. 10-11; crate::contact).
+fn coulomb_interface(
+    p: &Prepared,
+    d: &Drive,
+    ct: &Contact,
+    tscale: f64,
+    v0: f64,
+    ts_guess: Option<f64>,
+) -> (f64, f64, bool) {
     let visc = p.dr * v0 / p.r0;
-    let (ts, vr, stalled) = match contact::stick_half_angle_rad(&ct, tscale, d.t_load, visc, ts_guess) {
+    match contact::stick_half_angle_rad(ct, tscale, d.t_load, visc, ts_guess) {
         Some(t) => (t, v0 * t.cos(), false),
         None => {
-            let tmax = contact::stall_stick_half_angle_rad(&ct);
+            let tmax = contact::stall_stick_half_angle_rad(ct);
             // Narrow contact (φ0 < π/2): below v_r = v0·cos φ0 the whole contact drives with
             // the constant torque R0·μ·F, and the rotor's viscous torque sets the speed.
-            let drive = tscale * contact::torque_factor(tmax, &ct);
+            let drive = tscale * contact::torque_factor(tmax, ct);
             if tmax < 0.5 * PI && p.dr > 0.0 && d.t_load < drive {
                 (tmax, ((drive - d.t_load) / p.dr * p.r0).min(v0 * tmax.cos()), false)
             } else {
                 (tmax, 0.0, true)
             }
         }
+    }
+}
+
+/// Generalised interface (radial slip, saturating traction): the rotor speed ratio
+/// u = v_r/v0 solves R0·μ·A·torque(u) = T_load + d_r·v0·u/R0 by safeguarded regula falsi
+/// (torque(u) decreases with u, so the root is unique).
+fn general_interface(
+    p: &Prepared,
+    d: &Drive,
+    ct: &Contact,
+    tscale: f64,
+    v0: f64,
+    law: &crate::interface::Law,
+) -> (f64, f64, bool, crate::interface::Factors, f64) {
+    use crate::interface::factors;
+    let visc = p.dr * v0 / p.r0;
+    let f = |u: f64| {
+        let fac = factors(ct, u, law);
+        (tscale * fac.torque - d.t_load - visc * u, fac)
     };
-    // Friction damping: power taken from the wave over (ω W)², per unit ω: c_t·ω = 2Nμk_f·h0·[2E(θs) − E(φ0)].
-    let pf = 2.0 * contact::e_int(ts, ct.offset) - contact::e_int(ct.half_angle_rad, ct.offset);
+    let (f0, fac0) = f(0.0);
+    if f0 < 0.0 {
+        return (contact::stall_stick_half_angle_rad(ct), 0.0, true, fac0, fac0.torque);
+    }
+    let (mut lo, mut flo) = (0.0, f0);
+    let (f1, fac1) = f(1.0);
+    if f1 >= 0.0 {
+        return (0.0, v0, false, fac1, fac0.torque);
+    }
+    let (mut hi, mut fhi) = (1.0, f1);
+    let mut best = fac1;
+    let mut u = 0.5;
+    for i in 0..100 {
+        u = lo - flo * (hi - lo) / (fhi - flo);
+        if !(u > lo && u < hi) || i % 3 == 2 {
+            u = 0.5 * (lo + hi);
+        }
+        let (fu, fac) = f(u);
+        best = fac;
+        if fu > 0.0 {
+            lo = u;
+            flo = fu;
+        } else {
+            hi = u;
+            fhi = fu;
+        }
+        if hi - lo < 1e-13 || fu == 0.0 {
+            break;
+        }
+    }
+    let ts = u.clamp(-1.0, 1.0).acos().min(ct.half_angle_rad);
+    (ts, u * v0, false, best, fac0.torque)
+}
+
+fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>) -> Trial {
+    let a = contact::force_scale_n(p.n, p.kf, w, p.k);
+    let ct = contact::contact_from_ratio(d.f_n / a);
+    let v0 = stator::crest_surface_speed_m_s(p.k, p.h0, d.omega, w);
+    let tscale = p.r0 * d.mu * a;
+    let (ts, vr, stalled, tf, pf, rf, tf0);
+    if p.law.radial_ratio == 0.0 && p.compliance == 0.0 {
+        (ts, vr, stalled) = coulomb_interface(p, d, &ct, tscale, v0, ts_guess);
+        tf = contact::torque_factor(ts, &ct);
+        // c_t·ω = 2Nμk_f·h0·[2E(θs) − E(φ0)]: friction power taken from the wave over (ωW)².
+        pf = 2.0 * contact::e_int(ts, ct.offset) - contact::e_int(ct.half_angle_rad, ct.offset);
+        rf = 0.0;
+        tf0 = contact::torque_factor(contact::stall_stick_half_angle_rad(&ct), &ct);
+    } else {
+        let mut law = p.law;
+        if p.compliance > 0.0 {
+            // Slip-speed scale of the layer's shear compliance: the layer deflects κ·μ times
+            // its normal deflection W·(1 − c) before it slips, at the wave's frequency,
+            // relative to the crest speed k·h0·ω·W.
+            law.slip_scale = p.compliance * d.mu * (1.0 - ct.offset.max(-1.0)) / (p.k * p.h0);
+        }
+        let (t, v, st, fac, t0) = general_interface(p, d, &ct, tscale, v0, &law);
+        (ts, vr, stalled, tf, pf, rf, tf0) = (t, v, st, fac.torque, fac.power, fac.radial, t0);
+    }
     let ct_omega = 2.0 * p.n * d.mu * p.kf * p.h0 * pf;
     let mut k_eff = d.ks;
     if p.stiffening != 0.0 {
-        // seed 001 eq. 8: k_s' = (2 n k_f / k)·[sin(kx0) − kx0·cos(kx0)] = A·χ(φ0)/W.
-        k_eff += p.stiffening * a * ct.chi0() / w;
+        k_eff += p.stiffening
+            * if p.truth {
+                // modal projection of the pressure onto the mode shape: (N k_f/k)(φ0 − sin φ0 cos c)
+                let phi = ct.half_angle_rad;
+                (p.n * p.kf / p.k) * (phi - phi.sin() * ct.offset)
+            } else {
+                // seed 001 eq. 8: k_s' = (2 n k_f / k)·[sin(kx0) − kx0·cos(kx0)] = A·χ(φ0)/W.
+                a * ct.chi0() / w
+            };
     }
     if p.beta != 0.0 {
         // seed 003: softening cubic term, harmonic balance ⇒ k − (3/4)·β·W².
-        k_eff -= 0.75 * p.beta * (1.0 + p.beta_gain * d.f_n) * w * w;
+        let growth = if p.truth { (1.0 + p.beta_gain * d.f_n).powf(1.3) } else { 1.0 + p.beta_gain * d.f_n };
+        k_eff -= 0.75 * p.beta * growth * w * w;
     }
     let z = (k_eff - p.m * d.omega * d.omega, d.omega * p.c + ct_omega);
     let w_next = p.theta * d.v / (z.0 * z.0 + z.1 * z.1).sqrt();
-    Trial { w, contact: ct, ts, vr, stalled, a, v0, z, k_eff, w_next }
+    Trial { w, contact: ct, ts, vr, stalled, a, v0, tf, pf, rf, tf0, z, k_eff, w_next }
 }
 
 /// Solves one operating point from scratch. Never panics; an invalid or unsolvable point
@@ -350,7 +465,17 @@ pub fn solve_prepared(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: O
     if op.invalid_reason().is_some() {
         return Solution::invalid(Status::InvalidInput);
     }
-    let d = Drive {
+    if p.runout_m > 0.0 {
+        return eccentric_average(p, motor, op, guess);
+    }
+    solve_effects(p, op, guess)
+}
+
+/// Effects that depend on the solution itself (temperature from the losses, electrode
+/// voltage from the current) are solved by fixed-point iteration around the amplitude
+/// solve; both maps are contractions for physical strengths (a few passes).
+fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
+    let mut d = Drive {
         f_n: op.preload_n,
         t_load: op.torque_nm,
         v: op.voltage_v,
@@ -358,8 +483,158 @@ pub fn solve_prepared(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: O
         mu: p.mu,
         ks: p.ks,
     };
-    let _ = motor;
-    solve_drive(p, &d, op, guess)
+    let thermal = (p.thermal.0 != 0.0 || p.thermal.1 != 0.0) && op.elapsed_s > 0.0;
+    let sag = p.sag_ohm > 0.0;
+    if !thermal && !sag {
+        return solve_drive(p, &d, op, guess);
+    }
+    let mut rise = 0.0;
+    let mut s = solve_drive(p, &d, op, guess);
+    for _ in 0..100 {
+        let (mut new_rise, mut new_v) = (rise, d.v);
+        if thermal {
+            new_rise = temperature_rise_for_drift(p, s.total_loss_w(), op.elapsed_s);
+        }
+        if sag {
+            // V_set = V_e·(1 + Z_src·Y), Y = I/V_e the phase admittance (complex).
+            let (yr, yi) = (s.current_in_phase_a / d.v, s.current_quadrature_a / d.v);
+            let (zr, zi) = if p.truth { (p.sag_ohm, 0.5 * p.sag_ohm) } else { (p.sag_ohm, 0.0) };
+            let (re, im) = (1.0 + zr * yr - zi * yi, zr * yi + zi * yr);
+            new_v = op.voltage_v / re.hypot(im);
+        }
+        let done = (new_rise - rise).abs() <= 1e-10 * (1.0 + rise.abs()) && (new_v - d.v).abs() <= 1e-12 * op.voltage_v;
+        rise = new_rise;
+        d.v = new_v;
+        if thermal {
+            let (a, b) = p.thermal;
+            (d.ks, d.mu) = if p.truth {
+                (p.ks * (a * rise).exp(), p.mu * (b * rise).exp())
+            } else {
+                (p.ks * (1.0 + a * rise), p.mu * (1.0 + b * rise))
+            };
+        }
+        let prev = s.clone();
+        s = solve_drive(p, &d, op, Some(&prev).filter(|g| g.status.is_valid()));
+        if done {
+            break;
+        }
+        if !s.status.is_valid() {
+            break;
+        }
+    }
+    s.temperature_rise_at_elapsed_k = if thermal { rise } else { s.temperature_rise_at_elapsed_k };
+    s
+}
+
+/// Temperature rise driving `thermal_drift`: seed 000 eq. 11 (one lumped capacity) for
+/// the candidate form; the truth form adds a fast near-interface node (40 % of the rise
+/// with a tenth of the time constant), as the paper's sensor behind the teeth sees.
+fn temperature_rise_for_drift(p: &Prepared, loss_w: f64, elapsed_s: f64) -> f64 {
+    let ss = loss_w / p.alpha_s;
+    let tau = p.heat_cap / p.alpha_s;
+    if p.truth {
+        ss * (1.0 - 0.6 * (-elapsed_s / tau).exp() - 0.4 * (-elapsed_s / (0.1 * tau)).exp())
+    } else {
+        ss * (1.0 - (-elapsed_s / tau).exp())
+    }
+}
+
+/// `eccentricity`: the preload varies once per revolution by ΔF = δ/(1/k_sp + 1/K_z)
+/// (crate::fluctuation); every additive quantity is averaged over the revolution with
+/// the time spent at each angle (∝ 1/Ω), so the energy balance still holds, and the
+/// speed's time-weighted standard deviation is reported. The truth form adds a
+/// twice-per-revolution component of 30 % (tilted as well as offset rotor).
+fn eccentric_average(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
+    const SAMPLES: usize = 16;
+    let nominal = solve_effects(p, op, guess);
+    if nominal.status != Status::Ok {
+        return nominal;
+    }
+    let kz = crate::fluctuation::contact_normal_stiffness_n_per_m(motor, nominal.contact_half_angle_rad);
+    let ripple =
+        (p.runout_m / (1.0 / motor.assembly.axial_spring_stiffness_n_per_m + 1.0 / kz)).min(0.9 * op.preload_n);
+    let mut acc: Option<Solution> = None;
+    let mut tsum = 0.0;
+    let mut speeds = [0.0; SAMPLES];
+    let mut prev = nominal.clone();
+    for (j, sp) in speeds.iter_mut().enumerate() {
+        let phi = 2.0 * PI * j as f64 / SAMPLES as f64;
+        let shape = if p.truth { (phi.cos() + 0.3 * (2.0 * phi).cos()) / 1.3 } else { phi.cos() };
+        let mut o = *op;
+        o.preload_n = op.preload_n + ripple * shape;
+        let s = solve_effects(p, &o, Some(&prev));
+        if s.status != Status::Ok || s.speed_rad_s <= 0.0 {
+            // the rotor sticks in this sector: it stops there
+            let mut st = s;
+            st.speed_std_rpm = 0.0;
+            return st;
+        }
+        *sp = s.speed_rad_s;
+        let wt = 1.0 / s.speed_rad_s;
+        tsum += wt;
+        acc = Some(match acc {
+            None => scale_solution(&s, wt),
+            Some(a) => add_solution(&a, &scale_solution(&s, wt)),
+        });
+        prev = s;
+    }
+    let mut out = scale_solution(&acc.unwrap_or(nominal), 1.0 / tsum);
+    let mean = out.speed_rad_s;
+    let var: f64 = speeds.iter().map(|w| (w - mean).powi(2) / w).sum::<f64>() / tsum;
+    out.speed_std_rpm = var.sqrt() * RAD_S_TO_RPM;
+    out.status = Status::Ok;
+    out.efficiency =
+        if out.input_power_w > 0.0 { (out.output_power_w / out.input_power_w).clamp(0.0, 1.0) } else { 0.0 };
+    out.torque_nm = op.torque_nm;
+    out.iterations = prev.iterations;
+    out
+}
+
+fn map_solution(a: &Solution, b: Option<&Solution>, f: impl Fn(f64, f64) -> f64) -> Solution {
+    let mut o = a.clone();
+    let bb = b.unwrap_or(a);
+    macro_rules! each {
+        ($($x:ident),*) => { $( o.$x = f(a.$x, bb.$x); )* };
+    }
+    each!(
+        amplitude_m,
+        contact_half_angle_rad,
+        contact_angle_deg,
+        contact_length_m,
+        stick_half_angle_rad,
+        driving_angle_deg,
+        driving_ratio,
+        speed_rad_s,
+        speed_rpm,
+        crest_speed_m_s,
+        stall_torque_nm,
+        axial_force_n,
+        input_power_w,
+        output_power_w,
+        dielectric_loss_w,
+        damping_loss_w,
+        friction_loss_w,
+        radial_friction_loss_w,
+        rotor_loss_w,
+        feedback_v,
+        current_a,
+        current_in_phase_a,
+        current_quadrature_a,
+        electrode_voltage_v,
+        phase_lag_rad,
+        modal_stiffness_n_per_m,
+        temperature_rise_k,
+        temperature_rise_at_elapsed_k
+    );
+    o
+}
+
+fn scale_solution(a: &Solution, k: f64) -> Solution {
+    map_solution(a, None, |x, _| x * k)
+}
+
+fn add_solution(a: &Solution, b: &Solution) -> Solution {
+    map_solution(a, Some(b), |x, y| x + y)
 }
 
 fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
@@ -470,6 +745,10 @@ fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {
         stalled: true,
         a: 0.0,
         v0: 0.0,
+        tf: 0.0,
+        pf: 0.0,
+        rf: 0.0,
+        tf0: 0.0,
         z: (p.ks - p.m * d.omega * d.omega, f64::INFINITY),
         k_eff: d.ks,
         w_next: 0.0,
@@ -482,14 +761,12 @@ fn finish(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, status: Statu
     let clamped = status == Status::Clamped;
     let speed = if t.stalled { 0.0 } else { t.vr / p.r0 };
     let vr = speed * p.r0;
-    let stall_torque = if clamped {
-        0.0
-    } else {
-        p.r0 * d.mu * t.a * contact::torque_factor(contact::stall_stick_half_angle_rad(ct), ct)
-    };
-    // Friction loss = ∫ μ p |v_s − v_r| dx: closed form of crate::losses::friction_loss_coulomb_w.
-    let friction =
-        if clamped { 0.0 } else { crate::losses::friction_loss_coulomb_w(p.n, d.mu, p.kf, w, p.k, t.v0, vr, t.ts, ct) };
+    let stall_torque = if clamped { 0.0 } else { p.r0 * d.mu * t.a * t.tf0 };
+    // Friction loss = ∫ μ p |slip| dx = power taken from the wave − power given to the rotor
+    // (for the baseline this is crate::losses::friction_loss_coulomb_w, tested against quadrature).
+    let scale = 2.0 * p.n * d.mu * p.kf * w / p.k;
+    let friction = if clamped { 0.0 } else { (scale * (t.v0 * t.pf - vr * t.tf)).max(0.0) };
+    let radial = if clamped { 0.0 } else { scale * t.v0 * t.rf };
     let omega = d.omega;
     let damping = p.c * omega * omega * w * w;
     let dielectric = crate::losses::dielectric_loss_w(omega, p.c0, p.tan_d, d.v);
@@ -528,11 +805,13 @@ fn finish(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, status: Statu
         dielectric_loss_w: dielectric,
         damping_loss_w: damping,
         friction_loss_w: friction,
-        radial_friction_loss_w: 0.0,
+        radial_friction_loss_w: radial,
         rotor_loss_w: rotor,
         efficiency,
         feedback_v: stator::feedback_voltage_v(p.kfb, w),
         current_a: ire.hypot(iim),
+        current_in_phase_a: ire,
+        current_quadrature_a: iim,
         electrode_voltage_v: d.v,
         phase_lag_rad: if clamped { 0.5 * PI } else { t.z.1.atan2(t.z.0) },
         modal_stiffness_n_per_m: t.k_eff,

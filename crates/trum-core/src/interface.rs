@@ -1,0 +1,201 @@
+//! Friction in the contact interface beyond the 2-D Coulomb law of the baseline: the
+//! traction μ·p acts along the **total** slip velocity, which has a radial part when the
+//! stator surface points also move radially (`radial_friction`, seed 002), and its
+//! magnitude saturates smoothly over a slip-velocity scale set by the shear compliance
+//! of the friction layer (`tangential_compliance`, Storck and Wallaschek 2003; seed 004).
+//!
+//! Kinematics in the wave frame (θ wave phase, 0 at the crest; everything divided by the
+//! crest speed v0): tangential stator speed cos θ, rotor speed u = v_r/v0, radial
+//! stator speed ρ·sin θ (seed 002 eq. 10-12: the radial displacement −z·∂R/∂r·A·cos(ωt−mθ)
+//! is in phase with the transverse one, so its velocity is in quadrature with the
+//! tangential velocity — zero at the crest, largest towards the nodes).
+//! Slip s = (cos θ − u, ρ·sin θ), |s| = D; traction direction s/D, magnitude
+//! μ·p·S(D/σ) with S(x) = tanh x (σ = 0: S = 1, Coulomb).
+//!
+//! The factors returned generalise the baseline closed forms: with ρ = 0 and σ = 0 they
+//! are exactly 2χ(θs) − χ(φ0) and 2E(θs) − E(φ0) (a test checks this).
+
+use crate::contact::Contact;
+use std::sync::OnceLock;
+
+/// Parameters of the generalised friction law.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Law {
+    /// ρ: peak radial surface speed over peak tangential surface speed [-].
+    pub radial_ratio: f64,
+    /// σ: slip-speed scale of the saturation over the crest speed [-].
+    pub slip_scale: f64,
+    /// Use the bench-truth forms (radius-resolved radial slip, algebraic saturation)
+    /// instead of the candidate forms the diagnosis fits. See docs/EFFECTS.md.
+    pub truth: bool,
+}
+
+impl Law {
+    /// True when the law is the baseline Coulomb law.
+    pub fn is_coulomb(&self) -> bool {
+        self.radial_ratio == 0.0 && self.slip_scale == 0.0
+    }
+}
+
+/// Interface integrals per unit of k_f·W/k (one wave, both halves).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Factors {
+    /// ∫ (cos θ − c)·g_t dθ over [0, φ0]: the torque factor.
+    pub torque: f64,
+    /// ∫ (cos θ − c)·(g_t·cos θ + g_r·ρ sin θ) dθ: power taken from the wave per v0.
+    pub power: f64,
+    /// ∫ (cos θ − c)·g_r·ρ sin θ dθ: radial slip power per v0.
+    pub radial: f64,
+}
+
+const NODES: usize = 12;
+
+fn gauss_legendre() -> &'static [(f64, f64); NODES] {
+    static GL: OnceLock<[(f64, f64); NODES]> = OnceLock::new();
+    GL.get_or_init(|| {
+        // Newton iteration on P_n for the roots; weights 2/((1−x²)·P_n'(x)²).
+        let n = NODES;
+        let mut out = [(0.0, 0.0); NODES];
+        for (i, slot) in out.iter_mut().enumerate() {
+            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 1.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let dx = p1 / dp;
+                x -= dx;
+                if dx.abs() < 1e-16 {
+                    break;
+                }
+            }
+            *slot = (x, 2.0 / ((1.0 - x * x) * dp * dp));
+        }
+        out
+    })
+}
+
+#[inline]
+fn saturation(x: f64, truth: bool) -> f64 {
+    if truth {
+        x / (1.0 + x * x).sqrt()
+    } else {
+        x.tanh()
+    }
+}
+
+/// Adds the integrand at θ with weight `w` (ρ and the speed scale may vary over the width).
+#[inline]
+fn accumulate(f: &mut Factors, theta: f64, w: f64, c: f64, u: f64, rho: f64, law: &Law) {
+    let (s, co) = theta.sin_cos();
+    let q = co - c;
+    if q <= 0.0 {
+        return;
+    }
+    let dt = co - u;
+    let dr = rho * s;
+    let d = dt.hypot(dr);
+    if d == 0.0 {
+        return;
+    }
+    let g = if law.slip_scale > 0.0 { saturation(d / law.slip_scale, law.truth) / d } else { 1.0 / d };
+    let (gt, gr) = (dt * g, dr * g);
+    f.torque += w * q * gt;
+    f.power += w * q * (gt * co + gr * dr);
+    f.radial += w * q * gr * dr;
+}
+
+fn panel(f: &mut Factors, a: f64, b: f64, c: f64, u: f64, rho: f64, law: &Law, weight: f64) {
+    // four equal sub-panels of Gauss–Legendre nodes, graded towards the stick point by the
+    // caller's choice of panel ends
+    let gl = gauss_legendre();
+    let sub = 4;
+    let h = (b - a) / sub as f64;
+    for j in 0..sub {
+        let (lo, hi) = (a + h * j as f64, a + h * (j + 1) as f64);
+        let (m, r) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+        for &(x, w) in gl {
+            accumulate(f, m + r * x, weight * w * r, c, u, rho, law);
+        }
+    }
+}
+
+/// Interface factors for contact `ct`, rotor speed ratio u = v_r/v0 ∈ [0, 1] and `law`.
+/// The integration splits at the stick point θs = acos u where the tangential slip
+/// changes sign.
+pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
+    let mut f = Factors::default();
+    let phi0 = ct.half_angle_rad;
+    let c = ct.offset;
+    let ts = u.clamp(-1.0, 1.0).acos();
+    let mut run = |rho: f64, weight: f64| {
+        if ts > 0.0 && ts < phi0 {
+            panel(&mut f, 0.0, ts, c, u, rho, law, weight);
+            panel(&mut f, ts, phi0, c, u, rho, law, weight);
+        } else {
+            panel(&mut f, 0.0, phi0, c, u, rho, law, weight);
+        }
+    };
+    if law.truth && law.radial_ratio > 0.0 {
+        // Radius-resolved: the radial slope ∂R/∂r of the mode shape, hence ρ, varies
+        // linearly across the contact width (±40 % between inner and outer edge).
+        for &(y, w) in &[
+            (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
+            (-0.538_469_310_105_683, 0.478_628_670_499_366_5),
+            (0.0, 0.568_888_888_888_888_9),
+            (0.538_469_310_105_683, 0.478_628_670_499_366_5),
+            (0.906_179_845_938_664, 0.236_926_885_056_189_1),
+        ] {
+            run(law.radial_ratio * (1.0 + 0.4 * y), 0.5 * w);
+        }
+    } else {
+        run(law.radial_ratio, 1.0);
+    }
+    f
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::{chi, contact_from_ratio, e_int};
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials_exactly() {
+        let s: f64 = gauss_legendre().iter().map(|(x, w)| w * x.powi(22)).sum();
+        assert!((s - 2.0 / 23.0).abs() < 1e-14);
+        let s: f64 = gauss_legendre().iter().map(|(_, w)| w).sum();
+        assert!((s - 2.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn coulomb_limit_reproduces_the_closed_forms() {
+        let law = Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false };
+        for &y in &[0.3, 1.5, 3.0, 4.0] {
+            let ct = contact_from_ratio(y);
+            for &u in &[0.0, 0.2, 0.6, 0.95] {
+                let ts = u.acos().min(ct.half_angle_rad);
+                let f = factors(&ct, u, &law);
+                let tf = 2.0 * chi(ts, ct.offset) - ct.chi0();
+                let pf = 2.0 * e_int(ts, ct.offset) - e_int(ct.half_angle_rad, ct.offset);
+                assert!((f.torque - tf).abs() < 1e-10, "y={y} u={u}: {} vs {tf}", f.torque);
+                assert!((f.power - pf).abs() < 1e-10);
+                assert_eq!(f.radial, 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn radial_slip_lowers_torque_and_dissipates() {
+        let ct = contact_from_ratio(1.5);
+        let base = factors(&ct, 0.5, &Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false });
+        let rad = factors(&ct, 0.5, &Law { radial_ratio: 0.5, slip_scale: 0.0, truth: false });
+        assert!(rad.torque < base.torque);
+        assert!(rad.radial > 0.0);
+        // dissipation ∫ μ p |s| ≥ 0: power − u·torque
+        assert!(rad.power - 0.5 * rad.torque > base.power - 0.5 * base.torque);
+    }
+}

@@ -1,0 +1,186 @@
+//! Each effect moves the observables in the direction its paper reports; every effect at
+//! zero strength reproduces the baseline exactly; truth forms differ from candidate forms.
+
+use trum_core::effects::{Effect, ALL};
+use trum_core::presets::preset;
+use trum_core::{solve, Motor, OperatingPoint, Solution, Status};
+
+fn with(effect: Effect, params: &[f64]) -> Motor {
+    let mut m = preset("trum60a").unwrap();
+    m.effects.set(effect, params);
+    m
+}
+
+fn typical(effect: Effect) -> Motor {
+    let mut m = preset("trum60a").unwrap();
+    m.effects.set_strength(effect, effect.info().params[0].typical);
+    m
+}
+
+fn at(m: &Motor, f: f64, t: f64) -> Solution {
+    solve(m, &OperatingPoint::new(f, t, 200.0, 43e3))
+}
+
+#[test]
+fn zero_strength_reproduces_the_baseline_exactly() {
+    let base = preset("trum60a").unwrap();
+    for e in ALL {
+        for truth in [false, true] {
+            let mut m = with(e, &[0.0, 0.0]);
+            m.effects.set_truth_forms(truth);
+            for (f, t) in [(150.0, 0.0), (250.0, 0.4), (400.0, 0.2)] {
+                let mut op = OperatingPoint::new(f, t, 200.0, 43e3);
+                op.elapsed_s = 100.0;
+                let (a, b) = (solve(&base, &op), solve(&m, &op));
+                assert_eq!(a.status, b.status, "{e}");
+                for q in trum_core::quantities::QUANTITIES {
+                    let (x, y) = ((q.get)(&a), (q.get)(&b));
+                    assert!(x == y || (x.is_nan() && y.is_nan()), "{e} truth={truth}: {} {x} vs {y}", q.name);
+                }
+            }
+        }
+    }
+}
+
+/// Seed 002: radial friction is over half the interface loss at low torque, and
+/// neglecting it over-predicts no-load speed and stall torque.
+#[test]
+fn radial_friction_matches_seed002_claims() {
+    let base = preset("trum60a").unwrap();
+    let m = typical(Effect::RadialFriction);
+    for t in [0.0, 0.2, 0.35] {
+        let s = at(&m, 250.0, t);
+        assert!(
+            s.radial_friction_loss_w > 0.5 * s.friction_loss_w,
+            "T={t}: {} of {}",
+            s.radial_friction_loss_w,
+            s.friction_loss_w
+        );
+    }
+    let (b, r) = (at(&base, 250.0, 0.0), at(&m, 250.0, 0.0));
+    assert!(r.speed_rpm < b.speed_rpm - 5.0, "{} vs {}", r.speed_rpm, b.speed_rpm);
+    assert!(r.stall_torque_nm < b.stall_torque_nm);
+    let bal = r.input_power_w - r.output_power_w - r.total_loss_w();
+    assert!(bal.abs() < 1e-6 * r.input_power_w, "power balance {bal}");
+}
+
+fn speed_optimal_frequency(m: &Motor, f_n: f64) -> f64 {
+    // golden-section search of the no-load speed over 39.5-42.5 kHz
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let speed = |hz: f64| solve(m, &OperatingPoint::new(f_n, 0.0, 200.0, hz)).speed_rpm;
+    let (mut a, mut b) = (39_500.0, 42_500.0);
+    for _ in 0..60 {
+        let (x1, x2) = (b - g * (b - a), a + g * (b - a));
+        if speed(x1) > speed(x2) {
+            b = x2
+        } else {
+            a = x1
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// Seed 001 eq. 8/14, seed 002 section 5.3: the contact stiffens the mode, so the
+/// speed-optimal frequency moves up with preload (the baseline's does not move).
+#[test]
+fn preload_stiffening_moves_the_optimal_frequency_up_with_preload() {
+    let base = preset("trum60a").unwrap();
+    let b = speed_optimal_frequency(&base, 300.0) - speed_optimal_frequency(&base, 100.0);
+    let m = typical(Effect::PreloadStiffening);
+    let s = speed_optimal_frequency(&m, 300.0) - speed_optimal_frequency(&m, 100.0);
+    assert!(b.abs() < 2.0, "baseline shift {b} Hz");
+    assert!(s > 10.0, "shift {s} Hz");
+    let s1 = at(&m, 250.0, 0.0);
+    assert!(s1.modal_stiffness_n_per_m > at(&base, 250.0, 0.0).modal_stiffness_n_per_m);
+}
+
+/// Seed 003: the softening cubic term lowers the resonance, more at higher voltage.
+#[test]
+fn hertz_softening_shifts_resonance_down_with_amplitude() {
+    let base = preset("trum60a").unwrap();
+    let m = typical(Effect::HertzSoftening);
+    let fb = speed_optimal_frequency(&base, 200.0);
+    let fs = speed_optimal_frequency(&m, 200.0);
+    assert!(fs < fb - 50.0, "{fs} vs {fb}");
+    let lo = solve(&m, &OperatingPoint::new(200.0, 0.0, 100.0, 43e3)).modal_stiffness_n_per_m;
+    let hi = solve(&m, &OperatingPoint::new(200.0, 0.0, 250.0, 43e3)).modal_stiffness_n_per_m;
+    assert!(hi < lo, "softening grows with voltage: {hi} vs {lo}");
+}
+
+/// Seed 000 eq. 11 and section 4.2: the motor warms over a run and the speed drifts down.
+#[test]
+fn thermal_drift_makes_speed_fall_over_a_run() {
+    let m = typical(Effect::ThermalDrift);
+    let mut prev = f64::INFINITY;
+    for t in [0.0, 30.0, 120.0, 600.0] {
+        let mut op = OperatingPoint::new(250.0, 0.3, 200.0, 43e3);
+        op.elapsed_s = t;
+        let s = solve(&m, &op);
+        assert!(s.speed_rpm < prev || t == 0.0, "t={t}: {} after {prev}", s.speed_rpm);
+        prev = s.speed_rpm;
+        if t > 0.0 {
+            assert!(s.temperature_rise_at_elapsed_k > 0.0);
+        }
+    }
+}
+
+/// Seed 001 section 3.1: the electrode voltage falls as the load current grows with
+/// preload and torque.
+#[test]
+fn voltage_sag_grows_with_preload_and_torque() {
+    let m = typical(Effect::VoltageSag);
+    let a = at(&m, 100.0, 0.0);
+    let b = at(&m, 350.0, 0.0);
+    let c = at(&m, 350.0, 0.4);
+    assert!(a.electrode_voltage_v < 200.0);
+    assert!(b.electrode_voltage_v < a.electrode_voltage_v, "{} vs {}", b.electrode_voltage_v, a.electrode_voltage_v);
+    assert!(c.electrode_voltage_v < b.electrode_voltage_v);
+    assert!(at(&m, 250.0, 0.3).speed_rpm < at(&preset("trum60a").unwrap(), 250.0, 0.3).speed_rpm);
+}
+
+/// Seed 000 section 4.3: an eccentric rotor makes the speed fluctuate once per revolution;
+/// the fluctuation grows with the runout.
+#[test]
+fn eccentricity_makes_speed_fluctuate() {
+    let base = at(&preset("trum60a").unwrap(), 250.0, 0.2);
+    assert_eq!(base.speed_std_rpm, 0.0);
+    let s1 = at(&with(Effect::Eccentricity, &[10e-6]), 250.0, 0.2);
+    let s2 = at(&with(Effect::Eccentricity, &[40e-6]), 250.0, 0.2);
+    assert!(s1.speed_std_rpm > 0.0 && s2.speed_std_rpm > 2.0 * s1.speed_std_rpm);
+    assert!((s1.speed_rpm - base.speed_rpm).abs() < 0.05 * base.speed_rpm);
+    let bal = s2.input_power_w - s2.output_power_w - s2.total_loss_w();
+    assert!(bal.abs() < 1e-8 * s2.input_power_w);
+}
+
+/// Storck and Wallaschek / seed 004: shear compliance lets the contact slip partially
+/// around the stick points, lowering the speed at every load and rounding the
+/// speed–torque curve (no corner at stall).
+#[test]
+fn tangential_compliance_lowers_the_speed_torque_curve() {
+    let base = preset("trum60a").unwrap();
+    let m = typical(Effect::TangentialCompliance);
+    for t in [0.0, 0.3, 0.6] {
+        let (b, c) = (at(&base, 250.0, t), at(&m, 250.0, t));
+        assert!(c.speed_rpm < b.speed_rpm, "T={t}");
+        assert!(c.status == Status::Ok || c.status == Status::Stall);
+    }
+    let s = at(&m, 250.0, 0.0);
+    let bal = s.input_power_w - s.output_power_w - s.total_loss_w();
+    assert!(bal.abs() < 1e-6 * s.input_power_w);
+}
+
+#[test]
+fn truth_forms_differ_from_candidate_forms() {
+    for e in ALL {
+        let mut m = typical(e);
+        let mut op = OperatingPoint::new(250.0, 0.3, 200.0, 43e3);
+        op.elapsed_s = 120.0;
+        let cand = solve(&m, &op);
+        m.effects.set_truth_forms(true);
+        let truth = solve(&m, &op);
+        let differs = (cand.speed_rpm - truth.speed_rpm).abs() > 1e-6 * cand.speed_rpm
+            || (cand.speed_std_rpm - truth.speed_std_rpm).abs() > 1e-9
+            || (cand.electrode_voltage_v - truth.electrode_voltage_v).abs() > 1e-9;
+        assert!(differs, "{e}: truth form equals candidate form");
+    }
+}
