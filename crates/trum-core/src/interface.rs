@@ -176,7 +176,7 @@ mod tests {
         let law = Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false };
         for &y in &[0.3, 1.5, 3.0, 4.0] {
             let ct = contact_from_ratio(y);
-            for &u in &[0.0, 0.2, 0.6, 0.95] {
+            for &u in &[0.0f64, 0.2, 0.6, 0.95] {
                 let ts = u.acos().min(ct.half_angle_rad);
                 let f = factors(&ct, u, &law);
                 let tf = 2.0 * chi(ts, ct.offset) - ct.chi0();
