@@ -25,6 +25,7 @@ pub use effects::{Effect, Effects};
 pub use error::{ParamError, TrumError};
 pub use params::Motor;
 pub use solve::{solve, OperatingPoint, Solution, Status};
+pub mod calibrate;
 pub mod criterion;
 pub mod fluctuation;
 pub mod interface;
