@@ -31,3 +31,4 @@ pub mod fluctuation;
 pub mod interface;
 pub mod quantities;
 pub mod sweep;
+pub mod synth;
