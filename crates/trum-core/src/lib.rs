@@ -32,3 +32,4 @@ pub mod interface;
 pub mod quantities;
 pub mod sweep;
 pub mod synth;
+pub mod diagnose;

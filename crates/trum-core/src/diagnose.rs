@@ -1,0 +1,539 @@
+//! The sim-to-real gap diagnosis (`shared/spec/diagnose.md`): where the calibrated
+//! baseline misses, which unmodelled effect causes it, and how far the gap shrinks on
+//! held-out operating regions once that effect is added.
+//!
+//! Method (docs/DIAGNOSIS.md):
+//! 1. Rows are grouped into operating regions (run, preload level, frequency band, time
+//!    window); regions are dealt round-robin into K folds — block cross-validation, never
+//!    random rows, so a held-out block is an operating region the fit never saw.
+//! 2. The baseline is calibrated on each training set and predicts its held-out block;
+//!    the held-out normalised error is compared with the noise level.
+//! 3. Every candidate effect (and pairs of the best candidates when no single one closes
+//!    the gap) is refitted together with the baseline parameters the same way and scored
+//!    by its held-out error and by the BIC of the full-data fit (evidence = ½·ΔBIC, a log
+//!    Bayes factor: > 3 strong, > 5 very strong).
+//! 4. Where: baseline residuals grouped by quantity and region; a group is reported when
+//!    its mean normalised residual is more than 3.5 standard errors from zero (z-test;
+//!    3.5 keeps the family-wise false-alarm rate near 1 % over ~50 groups).
+
+use crate::calibrate::{baseline_params, calibrate, effect_params, FitOptions, FitParam, Observable, ObservedRow};
+use crate::effects::{Effect, ALL};
+use crate::error::TrumError;
+use crate::params::Motor;
+use crate::solve::{solve_prepared, Prepared, Status};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+
+/// Options of a diagnosis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DiagnoseOptions {
+    /// Number of cross-validation folds (≥ 2).
+    pub folds: usize,
+    /// Candidate effects (all seven by default).
+    pub candidates: Vec<Effect>,
+    /// Try pairs of the best candidates when no single effect closes the gap.
+    pub try_pairs: bool,
+    /// Bootstrap resamples for the shrink interval.
+    pub bootstrap: usize,
+    /// Seed of the bootstrap.
+    pub seed: u64,
+    /// Calibration settings.
+    pub fit: FitOptions,
+}
+
+impl Default for DiagnoseOptions {
+    fn default() -> Self {
+        DiagnoseOptions {
+            folds: 4,
+            candidates: ALL.to_vec(),
+            try_pairs: true,
+            bootstrap: 200,
+            seed: 7,
+            fit: FitOptions { huber_k: 3.0, irls_passes: 1, max_evaluations: 120 },
+        }
+    }
+}
+
+/// A region where the baseline misses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GapRegion {
+    /// Measured quantity (column name).
+    pub quantity: String,
+    /// Region in words, e.g. `torque_nm < 0.3`.
+    pub region: String,
+    /// Mean residual measured − model, in the quantity's unit.
+    pub mean_residual: f64,
+    /// Readings in the region.
+    pub n: usize,
+    /// z statistic of the mean normalised residual.
+    pub z: f64,
+}
+
+/// One candidate's score.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RankEntry {
+    /// Effect name, or two names joined with `+`.
+    pub effect: String,
+    /// ½·(BIC_baseline − BIC_effect) on the full data (larger = stronger).
+    pub evidence: f64,
+    /// Held-out NRMSE with the effect added.
+    pub heldout_nrmse_after: f64,
+    /// 1 − after/before on the held-out readings.
+    pub shrink: f64,
+    /// Bootstrap 90 % interval of the shrink.
+    pub shrink_interval: (f64, f64),
+    /// Fitted effect parameters on the full data (name, value).
+    pub params: Vec<(String, f64)>,
+}
+
+/// The diagnosis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Diagnosis {
+    /// One effect, several joined with `+`, `none` or `unexplained`.
+    pub verdict: String,
+    /// Effects that explain the data about as well as the verdict.
+    pub confounded_with: Vec<String>,
+    /// Held-out NRMSE of the calibrated baseline.
+    pub baseline_heldout_nrmse: f64,
+    /// NRMSE the measurement noise alone would give.
+    pub noise_nrmse: f64,
+    /// Held-out mean squared normalised residual of the baseline (1 = at noise level).
+    pub baseline_heldout_chi2_per_reading: f64,
+    /// Where the gap lies.
+    pub gap_where: Vec<GapRegion>,
+    /// Every candidate tried, strongest first.
+    pub ranking: Vec<RankEntry>,
+    /// What the data can and cannot support.
+    pub notes: Vec<String>,
+    /// Rows, readings, regions and folds used.
+    pub n_rows: usize,
+    /// Readings used.
+    pub n_readings: usize,
+    /// Folds used.
+    pub folds: usize,
+    /// Baseline parameters calibrated on all data (name, value).
+    pub baseline_params: Vec<(String, f64)>,
+    /// Per held-out reading: (row index, observable, measured, baseline prediction,
+    /// prediction with the verdict's effects) — for plots.
+    pub heldout: Vec<HeldOut>,
+}
+
+/// One held-out reading with its predictions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeldOut {
+    /// Row index in the input.
+    pub row: usize,
+    /// What was measured.
+    pub observable: Observable,
+    /// Measured value.
+    pub measured: f64,
+    /// Baseline prediction (trained without this row's region).
+    pub baseline: f64,
+    /// Prediction with the verdict's effect(s) (equal to baseline for `none`).
+    pub after: f64,
+}
+
+/// Region key of a row: run, preload level (25 N bins), frequency band (500 Hz), time
+/// window (120 s).
+fn region_key(r: &ObservedRow, group: &str) -> String {
+    let t = if r.op.elapsed_s > 0.0 { (r.op.elapsed_s / 120.0).floor() as i64 } else { -1 };
+    format!(
+        "{group}|{}|{}|{}",
+        (r.op.preload_n / 25.0).round() as i64,
+        (r.op.frequency_hz / 500.0).round() as i64,
+        t
+    )
+}
+
+/// Scale of each observable for the NRMSE: the spread (standard deviation) of its
+/// measured values, floored by its noise level.
+fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
+    let mut acc: BTreeMap<Observable, Vec<(f64, f64)>> = BTreeMap::new();
+    for r in rows {
+        for &(o, v, s) in &r.readings {
+            acc.entry(o).or_default().push((v, s));
+        }
+    }
+    acc.into_iter()
+        .map(|(o, vs)| {
+            let n = vs.len() as f64;
+            let mean = vs.iter().map(|x| x.0).sum::<f64>() / n;
+            let sd = (vs.iter().map(|x| (x.0 - mean).powi(2)).sum::<f64>() / n).sqrt();
+            let noise = vs.iter().map(|x| x.1).sum::<f64>() / n;
+            (o, sd.max(noise).max(1e-12))
+        })
+        .collect()
+}
+
+/// Predictions of `motor` for `rows` (NaN where the model has no solution).
+fn predict(motor: &Motor, rows: &[&ObservedRow]) -> Vec<Vec<f64>> {
+    let p = Prepared::new(motor);
+    rows.iter()
+        .map(|r| {
+            let s = solve_prepared(&p, motor, &r.op, None);
+            r.readings
+                .iter()
+                .map(|&(o, _, _)| if s.status.is_valid() { o.predict(&s, r.ambient_c) } else { f64::NAN })
+                .collect()
+        })
+        .collect()
+}
+
+struct CvResult {
+    /// held-out predictions aligned with rows/readings
+    preds: Vec<Vec<f64>>,
+}
+
+fn fit_params(motor: &Motor, rows: &[ObservedRow], effects: &[Effect], reduced: bool) -> (Motor, Vec<FitParam>) {
+    let mut m = motor.clone();
+    let mut params = baseline_params(motor, rows);
+    if reduced {
+        // few readings: keep friction, damping and force factor only
+        params.retain(|fp| {
+            let n = fp.param.name();
+            n.ends_with("friction_coefficient") || n.ends_with("modal_damping_ns_per_m") || n.ends_with("force_factor_n_per_v")
+        });
+    }
+    for &e in effects {
+        // start inside the range (a strength of exactly 0 sits on the bound, where the
+        // transformed gradient vanishes)
+        let info = e.info();
+        let start: Vec<f64> =
+            info.params.iter().enumerate().map(|(i, p)| if i == 0 { 0.5 * p.typical } else { p.typical }).collect();
+        m.effects.set(e, &start);
+        params.extend(effect_params(e));
+    }
+    (m, params)
+}
+
+fn cross_validate(motor: &Motor, rows: &[ObservedRow], folds: &[usize], k: usize, effects: &[Effect], opts: &DiagnoseOptions, reduced: bool) -> CvResult {
+    let mut preds: Vec<Vec<f64>> = rows.iter().map(|r| vec![f64::NAN; r.readings.len()]).collect();
+    for f in 0..k {
+        let train: Vec<ObservedRow> = rows.iter().zip(folds).filter(|(_, &g)| g != f).map(|(r, _)| r.clone()).collect();
+        let test_idx: Vec<usize> = (0..rows.len()).filter(|&i| folds[i] == f).collect();
+        if test_idx.is_empty() {
+            continue;
+        }
+        let (start, params) = fit_params(motor, &train, effects, reduced);
+        let fitted = match calibrate(&start, &train, &params, &opts.fit) {
+            Ok(c) => c.motor,
+            Err(_) => start,
+        };
+        let test: Vec<&ObservedRow> = test_idx.iter().map(|&i| &rows[i]).collect();
+        for (i, p) in test_idx.iter().zip(predict(&fitted, &test)) {
+            preds[*i] = p;
+        }
+    }
+    CvResult { preds }
+}
+
+/// Normalised held-out errors: (NRMSE with the quantity scales, mean squared residual in σ).
+fn errors(rows: &[ObservedRow], preds: &[Vec<f64>], sc: &BTreeMap<Observable, f64>) -> (f64, f64, Vec<f64>) {
+    let mut e2 = Vec::new();
+    let mut z2 = 0.0;
+    for (r, p) in rows.iter().zip(preds) {
+        for (&(o, v, s), &y) in r.readings.iter().zip(p) {
+            let y = if y.is_finite() { y } else { 0.0 };
+            let d = y - v;
+            e2.push((d / sc[&o]).powi(2));
+            z2 += (d / s).powi(2);
+        }
+    }
+    let n = e2.len().max(1) as f64;
+    ((e2.iter().sum::<f64>() / n).sqrt(), z2 / n, e2)
+}
+
+/// Diagnoses `rows` (with `groups[i]` the run of row i; empty strings are fine) against
+/// `motor`. Errors on data that cannot support any held-out test.
+pub fn diagnose(motor: &Motor, rows: &[ObservedRow], groups: &[String], opts: &DiagnoseOptions) -> Result<Diagnosis, TrumError> {
+    let n_read: usize = rows.iter().map(|r| r.readings.len()).sum();
+    if rows.len() < 4 {
+        return Err(TrumError::input(format!("{} rows are too few to diagnose anything; need at least 4 operating points", rows.len())));
+    }
+    // regions → folds
+    let keys: Vec<String> = rows.iter().zip(groups.iter().chain(std::iter::repeat(&String::new()))).map(|(r, g)| region_key(r, g)).collect();
+    let mut uniq: Vec<&String> = keys.iter().collect();
+    uniq.sort();
+    uniq.dedup();
+    if uniq.len() < 2 {
+        return Err(TrumError::input(
+            "all rows lie in one operating region (same run, preload, frequency and time window): no held-out block is possible",
+        ));
+    }
+    let k = opts.folds.clamp(2, uniq.len());
+    let fold_of: BTreeMap<&String, usize> = uniq.iter().enumerate().map(|(i, key)| (*key, i % k)).collect();
+    let folds: Vec<usize> = keys.iter().map(|key| fold_of[key]).collect();
+    let mut notes = Vec::new();
+    let n_base = baseline_params(motor, rows).len();
+    let reduced = n_read < 4 * (n_base + 2);
+    if reduced {
+        notes.push(format!(
+            "only {n_read} readings: the baseline fit is reduced to friction coefficient, damping and force factor, \
+             and no effect can be confirmed with confidence"
+        ));
+    }
+    let sc = scales(rows);
+    // noise level as NRMSE
+    let noise_nrmse = {
+        let mut acc = 0.0;
+        for r in rows {
+            for &(o, _, s) in &r.readings {
+                acc += (s / sc[&o]).powi(2);
+            }
+        }
+        (acc / n_read as f64).sqrt()
+    };
+    let base_cv = cross_validate(motor, rows, &folds, k, &[], opts, reduced);
+    let (base_nrmse, base_z2, base_e2) = errors(rows, &base_cv.preds, &sc);
+    // full-data baseline fit (for "where", BIC and the reported parameters)
+    let (start, bparams) = fit_params(motor, rows, &[], reduced);
+    let base_cal = calibrate(&start, rows, &bparams, &opts.fit)?;
+    let bic = |chi2: f64, kpar: usize| chi2 + kpar as f64 * (n_read as f64).ln();
+    let base_bic = bic(base_cal.chi2, bparams.len());
+
+    // what the data can see
+    let varies = |f: &dyn Fn(&ObservedRow) -> f64| {
+        let v: Vec<f64> = rows.iter().map(f).collect();
+        let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
+        hi - lo > 1e-9 * hi.abs().max(1.0)
+    };
+    let has = |o: Observable| rows.iter().any(|r| r.readings.iter().any(|x| x.0 == o));
+    if !varies(&|r| r.op.frequency_hz) {
+        notes.push("frequency never varies: preload_stiffening and hertz_softening show only through amplitude and speed, not through a resonance shift".into());
+    }
+    if !varies(&|r| r.op.elapsed_s) {
+        notes.push("no time series (elapsed_s): thermal_drift cannot act and is not testable".into());
+    }
+    if !has(Observable::SpeedStdRpm) {
+        notes.push("no speed_std_rpm column: eccentricity shows only through the mean speed".into());
+    }
+    if !has(Observable::InputPowerW) && !has(Observable::CurrentA) {
+        notes.push("no electrical readings (input_power_w, current_a): voltage_sag and the losses are weakly constrained".into());
+    }
+    if !varies(&|r| r.op.torque_nm) {
+        notes.push("load torque never varies: the speed-torque curve (radial_friction, tangential_compliance) is not observed".into());
+    }
+
+    // candidates in parallel
+    let score = |effects: &[Effect]| -> RankEntry {
+        let cv = cross_validate(motor, rows, &folds, k, effects, opts, reduced);
+        let (after, _, e2) = errors(rows, &cv.preds, &sc);
+        let (start, params) = fit_params(motor, rows, effects, reduced);
+        let (evidence, fitted) = match calibrate(&start, rows, &params, &opts.fit) {
+            Ok(c) => (0.5 * (base_bic - bic(c.chi2, params.len())), c.params),
+            Err(_) => (f64::NEG_INFINITY, Vec::new()),
+        };
+        let shrink = 1.0 - after / base_nrmse.max(1e-300);
+        let interval = bootstrap_shrink(&base_e2, &e2, opts.bootstrap, opts.seed);
+        RankEntry {
+            effect: effects.iter().map(|e| e.name()).collect::<Vec<_>>().join("+"),
+            evidence,
+            heldout_nrmse_after: after,
+            shrink,
+            shrink_interval: interval,
+            params: fitted.into_iter().filter(|p| p.name.starts_with("effects.")).map(|p| (p.name, p.value)).collect(),
+        }
+    };
+    let mut ranking: Vec<RankEntry> = opts.candidates.par_iter().map(|&e| score(&[e])).collect();
+    sort_ranking(&mut ranking);
+
+    // adequacy and closure thresholds in units of the noise (mean squared normalised residual)
+    let close_nrmse = |x: f64| x <= (2.0f64).sqrt() * noise_nrmse.max(1e-12) || x <= 0.3 * base_nrmse;
+    let adequate = base_z2 <= 2.0 || base_nrmse <= 1.5 * noise_nrmse;
+    let mut verdict = String::from("none");
+    let mut confounded = Vec::new();
+    if !adequate {
+        let best_single = ranking.first().cloned();
+        let closes = best_single.as_ref().is_some_and(|b| b.shrink > 0.0 && close_nrmse(b.heldout_nrmse_after) && b.evidence > 3.0);
+        if closes {
+            verdict = best_single.as_ref().map(|b| b.effect.clone()).unwrap_or_default();
+        } else if opts.try_pairs && ranking.len() >= 2 {
+            let top: Vec<Effect> = ranking.iter().take(3).filter_map(|r| Effect::from_name(&r.effect).ok()).collect();
+            let mut pairs = Vec::new();
+            for i in 0..top.len() {
+                for j in i + 1..top.len() {
+                    pairs.push([top[i], top[j]]);
+                }
+            }
+            let mut pr: Vec<RankEntry> = pairs.par_iter().map(|p| score(p)).collect();
+            sort_ranking(&mut pr);
+            let best_pair = pr.first().cloned();
+            ranking.extend(pr);
+            sort_ranking(&mut ranking);
+            match best_pair {
+                Some(bp) if close_nrmse(bp.heldout_nrmse_after) && bp.evidence > 3.0 => {
+                    // name the stronger single effect first
+                    let names: Vec<&str> = bp.effect.split('+').collect();
+                    let ev = |n: &str| ranking.iter().find(|r| r.effect == n).map(|r| r.evidence).unwrap_or(f64::NEG_INFINITY);
+                    let mut ns = names.clone();
+                    ns.sort_by(|a, b| ev(b).total_cmp(&ev(a)));
+                    let joined = ns.join("+");
+                    for r in ranking.iter_mut() {
+                        if r.effect == bp.effect {
+                            r.effect = joined.clone();
+                        }
+                    }
+                    verdict = joined;
+                }
+                _ => verdict = "unexplained".into(),
+            }
+        } else {
+            verdict = "unexplained".into();
+        }
+        if verdict != "unexplained" && !verdict.contains('+') {
+            if let Some(best) = ranking.iter().find(|r| r.effect == verdict).cloned() {
+                for r in &ranking {
+                    if r.effect != best.effect
+                        && !r.effect.contains('+')
+                        && r.heldout_nrmse_after <= 1.15 * best.heldout_nrmse_after
+                        && best.evidence - r.evidence < 5.0
+                    {
+                        confounded.push(r.effect.clone());
+                    }
+                }
+            }
+        }
+    } else {
+        notes.push(format!(
+            "the calibrated baseline predicts the held-out regions at the noise level (mean squared normalised residual {base_z2:.2}); no effect is needed"
+        ));
+    }
+    if reduced && verdict != "none" {
+        notes.push(format!("with so few readings the verdict '{verdict}' is tentative; measure more operating points"));
+    }
+
+    // where the gap lies: baseline full-fit residuals by quantity and region
+    let gap_where = locate_gap(&base_cal.motor, rows);
+    let after_motor_effects: Vec<Effect> =
+        if verdict == "none" || verdict == "unexplained" { Vec::new() } else { verdict.split('+').filter_map(|n| Effect::from_name(n).ok()).collect() };
+    let after_preds = if after_motor_effects.is_empty() {
+        base_cv.preds.clone()
+    } else {
+        cross_validate(motor, rows, &folds, k, &after_motor_effects, opts, reduced).preds
+    };
+    let mut heldout = Vec::new();
+    for (i, r) in rows.iter().enumerate() {
+        for (j, &(o, v, _)) in r.readings.iter().enumerate() {
+            heldout.push(HeldOut { row: i, observable: o, measured: v, baseline: base_cv.preds[i][j], after: after_preds[i][j] });
+        }
+    }
+    Ok(Diagnosis {
+        verdict,
+        confounded_with: confounded,
+        baseline_heldout_nrmse: base_nrmse,
+        noise_nrmse,
+        baseline_heldout_chi2_per_reading: base_z2,
+        gap_where,
+        ranking,
+        notes,
+        n_rows: rows.len(),
+        n_readings: n_read,
+        folds: k,
+        baseline_params: base_cal.params.iter().map(|p| (p.name.clone(), p.value)).collect(),
+        heldout,
+    })
+}
+
+fn sort_ranking(r: &mut [RankEntry]) {
+    r.sort_by(|a, b| b.evidence.total_cmp(&a.evidence).then(a.heldout_nrmse_after.total_cmp(&b.heldout_nrmse_after)));
+}
+
+/// Percentile bootstrap (5 %, 95 %) of 1 − sqrt(mean e2_after)/sqrt(mean e2_before) over
+/// readings resampled in pairs.
+fn bootstrap_shrink(before: &[f64], after: &[f64], n: usize, seed: u64) -> (f64, f64) {
+    use rand::{RngExt, SeedableRng};
+    let m = before.len().min(after.len());
+    if m == 0 || n == 0 {
+        return (f64::NAN, f64::NAN);
+    }
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut v: Vec<f64> = (0..n)
+        .map(|_| {
+            let (mut b, mut a) = (0.0f64, 0.0f64);
+            for _ in 0..m {
+                let i = rng.random_range(0..m);
+                b += before[i];
+                a += after[i];
+            }
+            1.0 - (a / b.max(1e-300)).sqrt()
+        })
+        .collect();
+    v.sort_by(f64::total_cmp);
+    (v[(0.05 * (n - 1) as f64) as usize], v[(0.95 * (n - 1) as f64) as usize])
+}
+
+fn locate_gap(motor: &Motor, rows: &[ObservedRow]) -> Vec<GapRegion> {
+    let refs: Vec<&ObservedRow> = rows.iter().collect();
+    let preds = predict(motor, &refs);
+    // (coordinate name, accessor)
+    type Coord = (&'static str, fn(&ObservedRow) -> f64);
+    let coords: [Coord; 5] = [
+        ("preload_n", |r| r.op.preload_n),
+        ("torque_nm", |r| r.op.torque_nm),
+        ("voltage_v", |r| r.op.voltage_v),
+        ("frequency_hz", |r| r.op.frequency_hz),
+        ("elapsed_s", |r| r.op.elapsed_s),
+    ];
+    let mut out = Vec::new();
+    for o in Observable::ALL {
+        let idx: Vec<(usize, usize)> = rows
+            .iter()
+            .enumerate()
+            .flat_map(|(i, r)| r.readings.iter().enumerate().filter(|(_, x)| x.0 == o).map(move |(j, _)| (i, j)))
+            .collect();
+        if idx.len() < 3 {
+            continue;
+        }
+        for (name, get) in coords {
+            let mut vals: Vec<f64> = idx.iter().map(|&(i, _)| get(&rows[i])).collect();
+            vals.sort_by(f64::total_cmp);
+            vals.dedup();
+            if vals.len() < 2 {
+                continue;
+            }
+            // terciles of the distinct values
+            let cut1 = vals[vals.len() / 3];
+            let cut2 = vals[(2 * vals.len()) / 3];
+            let bins: [(String, Box<dyn Fn(f64) -> bool>); 3] = [
+                (format!("{name} < {}", fmt_num(cut1)), Box::new(move |x| x < cut1)),
+                (format!("{} <= {name} < {}", fmt_num(cut1), fmt_num(cut2)), Box::new(move |x| x >= cut1 && x < cut2)),
+                (format!("{name} >= {}", fmt_num(cut2)), Box::new(move |x| x >= cut2)),
+            ];
+            for (label, inside) in bins.iter() {
+                let sel: Vec<&(usize, usize)> = idx.iter().filter(|&&(i, _)| inside(get(&rows[i]))).collect();
+                if sel.len() < 3 {
+                    continue;
+                }
+                let n = sel.len() as f64;
+                let (mut mean_raw, mut mean_z) = (0.0, 0.0);
+                for &&(i, j) in &sel {
+                    let (_, v, s) = rows[i].readings[j];
+                    let y = preds[i][j];
+                    let d = v - if y.is_finite() { y } else { 0.0 };
+                    mean_raw += d;
+                    mean_z += d / s;
+                }
+                mean_raw /= n;
+                mean_z /= n;
+                let z = mean_z * n.sqrt();
+                if z.abs() > 3.5 {
+                    out.push(GapRegion { quantity: o.column().into(), region: label.clone(), mean_residual: mean_raw, n: sel.len(), z });
+                }
+            }
+        }
+    }
+    out.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
+    out.truncate(10);
+    out
+}
+
+fn fmt_num(x: f64) -> String {
+    let s = format!("{x:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
+/// True for rows where the model must run (used by callers to pre-check data).
+pub fn status_ok(s: Status) -> bool {
+    s.is_valid()
+}
