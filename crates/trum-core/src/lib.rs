@@ -16,6 +16,7 @@ pub mod error;
 pub mod losses;
 pub mod params;
 pub mod presets;
+pub mod measurements;
 pub mod quad;
 pub mod solve;
 pub mod stator;
