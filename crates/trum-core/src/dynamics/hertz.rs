@@ -33,7 +33,8 @@ mod tests;
 
 pub use ident::{identify_beta, BetaIdentification, BetaIdentificationInput};
 pub use sim::{
-    find_jump, FrequencySweep, OscillatorState, SimulationSettings, SteadyState, SweepJump, SweepPoint, TimeSeries,
+    find_jump, FrequencySweep, OscillatorState, RecordOptions, SimulationSettings, SteadyState, SweepJump, SweepPoint,
+    TimeSeries,
 };
 
 /// Errors of the Hertzian-oscillator model, response, simulation and identification.
@@ -108,6 +109,16 @@ pub enum HertzError {
         /// Limit.
         limit: f64,
     },
+}
+
+/// `true` unless `x > y` (NaN-safe "not greater").
+pub(crate) fn not_gt(x: f64, y: f64) -> bool {
+    !matches!(x.partial_cmp(&y), Some(std::cmp::Ordering::Greater))
+}
+
+/// `true` unless `x >= y` (NaN-safe "not greater or equal").
+pub(crate) fn not_ge(x: f64, y: f64) -> bool {
+    !matches!(x.partial_cmp(&y), Some(std::cmp::Ordering::Greater | std::cmp::Ordering::Equal))
 }
 
 /// Result alias of this module.
@@ -298,7 +309,7 @@ impl HertzOscillator {
         let k = self.linear_stiffness_n_per_m;
         let ws = static_deflection_m(k, beta, op.preload_n)?;
         let k_eff = k + 3.0 * beta * ws * ws;
-        if !(k_eff > 0.0) {
+        if not_gt(k_eff, 0.0) {
             return Err(HertzError::NoStaticEquilibrium { preload_n: op.preload_n, max_force_n: f64::NAN });
         }
         let q = 3.0 * beta * ws;
@@ -668,7 +679,7 @@ impl HertzOscillator {
             let w = lo + (hi - lo) * (i as f64) / (n_scan as f64);
             let d = disc(w);
             if (prev_d > 0.0) != (d > 0.0) {
-                crossings.push(bisect(&disc, prev_w, w, 200));
+                crossings.push(bisect(disc, prev_w, w, 200));
             }
             prev_w = w;
             prev_d = d;
@@ -677,38 +688,14 @@ impl HertzOscillator {
             return Ok(None);
         }
         let (w_a, w_b) = (crossings[0], crossings[crossings.len() - 1]);
-        // The jump-up point is the double root at the *small* amplitude end.
         let (f_a, f_b) = (w_a / (2.0 * PI), w_b / (2.0 * PI));
-        let amp_double = |f: f64, want_small: bool| -> f64 {
-            let pts = response_at(&eff, f, method);
-            // At the saddle node two roots merge; take the merging pair's amplitude.
-            let amps: Vec<f64> = pts.iter().map(|p| p.amplitude_m).collect();
-            match amps.len() {
-                3 if want_small => 0.5 * (amps[0] + amps[1]),
-                3 => 0.5 * (amps[1] + amps[2]),
-                _ => {
-                    let v = amps.first().copied().unwrap_or(0.0);
-                    v
-                }
-            }
-        };
+        let (a_a, a_b) = (saddle_amplitude(&eff, w_a, method), saddle_amplitude(&eff, w_b, method));
         let jf = if kk0 < 0.0 {
-            // Softening: lower branch ends at the high-frequency end, upper at the low end.
-            JumpFrequencies {
-                jump_up_hz: f_b,
-                jump_up_amplitude_m: saddle_amplitude(&eff, w_b, method, true).unwrap_or_else(|| amp_double(f_b, true)),
-                jump_down_hz: f_a,
-                jump_down_amplitude_m: saddle_amplitude(&eff, w_a, method, false)
-                    .unwrap_or_else(|| amp_double(f_a, false)),
-            }
+            // Softening: the lower branch ends at the high-frequency saddle node (jump up
+            // on an up-sweep), the upper branch at the low-frequency one (jump down).
+            JumpFrequencies { jump_up_hz: f_b, jump_up_amplitude_m: a_b, jump_down_hz: f_a, jump_down_amplitude_m: a_a }
         } else {
-            JumpFrequencies {
-                jump_up_hz: f_a,
-                jump_up_amplitude_m: saddle_amplitude(&eff, w_a, method, true).unwrap_or_else(|| amp_double(f_a, true)),
-                jump_down_hz: f_b,
-                jump_down_amplitude_m: saddle_amplitude(&eff, w_b, method, false)
-                    .unwrap_or_else(|| amp_double(f_b, false)),
-            }
+            JumpFrequencies { jump_up_hz: f_a, jump_up_amplitude_m: a_a, jump_down_hz: f_b, jump_down_amplitude_m: a_b }
         };
         Ok(Some(jf))
     }
@@ -806,29 +793,27 @@ impl HertzOscillator {
     }
 }
 
-/// Amplitude at a saddle node found by bisection on the discriminant: the double root of
-/// the cubic is where p(x) = p'(x) = 0, i.e. the critical point of p on the requested side.
-fn saddle_amplitude(eff: &EffectiveDuffing, omega: f64, method: ResponseMethod, want_small: bool) -> Option<f64> {
+/// Amplitude at a saddle node: the double root of the cubic p(x) is the critical point of p
+/// (p = p' = 0) with the smaller |p|; falls back to the largest root if none is found.
+fn saddle_amplitude(eff: &EffectiveDuffing, omega: f64, method: ResponseMethod) -> f64 {
     let sf = slow_flow(eff, omega, method);
     let s = sf.sigma / sf.mu;
     let x_ref = (sf.h / sf.mu).powi(2);
     let kk = sf.kappa * x_ref / sf.mu;
     let disc = s * s - 3.0;
+    let fallback = || response_at(eff, omega / (2.0 * PI), method).iter().map(|p| p.amplitude_m).fold(0.0, f64::max);
     if disc < 0.0 || kk == 0.0 {
-        return None;
+        return fallback();
     }
     let r = kk.abs() * disc.sqrt();
     let c1 = (2.0 * s * kk - r) / (3.0 * kk * kk);
     let c2 = (2.0 * s * kk + r) / (3.0 * kk * kk);
-    let (small, large) = if c1 < c2 { (c1, c2) } else { (c2, c1) };
     let p = |x: f64| ((kk * kk * x - 2.0 * s * kk) * x + (1.0 + s * s)) * x - 1.0;
-    // The double root is the critical point with |p| ≈ 0.
-    let x = if p(small).abs() < p(large).abs() { small } else { large };
-    let _ = want_small;
+    let x = if p(c1).abs() < p(c2).abs() { c1 } else { c2 };
     if x > 0.0 {
-        Some((x * x_ref).sqrt())
+        (x * x_ref).sqrt()
     } else {
-        None
+        fallback()
     }
 }
 

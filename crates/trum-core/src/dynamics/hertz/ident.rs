@@ -9,14 +9,18 @@
 //! (k − n²ω²m + i·nωc)·a_n + β·b_n = c_n,   c_0 = N, c_{±1} = F/2, c_n = 0 otherwise.
 //! ```
 //!
-//! β is the real least-squares solution over n = 1..H (and n = 0 if the static force is
-//! given): β = Σ w_n Re(b̄_n r_n) / Σ w_n |b_n|², r_n = c_n − (k − n²ω²m + i nωc) a_n,
-//! w_n = 2 for n ≥ 1 (the ±n pair), 1 for n = 0. This replaces the garbled eq. 9.
+//! β is the real weighted least-squares solution over n = 1..H (and n = 0 if the static
+//! force is given): β = Σ w_n Re(b̄_n r_n) / Σ w_n |b_n|², r_n = c_n − D_n a_n,
+//! D_n = k − n²ω²m + i nωc, w_n = (2 for n ≥ 1 — the ±n pair —, 1 for n = 0) / |D_n|².
+//! The 1/|D_n|² weight measures every balance in displacement units (output error, the
+//! maximum-likelihood weighting for white measurement noise); unweighted balances let the
+//! noise of the stiffness-dominated higher harmonics (|D_3| ≈ 8k) swamp β. This replaces
+//! the garbled eq. 9.
 //! a_n come from a least-squares fit of the drive harmonics to the samples (any sample
 //! spacing); b_n are the exact Fourier coefficients of the cube of the fitted series
 //! (computed on a fine uniform grid), so additive measurement noise does not bias b_n.
 
-use super::{check_finite, check_positive, HertzError, HertzResult};
+use super::{check_finite, check_positive, not_ge, not_gt, HertzError, HertzResult};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -51,16 +55,18 @@ pub struct BetaIdentificationInput<'a> {
 pub struct BetaIdentification {
     /// Identified cubic coefficient β, N/m³ (multi-harmonic least squares).
     pub beta_n_per_m3: f64,
-    /// β from the fundamental balance alone (classical one-term harmonic balance:
-    /// β = Re[(F − (k − mω² + icω)A)·Ā] / (¾|A|⁴)), N/m³.
+    /// β from the fundamental balance alone (one-term harmonic balance about the measured
+    /// mean w̄: w = w̄ + Re(A e^{iωt}), β = Re[(F − (k − mω² + icω)A)·Ā] / (|A|²(3w̄² + ¾|A|²))),
+    /// N/m³.
     pub one_term_beta_n_per_m3: f64,
     /// Fraction of the sample variance explained by the fitted harmonic series (R²).
     pub harmonic_fit_r_squared: f64,
     /// RMS of the sample residual of the harmonic series, V.
     pub waveform_residual_rms_v: f64,
-    /// RMS of the complex harmonic-balance residuals after the fit, N.
-    pub balance_residual_rms_n: f64,
-    /// ‖balance residual‖ / ‖forcing coefficients‖ (0 is a perfect fit).
+    /// RMS over the balanced harmonics of the residual e_n = (D_n a_n + β b_n − c_n)/D_n
+    /// (displacement-equivalent harmonic-balance error), m.
+    pub balance_residual_rms_m: f64,
+    /// ‖e_n‖ / ‖a_n‖ over the balanced harmonics (0 is a perfect fit).
     pub balance_relative_residual: f64,
     /// Fundamental displacement amplitude |A|, m.
     pub displacement_amplitude_m: f64,
@@ -209,7 +215,7 @@ pub fn identify_beta(input: &BetaIdentificationInput<'_>) -> HertzResult<BetaIde
     }
     let span = t[t.len() - 1] - t[0];
     let periods = span * f;
-    if !(periods >= 4.0) {
+    if not_ge(periods, 4.0) {
         return Err(HertzError::TooShort { reason: format!("record spans {periods:.3} drive periods, need >= 4") });
     }
     let per_period = t.len() as f64 / periods;
@@ -220,7 +226,7 @@ pub fn identify_beta(input: &BetaIdentificationInput<'_>) -> HertzResult<BetaIde
     }
     let omega = 2.0 * PI * f;
     let fit = fit_harmonics(t, v, omega, h)?;
-    if !(fit.r_squared >= 0.9) {
+    if not_ge(fit.r_squared, 0.9) {
         return Err(HertzError::NonPeriodic {
             reason: format!("harmonic series explains R² = {:.4} < 0.9 of the variance", fit.r_squared),
         });
@@ -233,7 +239,7 @@ pub fn identify_beta(input: &BetaIdentificationInput<'_>) -> HertzResult<BetaIde
         let (p, q) = (f1.coeffs[1], f2.coeffs[1]);
         let diff = (p.0 - q.0).hypot(p.1 - q.1);
         let scale = fit.coeffs[1].0.hypot(fit.coeffs[1].1);
-        if !(scale > 0.0) || diff > 0.05 * scale {
+        if not_gt(scale, 0.0) || diff > 0.05 * scale {
             return Err(HertzError::NonPeriodic {
                 reason: format!(
                     "fundamental differs by {:.2} % between record halves",
@@ -245,60 +251,62 @@ pub fn identify_beta(input: &BetaIdentificationInput<'_>) -> HertzResult<BetaIde
     // Displacement coefficients.
     let a: Vec<C> = fit.coeffs.iter().map(|&(re, im)| (re / g, im / g)).collect();
     let amp = 2.0 * a[1].0.hypot(a[1].1);
-    if !(amp > 0.0) {
+    if not_gt(amp, 0.0) {
         return Err(HertzError::Degenerate("zero fundamental amplitude"));
     }
     let b = cube_coefficients(&a, h);
-    // Residuals r_n = c_n − D_n a_n, D_n = k − n²ω²m + i nωc.
+    // Residuals r_n = c_n − D_n a_n, D_n = k − n²ω²m + i nωc. Output-error weighting:
+    // each balance divided by D_n (displacement units), i.e. weights mult_n / |D_n|².
     let start = if input.static_force_n.is_some() { 0 } else { 1 };
-    let mut rs: Vec<(usize, C, C)> = Vec::new();
+    let forcing = |n: usize| match n {
+        0 => input.static_force_n.unwrap_or(0.0),
+        1 => 0.5 * force,
+        _ => 0.0,
+    };
+    let mut rs: Vec<(f64, C, C, C)> = Vec::new(); // (weight, r_n, b_n, D_n)
     for n in start..=h {
         let nf = n as f64;
         let d = (k - nf * nf * omega * omega * m, nf * omega * c);
+        let d2 = d.0 * d.0 + d.1 * d.1;
+        if not_gt(d2, 0.0) {
+            return Err(HertzError::Degenerate("a harmonic coincides with the undamped linear resonance"));
+        }
         let da = (d.0 * a[n].0 - d.1 * a[n].1, d.0 * a[n].1 + d.1 * a[n].0);
-        let cn = match n {
-            0 => input.static_force_n.unwrap_or(0.0),
-            1 => 0.5 * force,
-            _ => 0.0,
-        };
-        rs.push((n, (cn - da.0, -da.1), b[n]));
+        let mult = if n == 0 { 1.0 } else { 2.0 };
+        rs.push((mult / d2, (forcing(n) - da.0, -da.1), b[n], d));
     }
     let (mut num, mut den) = (0.0, 0.0);
-    for &(n, r, bn) in &rs {
-        let wgt = if n == 0 { 1.0 } else { 2.0 };
+    for &(wgt, r, bn, _) in &rs {
         num += wgt * (bn.0 * r.0 + bn.1 * r.1);
         den += wgt * (bn.0 * bn.0 + bn.1 * bn.1);
     }
-    if !(den > 0.0) {
+    if not_gt(den, 0.0) {
         return Err(HertzError::Degenerate("cubic term has no harmonic content"));
     }
     let beta = num / den;
-    let (mut res2, mut frc2, mut cnt) = (0.0, 0.0, 0.0);
-    for &(n, r, bn) in &rs {
-        let wgt = if n == 0 { 1.0 } else { 2.0 };
+    let (mut res2, mut amp2, mut cnt) = (0.0, 0.0, 0.0);
+    for (i, &(wgt, r, bn, d)) in rs.iter().enumerate() {
         let e = (r.0 - beta * bn.0, r.1 - beta * bn.1);
+        let mult = wgt * (d.0 * d.0 + d.1 * d.1);
         res2 += wgt * (e.0 * e.0 + e.1 * e.1);
-        cnt += wgt;
-        let cn = match n {
-            0 => input.static_force_n.unwrap_or(0.0),
-            1 => 0.5 * force,
-            _ => 0.0,
-        };
-        frc2 += wgt * cn * cn;
+        let an = a[start + i];
+        amp2 += mult * (an.0 * an.0 + an.1 * an.1);
+        cnt += mult;
     }
     // One-term harmonic balance with A = 2a_1.
     let big_a = (2.0 * a[1].0, 2.0 * a[1].1);
     let d1 = (k - omega * omega * m, omega * c);
     let r1 = (force - (d1.0 * big_a.0 - d1.1 * big_a.1), -(d1.0 * big_a.1 + d1.1 * big_a.0));
     let a2 = big_a.0 * big_a.0 + big_a.1 * big_a.1;
-    let one_term = (r1.0 * big_a.0 + r1.1 * big_a.1) / (0.75 * a2 * a2);
+    let mean = a[0].0;
+    let one_term = (r1.0 * big_a.0 + r1.1 * big_a.1) / (a2 * (3.0 * mean * mean + 0.75 * a2));
     Ok(BetaIdentification {
         beta_n_per_m3: beta,
         one_term_beta_n_per_m3: one_term,
         harmonic_fit_r_squared: fit.r_squared,
         waveform_residual_rms_v: fit.residual_rms,
-        balance_residual_rms_n: (res2 / cnt.max(1.0)).sqrt(),
-        balance_relative_residual: if frc2 > 0.0 { (res2 / frc2).sqrt() } else { f64::INFINITY },
+        balance_residual_rms_m: (res2 / cnt.max(1.0)).sqrt(),
+        balance_relative_residual: if amp2 > 0.0 { (res2 / amp2).sqrt() } else { f64::INFINITY },
         displacement_amplitude_m: amp,
         periods_spanned: periods,
     })

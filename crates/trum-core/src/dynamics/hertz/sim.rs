@@ -53,6 +53,22 @@ impl SimulationSettings {
     }
 }
 
+/// Which steps of [`HertzOscillator::simulate_constant_frequency`] are recorded.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RecordOptions {
+    /// Record only at or after this time, s (>= 0).
+    pub from_s: f64,
+    /// Record every `stride`-th RK4 step (>= 1).
+    pub stride: u32,
+}
+
+impl Default for RecordOptions {
+    fn default() -> Self {
+        Self { from_s: 0.0, stride: 1 }
+    }
+}
+
 /// Recorded samples of a simulation.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct TimeSeries {
@@ -107,13 +123,18 @@ pub struct SweepPoint {
 /// Largest amplitude jump detected in a sweep envelope.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SweepJump {
-    /// Frequency midway between the two windows across the jump, Hz.
+    /// Frequency midway between the two windows of the steepest step, Hz.
     pub frequency_hz: f64,
-    /// Amplitude before the jump, m.
+    /// Amplitude of the window before the steepest step, m.
     pub amplitude_before_m: f64,
-    /// Amplitude after the jump, m.
+    /// Amplitude just after the steepest step, m.
     pub amplitude_after_m: f64,
+    /// `true` for a jump up (amplitude increases), as requested.
+    pub upward: bool,
 }
+
+/// Half-steps between exact re-evaluations of the drive phasor.
+const RESYNC: u32 = 1024;
 
 /// Drive phasor z = e^{iφ}, φ(t) = 2π(f0·t + ½·r·t²), advanced on a half-step grid.
 struct Phasor {
@@ -121,6 +142,7 @@ struct Phasor {
     rate: f64,
     half_h: f64,
     j: u64,
+    until_resync: u32,
     z: (f64, f64),
     d: (f64, f64),
     q: (f64, f64),
@@ -136,7 +158,8 @@ fn cmul(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
 
 impl Phasor {
     fn new(f0: f64, rate: f64, h: f64) -> Self {
-        let mut p = Self { f0, rate, half_h: 0.5 * h, j: 0, z: (1.0, 0.0), d: (1.0, 0.0), q: (1.0, 0.0) };
+        let mut p =
+            Self { f0, rate, half_h: 0.5 * h, j: 0, until_resync: RESYNC, z: (1.0, 0.0), d: (1.0, 0.0), q: (1.0, 0.0) };
         p.q = cis(2.0 * PI * rate * p.half_h * p.half_h);
         p.resync();
         p
@@ -156,7 +179,9 @@ impl Phasor {
     }
     fn advance(&mut self) {
         self.j += 1;
-        if self.j % 1024 == 0 {
+        self.until_resync -= 1;
+        if self.until_resync == 0 {
+            self.until_resync = RESYNC;
             self.resync();
         } else {
             self.z = cmul(self.z, self.d);
@@ -256,47 +281,66 @@ impl HertzOscillator {
         })
     }
 
+    /// State at t = 0 of the first-order periodic solution w = w_s + a·cos(Ωt − φ) of a
+    /// response point (seed 003 eq. 10-12), used to start a simulation on a chosen branch.
+    pub fn branch_state(&self, op: &OperatingPoint, point: &super::ResponsePoint) -> HertzResult<OscillatorState> {
+        let eff = self.effective(op)?;
+        check_positive("frequency_hz", point.frequency_hz)?;
+        check_non_negative("amplitude_m", point.amplitude_m)?;
+        super::check_finite("phase_lag_rad", point.phase_lag_rad)?;
+        let omega = 2.0 * PI * point.frequency_hz;
+        Ok(OscillatorState {
+            displacement_m: eff.static_deflection_m + point.amplitude_m * point.phase_lag_rad.cos(),
+            velocity_m_per_s: omega * point.amplitude_m * point.phase_lag_rad.sin(),
+        })
+    }
+
     /// Time simulation of seed 003 eq. 2-3 at constant drive frequency `frequency_hz`
     /// (Hz, > 0) for `duration_s` (s, > 0) from `initial`, drive F·cos(2πft) starting at
-    /// t = 0. Every `record_stride`-th step (>= 1) at or after `record_from_s` (s, >= 0) is
-    /// recorded. Fixed-step RK4 with `settings.steps_per_period` steps per period.
+    /// t = 0. Steps selected by `record` are returned. Fixed-step RK4 with
+    /// `settings.steps_per_period` steps per period.
     pub fn simulate_constant_frequency(
         &self,
         op: &OperatingPoint,
         frequency_hz: f64,
         duration_s: f64,
         initial: &OscillatorState,
-        record_from_s: f64,
-        record_stride: usize,
+        record: &RecordOptions,
         settings: &SimulationSettings,
     ) -> HertzResult<TimeSeries> {
         settings.validate()?;
         check_positive("frequency_hz", frequency_hz)?;
         check_positive("duration_s", duration_s)?;
-        check_non_negative("record_from_s", record_from_s)?;
-        if record_stride == 0 {
-            return Err(HertzError::InvalidParameter { name: "record_stride", value: 0.0, reason: "must be >= 1" });
+        let record_from_s = check_non_negative("record.from_s", record.from_s)?;
+        if record.stride == 0 {
+            return Err(HertzError::InvalidParameter { name: "record.stride", value: 0.0, reason: "must be >= 1" });
         }
+        let record_stride = u64::from(record.stride);
         let spp = u64::from(settings.steps_per_period);
         let steps = step_count(duration_s * frequency_hz * spp as f64, settings)?;
         let h = 1.0 / (frequency_hz * spp as f64);
         let mut integ = self.integrator(op, frequency_hz, 0.0, h, initial)?;
         let first_recorded = (record_from_s / h).ceil() as u64;
         let mut out = TimeSeries::default();
-        let record = |out: &mut TimeSeries, i: u64, integ: &Integrator| {
-            if i >= first_recorded && (i - first_recorded) % record_stride as u64 == 0 {
-                out.time_s.push(i as f64 * h);
-                out.displacement_m.push(integ.w);
-                out.velocity_m_per_s.push(integ.v);
+        let mut countdown = 1u64;
+        let mut push = |out: &mut TimeSeries, i: u64, integ: &Integrator| {
+            if i >= first_recorded {
+                countdown -= 1;
+                if countdown == 0 {
+                    countdown = record_stride;
+                    out.time_s.push(i as f64 * h);
+                    out.displacement_m.push(integ.w);
+                    out.velocity_m_per_s.push(integ.v);
+                }
             }
         };
-        record(&mut out, 0, &integ);
+        push(&mut out, 0, &integ);
         for i in 1..=steps {
             integ.step();
             if !integ.ok() {
                 return Err(HertzError::Diverged { time_s: i as f64 * h });
             }
-            record(&mut out, i, &integ);
+            push(&mut out, i, &integ);
         }
         out.final_state = OscillatorState { displacement_m: integ.w, velocity_m_per_s: integ.v };
         Ok(out)
@@ -417,30 +461,31 @@ fn step_count(steps: f64, settings: &SimulationSettings) -> HertzResult<u64> {
     Ok((steps as u64).max(1))
 }
 
-/// Largest jump in a sweep envelope: the pair of consecutive windows with the largest
-/// amplitude ratio (up or down). `None` for fewer than two points or no finite positive
-/// amplitudes. Used to measure jump frequencies of seed 003 Fig. 5 / eq. 12.
-pub fn find_jump(points: &[SweepPoint]) -> Option<SweepJump> {
-    let mut best: Option<(f64, SweepJump)> = None;
-    for w in points.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        if !(a.amplitude_m > 0.0 && b.amplitude_m > 0.0) {
-            continue;
-        }
-        let r = (b.amplitude_m / a.amplitude_m).ln().abs();
-        if !r.is_finite() {
-            continue;
-        }
-        if best.as_ref().is_none_or(|(rb, _)| r > *rb) {
-            best = Some((
-                r,
-                SweepJump {
-                    frequency_hz: 0.5 * (a.frequency_hz + b.frequency_hz),
-                    amplitude_before_m: a.amplitude_m,
-                    amplitude_after_m: b.amplitude_m,
-                },
-            ));
-        }
-    }
-    best.map(|(_, j)| j)
+/// Largest jump of the requested direction in a sweep envelope (seed 003 Fig. 5 /
+/// eq. 12 jump phenomenon): the consecutive window pair with the largest amplitude change
+/// a_{i+1} − a_i of the requested sign (`upward`: increase, else decrease), in metres so
+/// that the beating of small free transients does not count. The steepest step lags the
+/// saddle node by the slow-passage delay (∝ sweep rate^(2/3)) in the sweep direction.
+/// `None` for fewer than two points or no change of that sign.
+pub fn find_jump(points: &[SweepPoint], upward: bool) -> Option<SweepJump> {
+    let (i_max, _) = points
+        .windows(2)
+        .map(|w| {
+            let d = w[1].amplitude_m - w[0].amplitude_m;
+            if upward {
+                d
+            } else {
+                -d
+            }
+        })
+        .enumerate()
+        .filter(|(_, d)| d.is_finite() && *d > 0.0)
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let (a, b) = (points[i_max], points[i_max + 1]);
+    Some(SweepJump {
+        frequency_hz: 0.5 * (a.frequency_hz + b.frequency_hz),
+        amplitude_before_m: a.amplitude_m,
+        amplitude_after_m: b.amplitude_m,
+        upward,
+    })
 }
