@@ -31,7 +31,7 @@ pub mod sim;
 #[cfg(test)]
 mod tests;
 
-pub use ident::{identify_beta, BetaIdentification, BetaIdentificationInput};
+pub use ident::{identify_beta, linear_stiffness_from_resonance_n_per_m, BetaIdentification, BetaIdentificationInput};
 pub use sim::{
     find_jump, FrequencySweep, OscillatorState, RecordOptions, SimulationSettings, SteadyState, SweepJump, SweepPoint,
     TimeSeries,
@@ -240,7 +240,9 @@ pub struct EffectiveDuffing {
 
 impl EffectiveDuffing {
     /// Linear (small-amplitude) resonance about the static equilibrium,
-    /// f = √(k_eff/m)/2π, Hz.
+    /// f = √(k_eff/m)/2π, Hz (seed 003 eq. 11: ν̄² = k_eff/m, the linearised restoring
+    /// force about the preload deflection). Always finite for a value built by
+    /// [`HertzOscillator::effective`].
     pub fn linear_resonance_hz(&self) -> f64 {
         (self.stiffness_n_per_m / self.modal_mass_kg).sqrt() / (2.0 * PI)
     }
@@ -644,7 +646,9 @@ impl HertzOscillator {
     /// Jump (saddle-node) frequencies at `op`, or `None` if the response is single valued.
     ///
     /// Found numerically for either method as the frequencies where the discriminant of
-    /// the cubic (in a²) of seed 003 eq. 12 changes sign (dense scan plus bisection).
+    /// the cubic (in a²) of seed 003 eq. 12 changes sign (8000-point scan over the band
+    /// that can be bistable, plus bisection). A band narrower than the scan step (only
+    /// just above the hysteresis threshold |κ|H²/μ³ = 8/(3√3)) is reported as `None`.
     /// For the multiple-scales method the closed form
     /// [`HertzOscillator::jump_frequencies_closed_form`] gives the same points.
     pub fn jump_frequencies(
