@@ -10,27 +10,28 @@
 //! equation numbers). SI units everywhere; every public quantity name carries its unit.
 #![warn(missing_docs)]
 
+pub mod calibrate;
 pub mod contact;
+pub mod criterion;
+pub mod diagnose;
+pub mod dynamics;
 pub mod effects;
 pub mod error;
+pub mod fluctuation;
+pub mod interface;
 pub mod losses;
+pub mod measurements;
 pub mod params;
 pub mod presets;
-pub mod measurements;
 pub mod quad;
+pub mod quantities;
 pub mod solve;
 pub mod stator;
+pub mod sweep;
+pub mod synth;
 pub mod thermal;
 
 pub use effects::{Effect, Effects};
 pub use error::{ParamError, TrumError};
 pub use params::Motor;
 pub use solve::{solve, OperatingPoint, Solution, Status};
-pub mod calibrate;
-pub mod criterion;
-pub mod fluctuation;
-pub mod interface;
-pub mod quantities;
-pub mod sweep;
-pub mod synth;
-pub mod diagnose;
