@@ -10,4 +10,5 @@
 //! equation numbers). SI units everywhere; every public quantity name carries its unit.
 #![warn(missing_docs)]
 
+pub mod papers;
 pub mod quad;
