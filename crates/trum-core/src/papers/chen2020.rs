@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 /// Number of waves N of the TRUM60A (B09 mode), for which eq. 1-2 are written.
 pub const TRUM60A_WAVE_NUMBER: f64 = 9.0;
 
-/// Upper end of the axial force range [N] where eq. 12 stays at or below the 40° that one
+/// Upper end of the axial force range \[N\] where eq. 12 stays at or below the 40° that one
 /// wave of the TRUM60A spans (the polynomial crosses 40° near 296 N).
 pub const EQ12_MAX_AXIAL_FORCE_N: f64 = 295.0;
 
@@ -21,7 +21,7 @@ fn chi(theta_rad: f64, half_angle_rad: f64) -> f64 {
     theta_rad.sin() - theta_rad * half_angle_rad.cos()
 }
 
-/// arccos with its argument clamped to [−1, 1]: a level above the crest means no contact
+/// arccos with its argument clamped to \[−1, 1\]: a level above the crest means no contact
 /// (angle 0), a level below the trough means contact over the whole wave (angle π).
 fn clamped_acos(ratio: f64) -> Option<f64> {
     if ratio.is_nan() {
@@ -30,11 +30,11 @@ fn clamped_acos(ratio: f64) -> Option<f64> {
     Some(ratio.clamp(-1.0, 1.0).acos())
 }
 
-/// Contact half-angle φ0 = arccos((h − z)/(R_sc·ξ)) [rad] in wave phase: the stator surface
+/// Contact half-angle φ0 = arccos((h − z)/(R_sc·ξ)) \[rad\] in wave phase: the stator surface
 /// w(θ) = R_sc·ξ·cos θ penetrates the rotor plane at height h − z where w > h − z.
 ///
-/// Seed 000, argument of eq. 1 (Xc). Units: lengths in m, `mode_shape_at_contact` [-].
-/// Range: returns a value in [0, π]; levels above the crest give 0, below the trough π.
+/// Seed 000, argument of eq. 1 (Xc). Units: lengths in m, `mode_shape_at_contact` \[-\].
+/// Range: returns a value in \[0, π\]; levels above the crest give 0, below the trough π.
 /// `None` if the crest height R_sc·ξ is not a positive finite number or an input is NaN.
 pub fn contact_half_angle_rad(
     half_thickness_m: f64,
@@ -49,12 +49,12 @@ pub fn contact_half_angle_rad(
     clamped_acos((half_thickness_m - rotor_axial_position_m) / crest_m)
 }
 
-/// Seed 000 eq. 1 (Xc) **as printed**: Xc = (20/π)·arccos((h − z)/(R_sc·ξ)) [deg].
+/// Seed 000 eq. 1 (Xc) **as printed**: Xc = (20/π)·arccos((h − z)/(R_sc·ξ)) \[deg\].
 ///
 /// The printed prefactor 20/π gives the contact *half*-arc in mechanical degrees (at most
 /// 20°), which contradicts the text (0 ≤ Xs ≤ Xc ≤ 40°), eq. 2 and eq. 12 (24-29° at
 /// 150-200 N). Use [`contact_length_deg`] for the consistent full arc. Units as in
-/// [`contact_half_angle_rad`]; result in [0, 20]; `None` as there.
+/// [`contact_half_angle_rad`]; result in \[0, 20\]; `None` as there.
 pub fn contact_length_printed_deg(
     half_thickness_m: f64,
     rotor_axial_position_m: f64,
@@ -71,7 +71,7 @@ pub fn contact_length_printed_deg(
 /// which eq. 2 gives k·x0 = φ0 and Xc ≤ 360°/N.
 ///
 /// Units: lengths in m, `mode_shape_at_contact` and `wave_number` (N) dimensionless.
-/// Range: [0, 360/N]. `None` if N is not positive and finite, or as in
+/// Range: \[0, 360/N\]. `None` if N is not positive and finite, or as in
 /// [`contact_half_angle_rad`].
 pub fn contact_length_deg(
     half_thickness_m: f64,
@@ -88,12 +88,12 @@ pub fn contact_length_deg(
     Some(360.0 * phi0 / (wave_number * PI))
 }
 
-/// Seed 000 eq. 1 (Xs) **as printed**: Xs = (20/π)·arccos(Ω_r·R0²/(λ·h·R_sc·ξ·f_s)) [deg].
+/// Seed 000 eq. 1 (Xs) **as printed**: Xs = (20/π)·arccos(Ω_r·R0²/(λ·h·R_sc·ξ·f_s)) \[deg\].
 ///
 /// Besides the 20/π half-arc factor, the printed argument has the dimension 1/m (it is
 /// not invariant when all lengths are scaled), so it is not a speed ratio; see
 /// [`drive_length_deg`]. Units: `rotor_speed_rad_s` Ω_r, lengths in m, `frequency_hz` f_s.
-/// Range: [0, 20]. `None` if the denominator is zero or an input is NaN.
+/// Range: \[0, 20\]. `None` if the denominator is zero or an input is NaN.
 pub fn drive_length_printed_deg(
     rotor_speed_rad_s: f64,
     mean_radius_m: f64,
@@ -111,7 +111,7 @@ pub fn drive_length_printed_deg(
     Some(20.0 / PI * theta)
 }
 
-/// Peak tangential speed of the stator surface v_sm = 2π·f_s·k·h·R_sc·ξ [m/s] with
+/// Peak tangential speed of the stator surface v_sm = 2π·f_s·k·h·R_sc·ξ \[m/s\] with
 /// k = N/R0 (seed 000 notation; same as seed 001 eq. 12 at the crest).
 ///
 /// Units: `frequency_hz`, lengths in m, N and R_sc dimensionless. Any finite input.
@@ -138,7 +138,7 @@ pub fn peak_surface_speed_m_per_s(
 ///
 /// The driving zone is the part of the wave where the stator is faster than the rotor; the
 /// caller caps it at the contact arc (Xs ≤ Xc). Units as in
-/// [`drive_length_printed_deg`], N dimensionless. Range [0, 360/N]. `None` if v_sm or N
+/// [`drive_length_printed_deg`], N dimensionless. Range \[0, 360/N\]. `None` if v_sm or N
 /// is not positive and finite, or an input is NaN.
 pub fn drive_length_deg(
     rotor_speed_rad_s: f64,
@@ -164,19 +164,19 @@ pub fn drive_length_deg(
     Some(360.0 * theta_s / (wave_number * PI))
 }
 
-/// Seed 000 eq. 2 **as printed**: x0 = π·Xc/(40·k) [m] (also x1 = π·Xs/(40·k)).
+/// Seed 000 eq. 2 **as printed**: x0 = π·Xc/(40·k) \[m\] (also x1 = π·Xs/(40·k)).
 ///
 /// Converts a full arc in mechanical degrees to the half arc length at R0. The 40 is 360/N
 /// for N = 9 only; [`half_length_from_arc_m`] holds for any N. Units: `arc_deg`,
-/// `wavenumber_per_m` k [1/m]. Any finite input (k = 0 gives ±∞ or NaN).
+/// `wavenumber_per_m` k \[1/m\]. Any finite input (k = 0 gives ±∞ or NaN).
 pub fn half_length_printed_m(arc_deg: f64, wavenumber_per_m: f64) -> f64 {
     PI * arc_deg / (40.0 * wavenumber_per_m)
 }
 
-/// Seed 000 eq. 2, any N: x0 = (1/2)·R0·Xc·π/180 = π·N·Xc/(360·k) [m], half the arc length
+/// Seed 000 eq. 2, any N: x0 = (1/2)·R0·Xc·π/180 = π·N·Xc/(360·k) \[m\], half the arc length
 /// at the mean radius of a full arc of `arc_deg` mechanical degrees.
 ///
-/// Units: `arc_deg` [deg], `mean_radius_m` [m]. Any finite input.
+/// Units: `arc_deg` \[deg\], `mean_radius_m` \[m\]. Any finite input.
 pub fn half_length_from_arc_m(arc_deg: f64, mean_radius_m: f64) -> f64 {
     0.5 * mean_radius_m * arc_deg.to_radians()
 }
@@ -184,28 +184,28 @@ pub fn half_length_from_arc_m(arc_deg: f64, mean_radius_m: f64) -> f64 {
 /// Parameters of the seed 000 contact model (eq. 3-6).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Contact {
-    /// K_f: contact stiffness per unit area [N/m³] (pressure per unit penetration).
+    /// K_f: contact stiffness per unit area \[N/m³\] (pressure per unit penetration).
     pub contact_stiffness_n_per_m3: f64,
-    /// R_sc: mode shape at the contact radius [-] (crest height is R_sc·ξ).
+    /// R_sc: mode shape at the contact radius \[-\] (crest height is R_sc·ξ).
     pub mode_shape_at_contact: f64,
-    /// ξ: modal amplitude [m].
+    /// ξ: modal amplitude \[m\].
     pub modal_amplitude_m: f64,
-    /// ε: radial width of the contact surface [m].
+    /// ε: radial width of the contact surface \[m\].
     pub contact_width_m: f64,
-    /// R0: mean radius of the contact surface [m].
+    /// R0: mean radius of the contact surface \[m\].
     pub mean_radius_m: f64,
-    /// N: number of waves around the ring [-].
+    /// N: number of waves around the ring \[-\].
     pub wave_number: f64,
 }
 
 impl Contact {
-    /// k = N/R0 [1/m], the wave number of eq. 2.
+    /// k = N/R0 \[1/m\], the wave number of eq. 2.
     pub fn wavenumber_per_m(&self) -> f64 {
         self.wave_number / self.mean_radius_m
     }
 }
 
-/// Seed 000 eq. 3: contact pressure p(x) = K_f·R_sc·ξ·[cos(kx) − cos(kx0)] [Pa].
+/// Seed 000 eq. 3: contact pressure p(x) = K_f·R_sc·ξ·\[cos(kx) − cos(kx0)\] \[Pa\].
 ///
 /// Spring compression times stiffness; valid for |x| ≤ x0 (outside it the printed form is
 /// negative, i.e. no contact, and callers take 0). Units: `x_m`, `contact_half_length_m`
@@ -219,7 +219,7 @@ pub fn contact_pressure_pa(c: &Contact, x_m: f64, contact_half_length_m: f64) ->
 }
 
 /// Seed 000 eq. 4: driving friction force of one wave
-/// F_R = 2μ·K_f·R_sc·ξ·ε·{2[(1/k)·sin(kx1) − x1·cos(kx0)] − [(1/k)·sin(kx0) − x0·cos(kx0)]} [N].
+/// F_R = 2μ·K_f·R_sc·ξ·ε·{2\[(1/k)·sin(kx1) − x1·cos(kx0)\] − \[(1/k)·sin(kx0) − x0·cos(kx0)\]} \[N\].
 ///
 /// Equals μ·∬ sgn(|Ω_s| − |Ω_r|)·p dx dy: the drive zone |x| < x1 counts positive, the two
 /// braking zones negative (the printed middle line drops these minus signs; the final
@@ -242,7 +242,7 @@ pub fn driving_force_n(
 }
 
 /// Seed 000 eq. 5: driving torque
-/// T_R = N·F_R·R0 = 2μ·ε·K_f·R_sc·R0²·ξ·{2[sin(kx1) − kx1·cos(kx0)] − [sin(kx0) − kx0·cos(kx0)]} [N·m].
+/// T_R = N·F_R·R0 = 2μ·ε·K_f·R_sc·R0²·ξ·{2\[sin(kx1) − kx1·cos(kx0)\] − \[sin(kx0) − kx0·cos(kx0)\]} \[N·m\].
 ///
 /// The printed R_s² is read as R0² (R_s is not defined; N·R0/k = R0² with k = N/R0).
 /// Range: 0 ≤ x1 ≤ x0 ≤ λ/4. Any finite input.
@@ -265,7 +265,7 @@ pub fn driving_torque_nm(
         * bracket
 }
 
-/// Seed 000 eq. 6: axial force F_z = 2N·K_f·R_sc·ε·ξ·[(1/k)·sin(kx0) − x0·cos(kx0)] [N],
+/// Seed 000 eq. 6: axial force F_z = 2N·K_f·R_sc·ε·ξ·\[(1/k)·sin(kx0) − x0·cos(kx0)\] \[N\],
 /// i.e. N·∬ p dx dy over the contact zones of all N waves.
 ///
 /// Range: 0 ≤ x0 ≤ λ/4 (k·x0 ≤ π/2 keeps the stator teeth in contact only near crests).
@@ -282,7 +282,7 @@ pub fn axial_force_n(c: &Contact, contact_half_length_m: f64) -> f64 {
         / k
 }
 
-/// Seed 000 eq. 7 **as printed**: dielectric loss Q1 = 2π·f_s·ε_p·(U_m/h_p)²·V_piezo·tan δ [W].
+/// Seed 000 eq. 7 **as printed**: dielectric loss Q1 = 2π·f_s·ε_p·(U_m/h_p)²·V_piezo·tan δ \[W\].
 ///
 /// Equals the cycle integral f·V·∮E dD for a sinusoidal field only if `voltage_v` is the
 /// RMS voltage; with the peak voltage it is twice the integral ([`dielectric_loss_w`]).
@@ -300,7 +300,7 @@ pub fn dielectric_loss_printed_w(
     2.0 * PI * frequency_hz * permittivity_f_per_m * e * e * piezo_volume_m3 * loss_tangent
 }
 
-/// Seed 000 eq. 7, corrected for a peak voltage: Q1 = π·f_s·ε_p·(U_peak/h_p)²·V_piezo·tan δ [W],
+/// Seed 000 eq. 7, corrected for a peak voltage: Q1 = π·f_s·ε_p·(U_peak/h_p)²·V_piezo·tan δ \[W\],
 /// the time average of V·E·dD/dt for E = (U_peak/h_p)·sin ωt and complex permittivity
 /// ε_p·(1 − j·tan δ). Same as [`dielectric_loss_printed_w`] with U_rms = U_peak/√2.
 /// Units as there. Any finite input.
@@ -322,8 +322,8 @@ pub fn dielectric_loss_w(
     )
 }
 
-/// Damped bending stiffness Σ E·I·η = E_s·I_s·η_s + E_p·I_p·η_p [N·m²] of seed 000 eq. 8
-/// (and seed 001 eq. 17). Moduli in Pa, moments of inertia in m⁴, loss factors η [-].
+/// Damped bending stiffness Σ E·I·η = E_s·I_s·η_s + E_p·I_p·η_p \[N·m²\] of seed 000 eq. 8
+/// (and seed 001 eq. 17). Moduli in Pa, moments of inertia in m⁴, loss factors η \[-\].
 pub fn damped_bending_stiffness_n_m2(
     stator_modulus_pa: f64,
     stator_inertia_m4: f64,
@@ -335,7 +335,7 @@ pub fn damped_bending_stiffness_n_m2(
     stator_modulus_pa * stator_inertia_m4 * stator_loss_factor + piezo_modulus_pa * piezo_inertia_m4 * piezo_loss_factor
 }
 
-/// Seed 000 eq. 8 **as printed**: stator damping loss Q2 = 4π⁴·ξ²·N⁴·w·ΣEIη/λ³ [W], with
+/// Seed 000 eq. 8 **as printed**: stator damping loss Q2 = 4π⁴·ξ²·N⁴·w·ΣEIη/λ³ \[W\], with
 /// w read as the angular frequency ω = 2π·f (which makes Q2 a power).
 ///
 /// With λ the wavelength (Table A1: 0.0187 m) this is N³ times the defining integral
@@ -359,7 +359,7 @@ pub fn stator_damping_loss_printed_w(
         / wavelength_m.powi(3)
 }
 
-/// Seed 000 eq. 8, corrected: Q2 = 4π⁴·ξ²·N·ω·ΣEIη/λ³ [W] = (ω/2π)·π·∫₀^{Nλ} ΣEIη·(ξ·k²·sin kx)² dx,
+/// Seed 000 eq. 8, corrected: Q2 = 4π⁴·ξ²·N·ω·ΣEIη/λ³ \[W\] = (ω/2π)·π·∫₀^{Nλ} ΣEIη·(ξ·k²·sin kx)² dx,
 /// k = 2π/λ; identical to f × seed 001 eq. 17 (with its k = N).
 ///
 /// Units as in [`stator_damping_loss_printed_w`]. Any finite input.
@@ -383,11 +383,11 @@ pub fn stator_damping_loss_w(
 /// `cross·v_sm·v_r + sm2·v_sm²/2 + r2·v_r²` (the paper's M1, M2, M3).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrictionCoefficients {
-    /// Coefficient of v_sm·v_r (M1) [-].
+    /// Coefficient of v_sm·v_r (M1) \[-\].
     pub cross: f64,
-    /// Coefficient of v_sm²/2 (M2) [-].
+    /// Coefficient of v_sm²/2 (M2) \[-\].
     pub sm2: f64,
-    /// Coefficient of v_r² (M3) [-].
+    /// Coefficient of v_r² (M3) \[-\].
     pub r2: f64,
 }
 
@@ -395,9 +395,9 @@ pub struct FrictionCoefficients {
 /// M1 = π − 2b + sin 2b, M2 = −0.33·cos 3b + 3·cos b − M1·sin b,
 /// M3 = 2·cos 3b − π·sin b + 2φ·sin b, with the undefined φ read as b.
 ///
-/// Against the integral of eq. 9 with its printed limits [b, π − b]: M1 has the wrong sign
+/// Against the integral of eq. 9 with its printed limits \[b, π − b\]: M1 has the wrong sign
 /// (the v_sm·v_r coefficient is −(π − 2b − sin 2b)), M2 is right up to 0.33 ≈ 1/3, M3 has
-/// cos 3b where cos b belongs. See [`friction_loss_coefficients`]. Range: b ∈ [0, π/2].
+/// cos 3b where cos b belongs. See [`friction_loss_coefficients`]. Range: b ∈ \[0, π/2\].
 pub fn friction_loss_coefficients_printed(limit_angle_rad: f64) -> FrictionCoefficients {
     let b = limit_angle_rad;
     let m1 = PI - 2.0 * b + (2.0 * b).sin();
@@ -412,7 +412,7 @@ pub fn friction_loss_coefficients_printed(limit_angle_rad: f64) -> FrictionCoeff
 /// r2 = 2·cos b − (π − 2b)·sin b.
 ///
 /// The limits make b the half-angle *outside* contact (seed 001's ϕ): the contact
-/// half-angle is φ0 = π/2 − b, not the k·x0 of eq. 2-3. Range: b ∈ [0, π/2].
+/// half-angle is φ0 = π/2 − b, not the k·x0 of eq. 2-3. Range: b ∈ \[0, π/2\].
 pub fn friction_loss_coefficients(limit_angle_rad: f64) -> FrictionCoefficients {
     let b = limit_angle_rad;
     let (s, c) = b.sin_cos();
@@ -428,13 +428,13 @@ fn friction_bracket(m: FrictionCoefficients, peak_stator_speed_m_per_s: f64, rot
     m.cross * vs * vr + m.sm2 * vs * vs / 2.0 + m.r2 * vr * vr
 }
 
-/// Seed 000 eq. 9 **as printed** (right-hand side): Q3 = N·ξ·K_f·μ·[M1·v_sm·v_r + M2·v_sm²/2 + M3·v_r²]
-/// with M from [`friction_loss_coefficients_printed`] [W].
+/// Seed 000 eq. 9 **as printed** (right-hand side): Q3 = N·ξ·K_f·μ·\[M1·v_sm·v_r + M2·v_sm²/2 + M3·v_r²\]
+/// with M from [`friction_loss_coefficients_printed`] \[W\].
 ///
-/// For Q3 to be a power, K_f here is per unit length [N/m²] and μ a viscous coefficient
-/// [s/m] (the integrand is ΔF·(v_s − v_r)², not Coulomb μ·p·|v_s − v_r|). Besides the M
+/// For Q3 to be a power, K_f here is per unit length \[N/m²\] and μ a viscous coefficient
+/// \[s/m\] (the integrand is ΔF·(v_s − v_r)², not Coulomb μ·p·|v_s − v_r|). Besides the M
 /// errors, the printed right-hand side lacks the factor λ/(2π) of the left-hand side; see
-/// [`friction_loss_w`]. Range: b ∈ [0, π/2]. Any finite input.
+/// [`friction_loss_w`]. Range: b ∈ \[0, π/2\]. Any finite input.
 pub fn friction_loss_printed_w(
     wave_number: f64,
     modal_amplitude_m: f64,
@@ -452,12 +452,12 @@ pub fn friction_loss_printed_w(
         * friction_bracket(m, peak_stator_speed_m_per_s, rotor_speed_m_per_s)
 }
 
-/// Seed 000 eq. 9, corrected: Q3 = N·(λ/2π)·ξ·K_f·μ·J [W], the left-hand side
+/// Seed 000 eq. 9, corrected: Q3 = N·(λ/2π)·ξ·K_f·μ·J \[W\], the left-hand side
 /// N·(λ/2π)·∫_b^{π−b} μ·ΔF·(v_s − v_r)² dθ with ΔF = K_f·ξ·(sin θ − sin b),
 /// v_s = v_sm·sin θ, evaluated with [`friction_loss_coefficients`].
 ///
 /// Pass b = π/2 − φ0 for a physical contact half-angle φ0. Units as in
-/// [`friction_loss_printed_w`], `wavelength_m` λ. Range: b ∈ [0, π/2]. Any finite input.
+/// [`friction_loss_printed_w`], `wavelength_m` λ. Range: b ∈ \[0, π/2\]. Any finite input.
 // One argument per symbol of the printed equation, so it can be read against the paper.
 #[allow(clippy::too_many_arguments)]
 pub fn friction_loss_w(
@@ -478,7 +478,7 @@ pub fn friction_loss_w(
         * friction_bracket(m, peak_stator_speed_m_per_s, rotor_speed_m_per_s)
 }
 
-/// Seed 000 eq. 11: shell temperature T = T_air + Q/(α·S)·(1 − exp(−α·S·t/C)) [K], the
+/// Seed 000 eq. 11: shell temperature T = T_air + Q/(α·S)·(1 − exp(−α·S·t/C)) \[K\], the
 /// solution of C·dT/dt = Q − α·S·(T − T_air), T(0) = T_air, for a constant total loss Q.
 ///
 /// Units: temperatures in K (or °C, differences are the same), `total_loss_w` Q1+Q2+Q3,
@@ -509,7 +509,7 @@ const EQ12_COEFFS: [f64; 8] = [0.72, 0.65, -0.0088, 6.4e-5, -2.5e-7, 5.4e-10, -6
 ///
 /// A fit with 2-digit coefficients and heavy cancellation: it gives 24.29° at 150 N and
 /// 28.58° at 200 N where the paper quotes 24.15° and 28.94°, and exceeds the 40° that one
-/// wave spans above ~296 N. Units: `axial_force_n` [N], result [deg].
+/// wave spans above ~296 N. Units: `axial_force_n` \[N\], result \[deg\].
 /// Range: `None` outside 0 ≤ F ≤ [`EQ12_MAX_AXIAL_FORCE_N`] or for NaN.
 pub fn contact_length_from_axial_force_deg(axial_force_n: f64) -> Option<f64> {
     if !(0.0..=EQ12_MAX_AXIAL_FORCE_N).contains(&axial_force_n) {
@@ -781,5 +781,27 @@ mod tests {
         assert!(poly(300.0) > 40.0);
         assert_eq!(contact_length_from_axial_force_deg(-1.0), None);
         assert_eq!(contact_length_from_axial_force_deg(f64::NAN), None);
+    }
+
+    #[test]
+    fn chen_table_a1_parameters_are_inconsistent_with_drive() {
+        // modal mass, stiffness, damping as printed (stiffness unit printed as kg·m², read as N/m)
+        let (m0, k0, d0): (f64, f64, f64) = (0.005, 4.56e9, 0.05);
+        let f0 = (k0 / m0).sqrt() / (2.0 * PI);
+        assert!((f0 - 151_991.0).abs() < 1.0, "{f0}");
+        let q = (k0 * m0).sqrt() / d0;
+        assert!((q - 95_499.0).abs() < 1.0, "{q}");
+        // stiffness that would put the mode at the 43 kHz drive
+        let k43 = m0 * (2.0 * PI * 43e3_f64).powi(2);
+        assert!((k43 / 3.650e8 - 1.0).abs() < 1e-3);
+        // resonant amplitude of the 200 V modal force k_c·U: millimetres, not micrometres
+        let force = 0.4147 * 200.0;
+        assert!((force / (d0 * 2.0 * PI * f0) - 1.737e-3).abs() < 1e-6);
+        // motional branch L_m, C_m resonates at 122 kHz, not 42-43 kHz
+        let fs = 1.0 / (2.0 * PI * (0.102_f64 * 16.63e-12).sqrt());
+        assert!((fs - 122_201.0).abs() < 1.0, "{fs}");
+        // printed wavelength vs 2π·R0/N
+        let lambda = 2.0 * PI * R0 / N;
+        assert!((0.0187 / lambda - 1.0 - 0.0204).abs() < 1e-4);
     }
 }

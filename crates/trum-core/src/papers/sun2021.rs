@@ -5,7 +5,7 @@
 //! (in eq. 5-12; but in eq. 17 and in the prefactor of eq. 22 the same letter only makes
 //! sense as the number of waves n), x0 contact half-length (eq. 5 integrates 0..x0 and
 //! doubles), x_r drive half-length, k_f = E_f·b_f/h_f friction-layer stiffness per unit
-//! length [N/m²], r rotor radius.
+//! length \[N/m²\], r rotor radius.
 
 use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_4, PI, SQRT_2};
 
@@ -14,11 +14,11 @@ fn chi(theta_rad: f64, half_angle_rad: f64) -> f64 {
     theta_rad.sin() - theta_rad * half_angle_rad.cos()
 }
 
-/// Seed 001 eq. 1 **as printed** (right-hand side): V_f = (√2/2)·K_WV·W·cos(ωt + π/4) [V].
+/// Seed 001 eq. 1 **as printed** (right-hand side): V_f = (√2/2)·K_WV·W·cos(ωt + π/4) \[V\].
 ///
 /// Wrong in amplitude and phase: the left-hand side K_WV·W·(sin ωt + cos ωt) equals
 /// √2·K_WV·W·cos(ωt − π/4) ([`feedback_voltage_closed_form_v`]). Units:
-/// `conversion_v_per_m` K_WV [V/m], `amplitude_m` W, `angular_frequency_rad_s` ω, `time_s`.
+/// `conversion_v_per_m` K_WV \[V/m\], `amplitude_m` W, `angular_frequency_rad_s` ω, `time_s`.
 /// Any finite input.
 pub fn feedback_voltage_printed_v(
     conversion_v_per_m: f64,
@@ -29,14 +29,14 @@ pub fn feedback_voltage_printed_v(
     FRAC_1_SQRT_2 * conversion_v_per_m * amplitude_m * (angular_frequency_rad_s * time_s + FRAC_PI_4).cos()
 }
 
-/// Seed 001 eq. 1, left-hand side (the definition): V_f = K_WV·(W·sin ωt + W·cos ωt) [V],
+/// Seed 001 eq. 1, left-hand side (the definition): V_f = K_WV·(W·sin ωt + W·cos ωt) \[V\],
 /// the sum of the two phase feedback signals. Units as in [`feedback_voltage_printed_v`].
 pub fn feedback_voltage_v(conversion_v_per_m: f64, amplitude_m: f64, angular_frequency_rad_s: f64, time_s: f64) -> f64 {
     let (s, c) = (angular_frequency_rad_s * time_s).sin_cos();
     conversion_v_per_m * amplitude_m * (s + c)
 }
 
-/// Seed 001 eq. 1, corrected right-hand side: V_f = √2·K_WV·W·cos(ωt − π/4) [V].
+/// Seed 001 eq. 1, corrected right-hand side: V_f = √2·K_WV·W·cos(ωt − π/4) \[V\].
 /// Units as in [`feedback_voltage_printed_v`]. Any finite input.
 pub fn feedback_voltage_closed_form_v(
     conversion_v_per_m: f64,
@@ -47,16 +47,16 @@ pub fn feedback_voltage_closed_form_v(
     SQRT_2 * conversion_v_per_m * amplitude_m * (angular_frequency_rad_s * time_s - FRAC_PI_4).cos()
 }
 
-/// Stator amplitude from the peak feedback voltage by the corrected eq. 1: W = V_peak/(√2·K_WV) [m].
+/// Stator amplitude from the peak feedback voltage by the corrected eq. 1: W = V_peak/(√2·K_WV) \[m\].
 ///
-/// Units: `feedback_peak_v` [V], `conversion_v_per_m` [V/m]. `None` unless K_WV is
+/// Units: `feedback_peak_v` \[V\], `conversion_v_per_m` \[V/m\]. `None` unless K_WV is
 /// non-zero and the result finite.
 pub fn amplitude_from_feedback_peak_m(feedback_peak_v: f64, conversion_v_per_m: f64) -> Option<f64> {
     let w = feedback_peak_v / (SQRT_2 * conversion_v_per_m);
     w.is_finite().then_some(w)
 }
 
-/// Seed 001 eq. 2: normalised drive frequency ω̄ = ω/ω_n = ω·√(m_s/k_s) [-] (the paper
+/// Seed 001 eq. 2: normalised drive frequency ω̄ = ω/ω_n = ω·√(m_s/k_s) \[-\] (the paper
 /// writes ω for both sides). Units: `angular_frequency_rad_s`, `modal_mass_kg`,
 /// `modal_stiffness_n_per_m`. `None` unless m_s > 0 and k_s > 0.
 pub fn frequency_ratio(angular_frequency_rad_s: f64, modal_mass_kg: f64, modal_stiffness_n_per_m: f64) -> Option<f64> {
@@ -64,7 +64,7 @@ pub fn frequency_ratio(angular_frequency_rad_s: f64, modal_mass_kg: f64, modal_s
         .then(|| angular_frequency_rad_s * (modal_mass_kg / modal_stiffness_n_per_m).sqrt())
 }
 
-/// Seed 001 eq. 3: damping ratio ζ = c_s/(2·√(m_s·k_s)) [-] (printed as ξ, used as ζ in
+/// Seed 001 eq. 3: damping ratio ζ = c_s/(2·√(m_s·k_s)) \[-\] (printed as ξ, used as ζ in
 /// eq. 9 and 14). Units: `modal_damping_n_s_per_m` c_s, mass, stiffness. `None` unless
 /// m_s > 0 and k_s > 0.
 pub fn damping_ratio(modal_damping_n_s_per_m: f64, modal_mass_kg: f64, modal_stiffness_n_per_m: f64) -> Option<f64> {
@@ -75,23 +75,23 @@ pub fn damping_ratio(modal_damping_n_s_per_m: f64, modal_mass_kg: f64, modal_sti
 /// Contact parameters shared by seed 001 eq. 5-9 and 22-26.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Contact {
-    /// n: number of waves around the ring [-].
+    /// n: number of waves around the ring \[-\].
     pub wave_number: f64,
-    /// k_f = E_f·b_f/h_f: friction-layer stiffness per unit circumferential length [N/m²].
+    /// k_f = E_f·b_f/h_f: friction-layer stiffness per unit circumferential length \[N/m²\].
     pub friction_layer_stiffness_n_per_m2: f64,
-    /// k: wave number [1/m] (= n/r).
+    /// k: wave number \[1/m\] (= n/r).
     pub wavenumber_per_m: f64,
 }
 
 impl Contact {
-    /// Seed 001 eq. 23: H = k_f/k [N/m], force per unit amplitude per radian of wave phase.
+    /// Seed 001 eq. 23: H = k_f/k \[N/m\], force per unit amplitude per radian of wave phase.
     pub fn h_coefficient_n_per_m(&self) -> f64 {
         self.friction_layer_stiffness_n_per_m2 / self.wavenumber_per_m
     }
 }
 
 /// Seed 001 eq. 5 (closed form as used in eq. 7-9): preload
-/// F_N = 2n·∫₀^{x0} k_f·W·(cos kx − cos kx0) dx = 2n·(k_f·W/k)·[sin kx0 − kx0·cos kx0] [N].
+/// F_N = 2n·∫₀^{x0} k_f·W·(cos kx − cos kx0) dx = 2n·(k_f·W/k)·\[sin kx0 − kx0·cos kx0\] \[N\].
 ///
 /// x0 is the contact *half*-length (the text calls it the full length; the integral from 0
 /// to x0 doubled makes it the half). Range: 0 ≤ x0 < λ/4. Any finite input.
@@ -101,18 +101,18 @@ pub fn axial_force_n(c: &Contact, amplitude_m: f64, contact_half_length_m: f64) 
 }
 
 /// Seed 001 eq. 8: additional stator stiffness from contact
-/// k_s' = N21·(2n·k_f/k)·[sin kx0 − kx0·cos kx0] [N/m], i.e. N21·F_N/W with F_N of eq. 5.
+/// k_s' = N21·(2n·k_f/k)·\[sin kx0 − kx0·cos kx0\] \[N/m\], i.e. N21·F_N/W with F_N of eq. 5.
 ///
-/// `n21` [-] is the paper's fitted force coefficient. Range: 0 ≤ x0 < λ/4. Any finite input.
+/// `n21` \[-\] is the paper's fitted force coefficient. Range: 0 ≤ x0 < λ/4. Any finite input.
 pub fn added_stiffness_n_per_m(c: &Contact, n21: f64, contact_half_length_m: f64) -> f64 {
     n21 * axial_force_n(c, 1.0, contact_half_length_m)
 }
 
 /// Seed 001 eq. 14: amplitude under preload
-/// W = [(N1·V_d − N22·F_N)/k_s] / √((1 + k_s'/k_s − ω̄²)² + (2ζω̄)²) [m], the steady-state
+/// W = \[(N1·V_d − N22·F_N)/k_s\] / √((1 + k_s'/k_s − ω̄²)² + (2ζω̄)²) \[m\], the steady-state
 /// amplitude of m_s·Ẅ + c_s·Ẇ + (k_s + k_s')·W = (N1·V_d − N22·F_N)·cos ωt.
 ///
-/// Units: `net_force_amplitude_n` = N1·V_d − N22·F_N [N], stiffnesses [N/m], ω̄ and ζ [-]
+/// Units: `net_force_amplitude_n` = N1·V_d − N22·F_N \[N\], stiffnesses \[N/m\], ω̄ and ζ \[-\]
 /// ([`frequency_ratio`], [`damping_ratio`]). `None` unless k_s > 0 and the denominator is
 /// non-zero.
 pub fn amplitude_under_preload_m(
@@ -134,7 +134,7 @@ pub fn amplitude_under_preload_m(
 }
 
 /// Seed 001 eq. 9: preload implied by a contact half-length,
-/// F_N = W(x0)·(2n·k_f/k)·[sin kx0 − kx0·cos kx0] [N] with W(x0) from eq. 14 and
+/// F_N = W(x0)·(2n·k_f/k)·\[sin kx0 − kx0·cos kx0\] \[N\] with W(x0) from eq. 14 and
 /// k_s'(x0) from eq. 8; eq. 9 is solved for x0 given F_N.
 ///
 /// Units as in [`amplitude_under_preload_m`] and [`axial_force_n`]. Range: 0 ≤ x0 < λ/4.
@@ -159,16 +159,16 @@ pub fn preload_from_contact_n(
     Some(axial_force_n(c, w, contact_half_length_m))
 }
 
-/// Seed 001 eq. 10: χ(x) = sin(kx) − kx·cos(kx0) [-].
+/// Seed 001 eq. 10: χ(x) = sin(kx) − kx·cos(kx0) \[-\].
 /// Units: `wavenumber_per_m` k, `x_m`, `contact_half_length_m` x0. Any finite input.
 pub fn torque_shape(wavenumber_per_m: f64, x_m: f64, contact_half_length_m: f64) -> f64 {
     chi(wavenumber_per_m * x_m, wavenumber_per_m * contact_half_length_m)
 }
 
-/// Seed 001 eq. 11: output torque M_T = r·μ·F_N·[2χ(x_r) − χ(x0)]/χ(x0) [N·m]: the drive
+/// Seed 001 eq. 11: output torque M_T = r·μ·F_N·\[2χ(x_r) − χ(x0)\]/χ(x0) \[N·m\]: the drive
 /// zone |x| < x_r pushes, the rest of the contact brakes, pressure normalised to F_N.
 ///
-/// Units: `rotor_radius_m` r, `preload_n` F_N, lengths in m, k [1/m]. Range:
+/// Units: `rotor_radius_m` r, `preload_n` F_N, lengths in m, k \[1/m\]. Range:
 /// 0 ≤ x_r ≤ x0 < λ/4. `None` if χ(x0) = 0 (no contact) or the result is not finite.
 pub fn output_torque_nm(
     rotor_radius_m: f64,
@@ -184,9 +184,9 @@ pub fn output_torque_nm(
     (chi0 != 0.0 && t.is_finite()).then_some(t)
 }
 
-/// Seed 001 eq. 12: tangential speed of the stator surface v_s(x) = k·W·h0·ω·cos(kx) [m/s]
-/// (magnitude; the surface moves against the wave). Units: k [1/m], `amplitude_m` W,
-/// `neutral_distance_m` h0, ω [rad/s], `x_m` (from the crest). Any finite input.
+/// Seed 001 eq. 12: tangential speed of the stator surface v_s(x) = k·W·h0·ω·cos(kx) \[m/s\]
+/// (magnitude; the surface moves against the wave). Units: k \[1/m\], `amplitude_m` W,
+/// `neutral_distance_m` h0, ω \[rad/s\], `x_m` (from the crest). Any finite input.
 pub fn stator_surface_speed_m_per_s(
     wavenumber_per_m: f64,
     amplitude_m: f64,
@@ -197,15 +197,15 @@ pub fn stator_surface_speed_m_per_s(
     wavenumber_per_m * amplitude_m * neutral_distance_m * angular_frequency_rad_s * (wavenumber_per_m * x_m).cos()
 }
 
-/// Seed 001 eq. 15: dielectric loss tangent tan δ = 1/(ω·C·R_n) [-] of a capacitance C in
-/// parallel with a dielectric resistance R_n. Units: ω [rad/s], `capacitance_f`,
+/// Seed 001 eq. 15: dielectric loss tangent tan δ = 1/(ω·C·R_n) \[-\] of a capacitance C in
+/// parallel with a dielectric resistance R_n. Units: ω \[rad/s\], `capacitance_f`,
 /// `dielectric_resistance_ohm`. `None` if ω·C·R_n is zero or the result not finite.
 pub fn loss_tangent(angular_frequency_rad_s: f64, capacitance_f: f64, dielectric_resistance_ohm: f64) -> Option<f64> {
     let t = 1.0 / (angular_frequency_rad_s * capacitance_f * dielectric_resistance_ohm);
     t.is_finite().then_some(t)
 }
 
-/// Magnitude of the parallel C–R_n impedance |Z| = 1/√(R_n⁻² + (ωC)²) [Ω]: the R_d for which
+/// Magnitude of the parallel C–R_n impedance |Z| = 1/√(R_n⁻² + (ωC)²) \[Ω\]: the R_d for which
 /// eq. 16 is consistent (then sin δ/R_d = 1/R_n). Units as in [`loss_tangent`]. `None`
 /// unless R_n > 0.
 pub fn parallel_impedance_ohm(
@@ -217,7 +217,7 @@ pub fn parallel_impedance_ohm(
         .then(|| 1.0 / (1.0 / dielectric_resistance_ohm).hypot(angular_frequency_rad_s * capacitance_f))
 }
 
-/// Seed 001 eq. 16 **as printed**: dielectric loss per drive cycle W1 = V_d²·sin δ·T/R_d [J].
+/// Seed 001 eq. 16 **as printed**: dielectric loss per drive cycle W1 = V_d²·sin δ·T/R_d \[J\].
 ///
 /// Equals ∫₀ᵀ v·i dt for the parallel C–R_n dielectric only if V_d is the RMS voltage and
 /// R_d = |Z| ([`parallel_impedance_ohm`]); with the peak voltage it is twice the integral
@@ -233,7 +233,7 @@ pub fn dielectric_loss_per_cycle_printed_j(
     w.is_finite().then_some(w)
 }
 
-/// Seed 001 eq. 16, corrected for a peak voltage: W1 = V_peak²·sin δ·T/(2·R_d) [J]
+/// Seed 001 eq. 16, corrected for a peak voltage: W1 = V_peak²·sin δ·T/(2·R_d) \[J\]
 /// (= V_peak²·T/(2·R_n) with R_d = |Z|). Units and `None` as in
 /// [`dielectric_loss_per_cycle_printed_j`].
 pub fn dielectric_loss_per_cycle_j(
@@ -247,12 +247,12 @@ pub fn dielectric_loss_per_cycle_j(
 }
 
 /// Seed 001 eq. 17 **as printed**: damping loss per cycle of the composite stator
-/// W2 = 8π⁵·W²·k⁴·ΣEIη/(2πr)³ [J], with the printed k taken as the number of waves n.
+/// W2 = 8π⁵·W²·k⁴·ΣEIη/(2πr)³ \[J\], with the printed k taken as the number of waves n.
 ///
 /// Only with k = n is eq. 17 dimensionally consistent, and then it equals its integral
 /// kπ·∫₀^{2πr/k} ΣEIη·(∂²u/∂x²)² dx for u = W·sin(kx/r) exactly (one wavelength 2πr/n,
-/// times n waves, times π). With k the wave number [1/m] of eq. 5-12 neither side is an
-/// energy. Units: `amplitude_m` W, `damped_bending_stiffness_n_m2` ΣEIη [N·m²],
+/// times n waves, times π). With k the wave number \[1/m\] of eq. 5-12 neither side is an
+/// energy. Units: `amplitude_m` W, `damped_bending_stiffness_n_m2` ΣEIη \[N·m²\],
 /// `rotor_radius_m` r. Any finite input.
 pub fn composite_damping_loss_printed_j(
     wave_number: f64,
@@ -265,15 +265,15 @@ pub fn composite_damping_loss_printed_j(
 }
 
 /// Seed 001 eq. 18: ring moment of inertia about the neutral layer
-/// I_e = b_e·[D³ + (h_e − D)³]/3 [m⁴] = b_e·∫₀^{h_e} (z − D)² dz (z down from the ring top).
+/// I_e = b_e·\[D³ + (h_e − D)³\]/3 \[m⁴\] = b_e·∫₀^{h_e} (z − D)² dz (z down from the ring top).
 /// Units: widths and heights in m. Any finite input.
 pub fn ring_moment_of_inertia_m4(ring_width_m: f64, ring_height_m: f64, neutral_depth_m: f64) -> f64 {
     ring_width_m * (neutral_depth_m.powi(3) + (ring_height_m - neutral_depth_m).powi(3)) / 3.0
 }
 
-/// Seed 001 eq. 19 **as printed**: I_p = b_p·[(h − D)³ + (h_e − D)³]/12 [m⁴].
+/// Seed 001 eq. 19 **as printed**: I_p = b_p·\[(h − D)³ + (h_e − D)³\]/12 \[m⁴\].
 ///
-/// Wrong: b_p·∫_{h_e}^{h} (z − D)² dz = b_p·[(h − D)³ − (h_e − D)³]/3
+/// Wrong: b_p·∫_{h_e}^{h} (z − D)² dz = b_p·\[(h − D)³ − (h_e − D)³\]/3
 /// ([`piezo_moment_of_inertia_m4`]). Units: m. Any finite input.
 pub fn piezo_moment_of_inertia_printed_m4(
     piezo_width_m: f64,
@@ -284,7 +284,7 @@ pub fn piezo_moment_of_inertia_printed_m4(
     piezo_width_m * ((total_height_m - neutral_depth_m).powi(3) + (ring_height_m - neutral_depth_m).powi(3)) / 12.0
 }
 
-/// Seed 001 eq. 19, corrected: I_p = b_p·[(h − D)³ − (h_e − D)³]/3 [m⁴], the second moment
+/// Seed 001 eq. 19, corrected: I_p = b_p·\[(h − D)³ − (h_e − D)³\]/3 \[m⁴\], the second moment
 /// of the piezo layer h_e ≤ z ≤ h about the neutral layer at depth D. Units: m. Any finite
 /// input.
 pub fn piezo_moment_of_inertia_m4(
@@ -296,13 +296,13 @@ pub fn piezo_moment_of_inertia_m4(
     piezo_width_m * ((total_height_m - neutral_depth_m).powi(3) - (ring_height_m - neutral_depth_m).powi(3)) / 3.0
 }
 
-/// Seed 001 eq. 20: stator height h = h_e + h_p [m].
+/// Seed 001 eq. 20: stator height h = h_e + h_p \[m\].
 pub fn total_height_m(ring_height_m: f64, piezo_height_m: f64) -> f64 {
     ring_height_m + piezo_height_m
 }
 
 /// Seed 001 eq. 21: depth of the neutral layer below the ring top
-/// D = (E_eq·h_e²·b_e + 2E_p·h_p·h_e·b_p + E_p·h_p²·b_p)/(2·(E_eq·h_e·b_e + E_p·h_p·b_p)) [m]
+/// D = (E_eq·h_e²·b_e + 2E_p·h_p·h_e·b_p + E_p·h_p²·b_p)/(2·(E_eq·h_e·b_e + E_p·h_p·b_p)) \[m\]
 /// = ∫E·z dA/∫E dA. Units: moduli in Pa, lengths in m. `None` if the axial stiffness
 /// E_eq·h_e·b_e + E_p·h_p·b_p is zero or the result not finite.
 pub fn neutral_layer_depth_m(
@@ -322,16 +322,16 @@ pub fn neutral_layer_depth_m(
 /// Coefficients of seed 001 eq. 24-26 (bracket M1·v_m² − M2·v_s0·v_m + M3·v_s0²/2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrictionCoefficients {
-    /// M1 = 2·sin(φ/2) − φ·cos(φ/2) [-].
+    /// M1 = 2·sin(φ/2) − φ·cos(φ/2) \[-\].
     pub m1: f64,
-    /// M2 = φ − sin φ [-].
+    /// M2 = φ − sin φ \[-\].
     pub m2: f64,
-    /// M3 = (1/3)·sin(3φ/2) + 3·sin(φ/2) − (φ + sin φ)·cos(φ/2) [-].
+    /// M3 = (1/3)·sin(3φ/2) + 3·sin(φ/2) − (φ + sin φ)·cos(φ/2) \[-\].
     pub m3: f64,
 }
 
-/// Seed 001 eq. 24-26 as printed, for the full contact angle φ = π − 2ϕ = 2·k·x0 [rad].
-/// They agree with the integral of eq. 22 (tested). Range: φ ∈ [0, π].
+/// Seed 001 eq. 24-26 as printed, for the full contact angle φ = π − 2ϕ = 2·k·x0 \[rad\].
+/// They agree with the integral of eq. 22 (tested). Range: φ ∈ \[0, π\].
 pub fn friction_loss_coefficients(contact_angle_rad: f64) -> FrictionCoefficients {
     let p = contact_angle_rad;
     let (s2, c2) = (p / 2.0).sin_cos();
@@ -343,12 +343,12 @@ pub fn friction_loss_coefficients(contact_angle_rad: f64) -> FrictionCoefficient
 }
 
 /// Seed 001 eq. 22: friction loss per drive cycle
-/// W3 = k·ε·W·H·(2π/ω)·[M1·v_m² − M2·v_s0·v_m + M3·v_s0²/2] [J], with the prefactor k
+/// W3 = k·ε·W·H·(2π/ω)·\[M1·v_m² − M2·v_s0·v_m + M3·v_s0²/2\] \[J\], with the prefactor k
 /// read as the number of waves n and H = k_f/k with k the wave number (eq. 23).
 ///
 /// Equals n·(λ/ω)·∫_ϕ^{π−ϕ} ε·ΔF·(v_s0·sin θ − v_m)² dθ with ΔF = k_f·W·(sin θ − sin ϕ),
-/// λ = 2π/k. ε is a viscous coefficient [s/m] (loss ∝ ΔF·Δv², not Coulomb).
-/// Units: ω [rad/s], speeds [m/s], `contact_angle_rad` φ = π − 2ϕ ∈ [0, π]. Any finite input.
+/// λ = 2π/k. ε is a viscous coefficient \[s/m\] (loss ∝ ΔF·Δv², not Coulomb).
+/// Units: ω \[rad/s\], speeds \[m/s\], `contact_angle_rad` φ = π − 2ϕ ∈ \[0, π\]. Any finite input.
 pub fn friction_loss_per_cycle_j(
     c: &Contact,
     viscous_friction_s_per_m: f64,
@@ -490,7 +490,7 @@ mod tests {
     }
 
     #[test]
-    fn sun_eq11_torque_equals_chen_eq5() {
+    fn sun_eq5_eq11_equal_chen_eq6_eq5() {
         let cc = chen2020::Contact {
             contact_stiffness_n_per_m3: 8.0e12,
             mode_shape_at_contact: 0.9,
@@ -503,6 +503,14 @@ mod tests {
         for (phi0, phis) in [(0.4, 0.2), (1.0, 0.7), (1.5, 0.3)] {
             let (x0, x1) = (phi0 / k, phis / k);
             let f_n = chen2020::axial_force_n(&cc, x0);
+            // seed 001 eq. 5 is seed 000 eq. 6 with k_f = K_f·ε and W = R_sc·ξ
+            let sc = Contact {
+                wave_number: cc.wave_number,
+                friction_layer_stiffness_n_per_m2: cc.contact_stiffness_n_per_m3 * cc.contact_width_m,
+                wavenumber_per_m: k,
+            };
+            let w = cc.mode_shape_at_contact * cc.modal_amplitude_m;
+            assert!(rel(axial_force_n(&sc, w, x0), f_n) < 1e-12);
             let t_sun = output_torque_nm(cc.mean_radius_m, 0.3, f_n, k, x0, x1).expect("contact");
             let t_chen = chen2020::driving_torque_nm(&cc, 0.3, x0, x1);
             assert!(rel(t_sun, t_chen) < 1e-12);
@@ -639,5 +647,27 @@ mod tests {
             let q3 = chen2020::friction_loss_w(N, lambda, w, kf, eps, vs0, vm, lo);
             assert!(rel(q3 * 2.0 * PI / om, w3) < 1e-10);
         }
+    }
+
+    #[test]
+    fn sun_table1_table2_derived_values() {
+        let (ms, ks, cs): (f64, f64, f64) = (0.55e-3, 345.0, 8.8e-2);
+        let fn_hz = (ks / ms).sqrt() / (2.0 * PI);
+        assert!((fn_hz - 126.05).abs() < 0.01, "{fn_hz}");
+        let z = damping_ratio(cs, ms, ks).expect("valid");
+        assert!((z - 0.1010).abs() < 1e-4);
+        // at the 42 kHz drive the frequency ratio is ~333 and eq. 14 is ~1/ω̄² of the static value
+        let wr = frequency_ratio(2.0 * PI * 42e3, ms, ks).expect("valid");
+        assert!((wr - 333.2).abs() < 0.1);
+        let gain = amplitude_under_preload_m(ks, ks, 0.0, wr, z).expect("valid");
+        assert!((gain - 9.0e-6).abs() < 0.01e-6, "{gain}");
+        // Table 2, 100 N: 38 V with K = 3.07e7 V/m; W under the corrected and the printed eq. 1
+        let w_corrected = amplitude_from_feedback_peak_m(38.0, 3.07e7).expect("finite");
+        assert!((w_corrected - 0.875e-6).abs() < 1e-9);
+        assert!((38.0 / (FRAC_1_SQRT_2 * 3.07e7) - 1.750e-6).abs() < 1e-9);
+        // contact stiffness k_s'/N21 at φ0 = 0.5 with h_f = 0.5 mm dwarfs k_s
+        let x0 = 0.5 / contact().wavenumber_per_m;
+        let ratio = added_stiffness_n_per_m(&contact(), 1.0, x0) / ks;
+        assert!((ratio / 1.945e5 - 1.0).abs() < 1e-3, "{ratio}");
     }
 }
