@@ -13,7 +13,7 @@
 //! number, N the number of waves), contact half-angle φ0 = k·x0, the pressure per unit
 //! circumferential length is p(θ) = k_f·W·(cos θ − cos φ0) for |θ| ≤ φ0, the axial force is
 //! F_N = 2N·(k_f·W/k)·(sin φ0 − φ0·cos φ0), and with χ(θ) = sin θ − θ·cos φ0 the torque is
-//! T = R0·μ·F_N·[2χ(θs) − χ(φ0)]/χ(φ0) (θs the stick half-angle).
+//! T = R0·μ·F_N·\[2χ(θs) − χ(φ0)\]/χ(φ0) (θs the stick half-angle).
 //!
 //! Conventions: SI units, names carry their unit; dimensionless quantities are named for
 //! what they are (`wave_number` = N, `friction_coefficient`, `loss_tangent`). Plain
