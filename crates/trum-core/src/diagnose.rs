@@ -184,8 +184,10 @@ struct CvResult {
     preds: Vec<Vec<f64>>,
 }
 
-fn fit_params(motor: &Motor, rows: &[ObservedRow], effects: &[Effect], reduced: bool) -> (Motor, Vec<FitParam>) {
-    let mut m = motor.clone();
+/// Start point and parameters of a fit: bounds around the nominal `motor`, starting from
+/// `start` (the full-data baseline calibration, which saves most LM iterations).
+fn fit_params(motor: &Motor, start: &Motor, rows: &[ObservedRow], effects: &[Effect], reduced: bool) -> (Motor, Vec<FitParam>) {
+    let mut m = start.clone();
     let mut params = baseline_params(motor, rows);
     if reduced {
         // few readings: keep friction, damping and force factor only
@@ -206,7 +208,17 @@ fn fit_params(motor: &Motor, rows: &[ObservedRow], effects: &[Effect], reduced: 
     (m, params)
 }
 
-fn cross_validate(motor: &Motor, rows: &[ObservedRow], folds: &[usize], k: usize, effects: &[Effect], opts: &DiagnoseOptions, reduced: bool) -> CvResult {
+#[allow(clippy::too_many_arguments)]
+fn cross_validate(
+    motor: &Motor,
+    start: &Motor,
+    rows: &[ObservedRow],
+    folds: &[usize],
+    k: usize,
+    effects: &[Effect],
+    opts: &DiagnoseOptions,
+    reduced: bool,
+) -> CvResult {
     let mut preds: Vec<Vec<f64>> = rows.iter().map(|r| vec![f64::NAN; r.readings.len()]).collect();
     for f in 0..k {
         let train: Vec<ObservedRow> = rows.iter().zip(folds).filter(|(_, &g)| g != f).map(|(r, _)| r.clone()).collect();
@@ -214,10 +226,10 @@ fn cross_validate(motor: &Motor, rows: &[ObservedRow], folds: &[usize], k: usize
         if test_idx.is_empty() {
             continue;
         }
-        let (start, params) = fit_params(motor, &train, effects, reduced);
-        let fitted = match calibrate(&start, &train, &params, &opts.fit) {
+        let (s0, params) = fit_params(motor, start, &train, effects, reduced);
+        let fitted = match calibrate(&s0, &train, &params, &opts.fit) {
             Ok(c) => c.motor,
-            Err(_) => start,
+            Err(_) => s0,
         };
         let test: Vec<&ObservedRow> = test_idx.iter().map(|&i| &rows[i]).collect();
         for (i, p) in test_idx.iter().zip(predict(&fitted, &test)) {
@@ -283,11 +295,12 @@ pub fn diagnose(motor: &Motor, rows: &[ObservedRow], groups: &[String], opts: &D
         }
         (acc / n_read as f64).sqrt()
     };
-    let base_cv = cross_validate(motor, rows, &folds, k, &[], opts, reduced);
+    // full-data baseline fit (the start of every other fit; "where", BIC, reported parameters)
+    let (start0, bparams) = fit_params(motor, motor, rows, &[], reduced);
+    let base_cal = calibrate(&start0, rows, &bparams, &opts.fit)?;
+    let start = base_cal.motor.clone();
+    let base_cv = cross_validate(motor, &start, rows, &folds, k, &[], opts, reduced);
     let (base_nrmse, base_z2, base_e2) = errors(rows, &base_cv.preds, &sc);
-    // full-data baseline fit (for "where", BIC and the reported parameters)
-    let (start, bparams) = fit_params(motor, rows, &[], reduced);
-    let base_cal = calibrate(&start, rows, &bparams, &opts.fit)?;
     let bic = |chi2: f64, kpar: usize| chi2 + kpar as f64 * (n_read as f64).ln();
     let base_bic = bic(base_cal.chi2, bparams.len());
 
@@ -316,10 +329,10 @@ pub fn diagnose(motor: &Motor, rows: &[ObservedRow], groups: &[String], opts: &D
 
     // candidates in parallel
     let score = |effects: &[Effect]| -> RankEntry {
-        let cv = cross_validate(motor, rows, &folds, k, effects, opts, reduced);
+        let cv = cross_validate(motor, &start, rows, &folds, k, effects, opts, reduced);
         let (after, _, e2) = errors(rows, &cv.preds, &sc);
-        let (start, params) = fit_params(motor, rows, effects, reduced);
-        let (evidence, fitted) = match calibrate(&start, rows, &params, &opts.fit) {
+        let (s0, params) = fit_params(motor, &start, rows, effects, reduced);
+        let (evidence, fitted) = match calibrate(&s0, rows, &params, &opts.fit) {
             Ok(c) => (0.5 * (base_bic - bic(c.chi2, params.len())), c.params),
             Err(_) => (f64::NEG_INFINITY, Vec::new()),
         };
@@ -409,7 +422,7 @@ pub fn diagnose(motor: &Motor, rows: &[ObservedRow], groups: &[String], opts: &D
     let after_preds = if after_motor_effects.is_empty() {
         base_cv.preds.clone()
     } else {
-        cross_validate(motor, rows, &folds, k, &after_motor_effects, opts, reduced).preds
+        cross_validate(motor, &start, rows, &folds, k, &after_motor_effects, opts, reduced).preds
     };
     let mut heldout = Vec::new();
     for (i, r) in rows.iter().enumerate() {

@@ -110,10 +110,9 @@ fn accumulate(f: &mut Factors, theta: f64, w: f64, c: f64, u: f64, rho: f64, law
 }
 
 fn panel(f: &mut Factors, a: f64, b: f64, c: f64, u: f64, rho: f64, law: &Law, weight: f64) {
-    // four equal sub-panels of Gauss–Legendre nodes, graded towards the stick point by the
-    // caller's choice of panel ends
+    // two equal sub-panels of 12 Gauss–Legendre nodes each; the caller splits at the stick point
     let gl = gauss_legendre();
-    let sub = 4;
+    let sub = 2;
     let h = (b - a) / sub as f64;
     for j in 0..sub {
         let (lo, hi) = (a + h * j as f64, a + h * (j + 1) as f64);

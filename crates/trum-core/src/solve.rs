@@ -365,6 +365,7 @@ fn general_interface(
     tscale: f64,
     v0: f64,
     law: &crate::interface::Law,
+    ts_guess: Option<f64>,
 ) -> (f64, f64, bool, crate::interface::Factors, f64) {
     use crate::interface::factors;
     let visc = p.dr * v0 / p.r0;
@@ -376,29 +377,51 @@ fn general_interface(
     if f0 < 0.0 {
         return (contact::stall_stick_half_angle_rad(ct), 0.0, true, fac0, fac0.torque);
     }
-    let (mut lo, mut flo) = (0.0, f0);
+    // Bracket [lo, hi] with f(lo) ≥ 0 > f(hi); a warm start narrows it first.
+    let (mut lo, mut flo, mut hi, mut fhi, mut best);
+    (lo, flo) = (0.0, f0);
     let (f1, fac1) = f(1.0);
     if f1 >= 0.0 {
         return (0.0, v0, false, fac1, fac0.torque);
     }
-    let (mut hi, mut fhi) = (1.0, f1);
-    let mut best = fac1;
-    let mut u = 0.5;
-    for i in 0..100 {
+    (hi, fhi, best) = (1.0, f1, fac1);
+    if let Some(g) = ts_guess.map(f64::cos).filter(|g| *g > 0.0 && *g < 1.0) {
+        for w in [g - 0.01, g + 0.01] {
+            let w = w.clamp(1e-6, 1.0 - 1e-6);
+            if w > lo && w < hi {
+                let (fw, fac) = f(w);
+                if fw >= 0.0 {
+                    (lo, flo) = (w, fw);
+                } else {
+                    (hi, fhi, best) = (w, fw, fac);
+                }
+            }
+        }
+    }
+    // Illinois regula falsi: superlinear, and never leaves the bracket.
+    let mut u = hi;
+    let mut side = 0i8;
+    for _ in 0..100 {
         u = lo - flo * (hi - lo) / (fhi - flo);
-        if !(u > lo && u < hi) || i % 3 == 2 {
+        if !(u > lo && u < hi) {
             u = 0.5 * (lo + hi);
         }
         let (fu, fac) = f(u);
         best = fac;
-        if fu > 0.0 {
-            lo = u;
-            flo = fu;
+        if fu >= 0.0 {
+            (lo, flo) = (u, fu);
+            if side == 1 {
+                fhi *= 0.5;
+            }
+            side = 1;
         } else {
-            hi = u;
-            fhi = fu;
+            (hi, fhi) = (u, fu);
+            if side == -1 {
+                flo *= 0.5;
+            }
+            side = -1;
         }
-        if hi - lo < 1e-13 || fu == 0.0 {
+        if hi - lo < 1e-11 || fu.abs() <= 1e-13 * tscale {
             break;
         }
     }
@@ -427,7 +450,7 @@ fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>) -> Trial {
             // relative to the crest speed k·h0·ω·W.
             law.slip_scale = p.compliance * d.mu * (1.0 - ct.offset.max(-1.0)) / (p.k * p.h0);
         }
-        let (t, v, st, fac, t0) = general_interface(p, d, &ct, tscale, v0, &law);
+        let (t, v, st, fac, t0) = general_interface(p, d, &ct, tscale, v0, &law, ts_guess);
         (ts, vr, stalled, tf, pf, rf, tf0) = (t, v, st, fac.torque, fac.power, fac.radial, t0);
     }
     let ct_omega = 2.0 * p.n * d.mu * p.kf * p.h0 * pf;
