@@ -89,16 +89,16 @@ pub fn parse_axis(s: &str) -> Result<Axis, String> {
 #[derive(Args, Debug, Clone, Default)]
 pub struct GridArgs {
     /// Axial preload [N]: VALUE or START:STOP:N.
-    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis)]
+    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true)]
     pub preload_n: Option<Axis>,
     /// Load torque [N m]: VALUE or START:STOP:N.
-    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis)]
+    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true)]
     pub torque_nm: Option<Axis>,
     /// Drive voltage amplitude per phase, zero-to-peak [V]: VALUE or START:STOP:N.
-    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis)]
+    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true)]
     pub voltage_v: Option<Axis>,
     /// Drive frequency [Hz]: VALUE or START:STOP:N.
-    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis)]
+    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true)]
     pub frequency_hz: Option<Axis>,
 }
 
@@ -203,11 +203,17 @@ impl OutputTarget {
             bail!("cannot write '{}': directory '{}' does not exist", path.display(), dir.display());
         }
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let tmp = tempfile::Builder::new()
-            .prefix(&format!(".{name}."))
-            .suffix(suffix)
-            .tempfile_in(&dir)
-            .with_context(|| format!("cannot create a temporary file in '{}'", dir.display()))?;
+        let prefix = format!(".{name}.");
+        let mut b = tempfile::Builder::new();
+        b.prefix(&prefix).suffix(suffix);
+        // tempfile creates 0600 files; an output file should have ordinary permissions.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            b.permissions(std::fs::Permissions::from_mode(0o644));
+        }
+        let tmp =
+            b.tempfile_in(&dir).with_context(|| format!("cannot create a temporary file in '{}'", dir.display()))?;
         Ok(OutputTarget::File(tmp, path.to_path_buf()))
     }
 

@@ -20,7 +20,7 @@ pub use args::parse_axis;
 
 /// Simulate, map and optimise traveling-wave rotary ultrasonic motors (SI units throughout).
 #[derive(Parser, Debug)]
-#[command(name = "trum", version, about, long_about = None, allow_negative_numbers = true)]
+#[command(name = "trum", version, about, long_about = None)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -29,16 +29,20 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Solve one operating point and print every quantity with its unit.
+    #[command(allow_negative_numbers = true)]
     Point(point::PointArgs),
     /// Solve a grid of operating points and write a CSV map (streamed, parallel).
+    #[command(allow_negative_numbers = true)]
     Map(map::MapArgs),
     /// Evaluate the preload optimisation criterion (seed 000 section 5).
+    #[command(allow_negative_numbers = true)]
     Optimize(optimize::OptimizeArgs),
     /// List the built-in motor presets, or print one as a motor file.
     Presets(info::PresetsArgs),
     /// List the switchable unmodelled effects and their parameters.
     Effects,
     /// Plot curves or heat maps from a motor or from a map CSV (.png or .svg).
+    #[command(allow_negative_numbers = true)]
     Plot(plot::PlotArgs),
 }
 
@@ -67,7 +71,7 @@ where
         Ok(c) => c,
         Err(e) => {
             // --help and --version are "errors" with exit code 0 that belong on stdout.
-            let text = e.render().ansi().to_string();
+            let text = e.render().to_string();
             let _ = if e.use_stderr() { write!(err, "{text}") } else { write!(out, "{text}") };
             return e.exit_code();
         }
