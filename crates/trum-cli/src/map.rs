@@ -161,11 +161,16 @@ fn write_map(
                 first = last;
             }
         });
+        // Fault injection for the test that checks a failed run leaves no file behind.
+        let fail_after: Option<u64> = std::env::var("TRUM_TEST_FAIL_AFTER_POINTS").ok().and_then(|v| v.parse().ok());
         for (done, bufs) in rx {
             for b in &bufs {
                 w.write_all(b)?;
             }
             progress.set(done);
+            if fail_after.is_some_and(|n| done >= n) {
+                bail!("injected failure after {done} points (TRUM_TEST_FAIL_AFTER_POINTS)");
+            }
         }
         Ok(())
     })
