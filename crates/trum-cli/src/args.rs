@@ -307,13 +307,13 @@ mod tests {
 
     #[test]
     fn axis_syntax() {
-        assert_eq!(parse_axis("250").unwrap(), Axis::fixed(250.0));
-        assert_eq!(parse_axis("100:300:5").unwrap(), Axis::linspace(100.0, 300.0, 5));
-        assert!(parse_axis("100:300").unwrap_err().contains("START:STOP:N"));
-        assert!(parse_axis("100:300:0").unwrap_err().contains("whole number"));
-        assert!(parse_axis("100:300:2.5").unwrap_err().contains("whole number"));
-        assert!(parse_axis("nan").unwrap_err().contains("finite"));
-        assert!(parse_axis("abc").unwrap_err().contains("not a number"));
+        assert_eq!(parse_axis("250").expect("valid"), Axis::fixed(250.0));
+        assert_eq!(parse_axis("100:300:5").expect("valid"), Axis::linspace(100.0, 300.0, 5));
+        assert!(parse_axis("100:300").expect_err("invalid").contains("START:STOP:N"));
+        assert!(parse_axis("100:300:0").expect_err("invalid").contains("whole number"));
+        assert!(parse_axis("100:300:2.5").expect_err("invalid").contains("whole number"));
+        assert!(parse_axis("nan").expect_err("invalid").contains("finite"));
+        assert!(parse_axis("abc").expect_err("invalid").contains("not a number"));
     }
 
     #[test]

@@ -20,7 +20,7 @@ pub use args::parse_axis;
 
 /// Simulate, map and optimise traveling-wave rotary ultrasonic motors (SI units throughout).
 #[derive(Parser, Debug)]
-#[command(name = "trum", version, about, long_about = None)]
+#[command(name = "trum", version)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

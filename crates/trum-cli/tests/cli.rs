@@ -417,3 +417,12 @@ fn plots_png_and_svg() {
     );
     assert!(e.contains("column 'torque' does not exist") && e.contains("torque_nm"), "{e}");
 }
+
+#[test]
+fn motor_file_doc_lists_every_key() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let doc = std::fs::read_to_string(root.join("docs/MOTOR_FILE.md")).expect("docs/MOTOR_FILE.md");
+    for k in trum_core::Motor::all_keys() {
+        assert!(doc.contains(&format!("| `[{}]` | `{}` |", k.section, k.key)), "{}.{} missing", k.section, k.key);
+    }
+}
