@@ -1,12 +1,115 @@
 //! The `trum` command-line tool as a library, so tests can run it in-process.
-use std::ffi::OsString;
+//!
+//! Errors use `anyhow` in this layer only; messages from trum-core (which already name
+//! the file, line and key) are shown unchanged. Exit codes: 0 success, 1 bad input or a
+//! failed run, 2 usage errors (clap), 101 an internal error (a panic, which is a bug).
 
-/// Runs the CLI with the given arguments and returns the process exit code.
+use clap::{Parser, Subcommand};
+use std::ffi::OsString;
+use std::io::Write;
+
+mod args;
+mod info;
+mod map;
+mod optimize;
+mod plot;
+mod point;
+mod table;
+
+pub use args::parse_axis;
+
+/// Simulate, map and optimise traveling-wave rotary ultrasonic motors (SI units throughout).
+#[derive(Parser, Debug)]
+#[command(name = "trum", version)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Solve one operating point and print every quantity with its unit.
+    #[command(allow_negative_numbers = true)]
+    Point(point::PointArgs),
+    /// Solve a grid of operating points and write a CSV map (streamed, parallel).
+    #[command(allow_negative_numbers = true)]
+    Map(map::MapArgs),
+    /// Evaluate the preload optimisation criterion (seed 000 section 5).
+    #[command(allow_negative_numbers = true)]
+    Optimize(optimize::OptimizeArgs),
+    /// List the built-in motor presets, or print one as a motor file.
+    Presets(info::PresetsArgs),
+    /// List the switchable unmodelled effects and their parameters.
+    Effects,
+    /// Plot curves or heat maps from a motor or from a map CSV (.png or .svg).
+    #[command(allow_negative_numbers = true)]
+    Plot(plot::PlotArgs),
+}
+
+/// Runs the CLI with the given arguments (the first is the program name) and returns
+/// the process exit code. Output goes to the process's stdout and stderr.
 pub fn main_with_args<I, T>(args: I) -> i32
 where
     I: IntoIterator<Item = T>,
     T: Into<OsString> + Clone,
 {
-    let _ = args.into_iter().count();
-    0
+    let stdout = std::io::stdout();
+    let stderr = std::io::stderr();
+    let mut out = stdout.lock();
+    let mut err = stderr.lock();
+    run_with_io(args, &mut out, &mut err)
+}
+
+/// Like [`main_with_args`], writing to the given streams (tests capture them this way).
+/// Progress bars, when shown, still go to the terminal's stderr.
+pub fn run_with_io<I, T>(args: I, out: &mut dyn Write, err: &mut dyn Write) -> i32
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            // --help and --version are "errors" with exit code 0 that belong on stdout.
+            let text = e.render().to_string();
+            let _ = if e.use_stderr() { write!(err, "{text}") } else { write!(out, "{text}") };
+            return e.exit_code();
+        }
+    };
+    // Last resort: nothing should panic, but a bug must not print a backtrace at the user.
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(cli, out, err)));
+    match result {
+        Ok(Ok(code)) => {
+            let _ = out.flush();
+            code
+        }
+        Ok(Err(e)) => {
+            if is_broken_pipe(&e) {
+                // `trum map -o - | head`: the reader went away; that is not an error.
+                return 0;
+            }
+            let _ = out.flush();
+            let _ = writeln!(err, "error: {e:#}");
+            1
+        }
+        Err(_) => {
+            let _ = writeln!(err, "error: internal error (a bug in trum; please report it with the command line)");
+            101
+        }
+    }
+}
+
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| c.downcast_ref::<std::io::Error>().is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe))
+}
+
+fn run(cli: Cli, out: &mut dyn Write, err: &mut dyn Write) -> anyhow::Result<i32> {
+    match cli.command {
+        Command::Point(a) => point::run(&a, out, err),
+        Command::Map(a) => map::run(&a, out, err),
+        Command::Optimize(a) => optimize::run(&a, out, err),
+        Command::Presets(a) => info::presets(&a, out),
+        Command::Effects => info::effects(out),
+        Command::Plot(a) => plot::run(&a, err),
+    }
 }

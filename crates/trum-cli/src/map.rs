@@ -1,0 +1,177 @@
+//! `trum map`: a grid of operating points to CSV, streamed in constant memory.
+//!
+//! The grid is cut into fixed chunks of `CHUNK` points. Each chunk is solved serially
+//! with warm starts ([`trum_core::sweep::solve_range`]) and formatted into a byte buffer;
+//! a wave of chunks is solved in parallel with rayon while the previous wave is being
+//! written. Chunk boundaries do not depend on the thread count, so the output is
+//! byte-identical whatever the parallelism. At most three waves exist at once (one being
+//! solved, one queued, one being written): memory is constant for any grid size.
+
+use crate::args::{check_grid, csv_number, default_grid, GridArgs, MotorArgs, OutputTarget, Progress};
+use anyhow::{anyhow, bail, Context, Result};
+use clap::Args;
+use rayon::prelude::*;
+use std::io::{BufWriter, Write};
+use std::path::PathBuf;
+use trum_core::quantities::{self, Quantity, QUANTITIES};
+use trum_core::solve::Prepared;
+use trum_core::sweep::{solve_range, Grid};
+use trum_core::Motor;
+
+/// Points per chunk: large enough that warm starts pay off and scheduling is cheap,
+/// small enough that a wave of chunks stays a few megabytes.
+const CHUNK: u64 = 4096;
+
+/// Input columns, in the order they are written.
+pub const INPUT_COLUMNS: [&str; 4] = ["preload_n", "torque_nm", "voltage_v", "frequency_hz"];
+
+#[derive(Args, Debug)]
+pub struct MapArgs {
+    #[command(flatten)]
+    motor: MotorArgs,
+    #[command(flatten)]
+    grid: GridArgs,
+    /// Quantity columns to write, comma-separated (default: all; see `trum point` for the list).
+    #[arg(long, value_name = "a,b,c")]
+    columns: Option<String>,
+    /// Output CSV file (`-` for stdout). Written to a temporary file and renamed at the end.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: PathBuf,
+    /// Worker threads (default: RAYON_NUM_THREADS or the number of cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No progress bar.
+    #[arg(short, long)]
+    quiet: bool,
+    /// Points per chunk (advanced; changes warm-start boundaries, so the last digits may differ).
+    #[arg(long, default_value_t = CHUNK, hide = true)]
+    chunk_points: u64,
+}
+
+/// Parses `--columns`: known quantity names, no duplicates.
+pub fn parse_columns(spec: Option<&str>) -> Result<Vec<&'static Quantity>> {
+    let Some(spec) = spec else { return Ok(QUANTITIES.iter().collect()) };
+    let mut cols: Vec<&'static Quantity> = Vec::new();
+    for name in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        if INPUT_COLUMNS.contains(&name) || name == "status" {
+            bail!("--columns: '{name}' is always written (inputs and status come first); list only quantities");
+        }
+        let q = quantities::find(name).map_err(|m| anyhow!("--columns: {m}"))?;
+        if cols.iter().any(|c| c.name == q.name) {
+            bail!("--columns: '{name}' is listed twice");
+        }
+        cols.push(q);
+    }
+    if cols.is_empty() {
+        bail!("--columns: no column given");
+    }
+    Ok(cols)
+}
+
+pub fn run(a: &MapArgs, out: &mut dyn Write, _err: &mut dyn Write) -> Result<i32> {
+    let (motor, sweep) = a.motor.load()?;
+    let grid = a.grid.resolve(&sweep, &default_grid());
+    check_grid(&grid)?;
+    let cols = parse_columns(a.columns.as_deref())?;
+    if a.chunk_points == 0 {
+        bail!("--chunk-points must be >= 1");
+    }
+    let target = OutputTarget::create(&a.output, ".csv")?;
+    let threads = a.threads.unwrap_or(0);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start worker threads")?;
+    let mut progress = Progress::new(grid.len(), "points", a.quiet);
+    let result = match &target {
+        OutputTarget::Stdout => write_map(&motor, &grid, &cols, a.chunk_points, &pool, out, &mut progress),
+        OutputTarget::File(tmp, path) => {
+            let file = tmp.reopen().with_context(|| format!("cannot write '{}'", path.display()))?;
+            let mut w = BufWriter::with_capacity(1 << 20, file);
+            write_map(&motor, &grid, &cols, a.chunk_points, &pool, &mut w, &mut progress)
+                .and_then(|()| w.flush().map_err(Into::into))
+                .with_context(|| format!("writing '{}'", path.display()))
+        }
+    };
+    progress.finish();
+    result?;
+    target.finish()?;
+    Ok(0)
+}
+
+/// The CSV header line.
+pub fn header(cols: &[&Quantity]) -> String {
+    let mut h: Vec<&str> = INPUT_COLUMNS.to_vec();
+    h.push("status");
+    h.extend(cols.iter().map(|q| q.name));
+    h.join(",") + "\n"
+}
+
+/// Solves and formats one chunk.
+fn chunk_csv(motor: &Motor, prep: &Prepared, grid: &Grid, cols: &[&Quantity], range: std::ops::Range<u64>) -> Vec<u8> {
+    let mut buf = Vec::with_capacity((range.end - range.start) as usize * (24 * cols.len() + 64));
+    solve_range(motor, prep, grid, range, |_, op, s| {
+        use std::fmt::Write as _;
+        let mut line = String::with_capacity(24 * cols.len() + 64);
+        let _ = write!(line, "{},{},{},{},{}", op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz, s.status);
+        let valid = s.status.is_valid();
+        for q in cols {
+            line.push(',');
+            // Invalid points: empty cells (never "NaN"); the status column says why.
+            if valid {
+                line.push_str(&csv_number((q.get)(s)));
+            }
+        }
+        line.push('\n');
+        buf.extend_from_slice(line.as_bytes());
+    });
+    buf
+}
+
+fn write_map(
+    motor: &Motor,
+    grid: &Grid,
+    cols: &[&Quantity],
+    chunk: u64,
+    pool: &rayon::ThreadPool,
+    w: &mut dyn Write,
+    progress: &mut Progress,
+) -> Result<()> {
+    w.write_all(header(cols).as_bytes())?;
+    let total = grid.len();
+    let nchunks = total.div_ceil(chunk);
+    let wave = (4 * pool.current_num_threads() as u64).max(2);
+    let prep = Prepared::new(motor);
+    // A bounded channel of one wave is the reorder buffer: the solver thread runs at most
+    // one wave ahead of the writer.
+    let (tx, rx) = std::sync::mpsc::sync_channel::<(u64, Vec<Vec<u8>>)>(1);
+    std::thread::scope(|scope| -> Result<()> {
+        let prep = &prep;
+        scope.spawn(move || {
+            let mut first = 0;
+            while first < nchunks {
+                let last = (first + wave).min(nchunks);
+                let bufs: Vec<Vec<u8>> = pool.install(|| {
+                    (first..last)
+                        .into_par_iter()
+                        .map(|c| chunk_csv(motor, prep, grid, cols, c * chunk..((c + 1) * chunk).min(total)))
+                        .collect()
+                });
+                let done = (last * chunk).min(total);
+                if tx.send((done, bufs)).is_err() {
+                    return; // the writer failed and hung up; stop solving
+                }
+                first = last;
+            }
+        });
+        // Fault injection for the test that checks a failed run leaves no file behind.
+        let fail_after: Option<u64> = std::env::var("TRUM_TEST_FAIL_AFTER_POINTS").ok().and_then(|v| v.parse().ok());
+        for (done, bufs) in rx {
+            for b in &bufs {
+                w.write_all(b)?;
+            }
+            progress.set(done);
+            if fail_after.is_some_and(|n| done >= n) {
+                bail!("injected failure after {done} points (TRUM_TEST_FAIL_AFTER_POINTS)");
+            }
+        }
+        Ok(())
+    })
+}

@@ -1,0 +1,170 @@
+//! `trum optimize`: the preload criterion table and the optimum region.
+
+use crate::args::{csv_number, fmt_sig, parse_axis, MotorArgs, OutputTarget, Progress};
+use crate::table::{write_table, Align};
+use anyhow::{anyhow, bail, Context, Result};
+use clap::Args;
+use std::io::{BufWriter, Write};
+use std::path::PathBuf;
+use trum_core::criterion::{evaluate, CriterionConfig, CriterionRow};
+use trum_core::sweep::Axis;
+
+/// The paper's optimum preload region for the TRUM60A (seed 000 section 5) [N].
+const PAPER_REGION_TRUM60A_N: (f64, f64) = (260.0, 320.0);
+
+#[derive(Args, Debug)]
+pub struct OptimizeArgs {
+    #[command(flatten)]
+    motor: MotorArgs,
+    /// Drive voltage amplitude per phase [V].
+    #[arg(long, default_value_t = 200.0)]
+    voltage_v: f64,
+    /// Drive frequency [Hz].
+    #[arg(long, default_value_t = 43_000.0)]
+    frequency_hz: f64,
+    /// Candidate preloads [N] as START:STOP:N (default 150:500:36, as in seed 000).
+    #[arg(long, value_name = "START:STOP:N", value_parser = parse_axis)]
+    preload_n: Option<Axis>,
+    /// Weights of stall torque, max efficiency, temperature rise, speed fluctuation.
+    #[arg(long, value_name = "a,b,c,d", default_value = "1,1,2,2")]
+    weights: String,
+    /// Run time for the temperature rise [s].
+    #[arg(long, default_value_t = 10.0)]
+    run_time_s: f64,
+    /// Axial runout of the rotor for the speed fluctuation [m].
+    #[arg(long, default_value_t = 5e-6)]
+    runout_m: f64,
+    /// Score tolerance of the optimum region, as a fraction of the best score.
+    #[arg(long, default_value_t = 0.1)]
+    region_tolerance: f64,
+    /// Also write the table as CSV (`-` for stdout instead of the text table).
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: Option<PathBuf>,
+    /// No progress bar.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// Columns of the criterion table.
+pub const COLUMNS: [&str; 10] = [
+    "preload_n",
+    "status",
+    "stall_torque_nm",
+    "max_efficiency",
+    "torque_at_max_efficiency_nm",
+    "temperature_rise_k",
+    "speed_std_rpm",
+    "no_load_speed_rpm",
+    "score",
+    "in_region",
+];
+
+fn parse_weights(s: &str) -> Result<[f64; 4]> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f64>().map_err(|_| anyhow!("--weights: '{}' is not a number", t.trim())))
+        .collect::<Result<_>>()?;
+    let w: [f64; 4] = v.try_into().map_err(|v: Vec<f64>| {
+        anyhow!(
+            "--weights: expected 4 numbers (stall torque, max efficiency, temperature rise, speed fluctuation), got {}",
+            v.len()
+        )
+    })?;
+    if w.iter().any(|x| !(x.is_finite() && *x >= 0.0)) || w.iter().sum::<f64>() <= 0.0 {
+        bail!("--weights: weights must be finite, >= 0 and not all zero");
+    }
+    Ok(w)
+}
+
+fn row_cells(r: &CriterionRow, fmt: &dyn Fn(f64) -> String) -> Vec<String> {
+    let valid = r.status.as_str() == "ok";
+    // Disqualified candidates (not running at no load) have no indicators: leave them empty.
+    let ind = |v: f64| if valid { fmt(v) } else { fmt(f64::NAN) };
+    vec![
+        fmt(r.preload_n),
+        r.status.as_str().to_string(),
+        fmt(r.stall_torque_nm),
+        ind(r.max_efficiency),
+        ind(r.torque_at_max_efficiency_nm),
+        ind(r.temperature_rise_k),
+        ind(r.speed_std_rpm),
+        fmt(r.no_load_speed_rpm),
+        ind(r.score),
+        r.in_region.to_string(),
+    ]
+}
+
+pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
+    let (motor, _) = a.motor.load()?;
+    let mut cfg = CriterionConfig::seed000();
+    if let Some(p) = a.preload_n {
+        cfg.preload_n = p;
+    }
+    cfg.voltage_v = a.voltage_v;
+    cfg.frequency_hz = a.frequency_hz;
+    cfg.weights = parse_weights(&a.weights)?;
+    cfg.run_time_s = a.run_time_s;
+    cfg.runout_m = a.runout_m;
+    cfg.region_tolerance = a.region_tolerance;
+    let target = a.output.as_ref().map(|p| OutputTarget::create(p, ".csv")).transpose()?;
+    let mut progress = Progress::new(cfg.preload_n.n as u64, "preloads", a.quiet);
+    let res = evaluate(&motor, &cfg, &mut |done, _| progress.set(done as u64));
+    progress.finish();
+    let res = res.map_err(|e| anyhow!("{e}"))?;
+
+    let to_stdout = matches!(target, Some(OutputTarget::Stdout));
+    if let Some(t) = target {
+        let rows: Vec<Vec<String>> = res.rows.iter().map(|r| row_cells(r, &csv_number)).collect();
+        let write = |w: &mut dyn Write| -> std::io::Result<()> {
+            writeln!(w, "{}", COLUMNS.join(","))?;
+            for r in &rows {
+                writeln!(w, "{}", r.join(","))?;
+            }
+            w.flush()
+        };
+        match &t {
+            OutputTarget::Stdout => write(out)?,
+            OutputTarget::File(tmp, path) => {
+                let f = tmp.reopen().with_context(|| format!("cannot write '{}'", path.display()))?;
+                write(&mut BufWriter::new(f)).with_context(|| format!("writing '{}'", path.display()))?;
+            }
+        }
+        t.finish()?;
+    }
+    if !to_stdout {
+        let rows: Vec<Vec<String>> = res.rows.iter().map(|r| row_cells(r, &|v| fmt_sig(v, 5))).collect();
+        let header: Vec<String> = COLUMNS
+            .iter()
+            .map(|c| match crate::args::unit_of(c) {
+                Some(u) if u != "-" => format!("{c} [{}]", u.replace(' ', "·")),
+                _ => c.to_string(),
+            })
+            .collect();
+        let header: Vec<&str> = header.iter().map(String::as_str).collect();
+        let mut align = vec![Align::Right; COLUMNS.len()];
+        align[1] = Align::Left;
+        write_table(out, &header, &align, &rows)?;
+        writeln!(out)?;
+    }
+    // The summary goes to stdout after the table, or to stderr when stdout carries the CSV.
+    let mut summary = format!(
+        "optimum preload {} N; optimum region {}-{} N (score within {}% of the best; weights {})",
+        fmt_sig(res.optimum_preload_n, 5),
+        fmt_sig(res.region_n.0, 5),
+        fmt_sig(res.region_n.1, 5),
+        fmt_sig(100.0 * cfg.region_tolerance, 3),
+        a.weights
+    );
+    if motor.preset.as_deref() == Some("trum60a") {
+        summary.push_str(&format!(
+            "; paper (seed 000, TRUM60A): {}-{} N",
+            PAPER_REGION_TRUM60A_N.0, PAPER_REGION_TRUM60A_N.1
+        ));
+    }
+    if to_stdout {
+        writeln!(err, "{summary}")?;
+    } else {
+        writeln!(out, "{summary}")?;
+    }
+    Ok(0)
+}

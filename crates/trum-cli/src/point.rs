@@ -1,0 +1,115 @@
+//! `trum point`: one operating point, every quantity with its unit.
+
+use crate::args::{fmt_sig, MotorArgs};
+use crate::table::{write_table, Align};
+use anyhow::{bail, Result};
+use clap::Args;
+use serde_json::{json, Map, Value};
+use std::io::Write;
+use trum_core::quantities::QUANTITIES;
+use trum_core::{solve, OperatingPoint, Status};
+
+#[derive(Args, Debug)]
+pub struct PointArgs {
+    #[command(flatten)]
+    motor: MotorArgs,
+    /// Axial preload [N].
+    #[arg(long)]
+    preload_n: f64,
+    /// Load torque [N m].
+    #[arg(long, default_value_t = 0.0)]
+    torque_nm: f64,
+    /// Drive voltage amplitude per phase, zero-to-peak [V].
+    #[arg(long, default_value_t = 200.0)]
+    voltage_v: f64,
+    /// Drive frequency [Hz].
+    #[arg(long, default_value_t = 43_000.0)]
+    frequency_hz: f64,
+    /// Time since the drive was switched on [s] (only thermal quantities and `thermal_drift` use it).
+    #[arg(long, default_value_t = 0.0)]
+    elapsed_s: f64,
+    /// Print JSON (full precision, null for invalid numbers) instead of the table.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
+    let (motor, _) = a.motor.load()?;
+    let op = OperatingPoint {
+        preload_n: a.preload_n,
+        torque_nm: a.torque_nm,
+        voltage_v: a.voltage_v,
+        frequency_hz: a.frequency_hz,
+        elapsed_s: a.elapsed_s,
+    };
+    if let Some(reason) = op.invalid_reason() {
+        bail!("invalid operating point: {reason}");
+    }
+    let s = solve(&motor, &op);
+    let valid = s.status.is_valid();
+    let inputs: [(&str, f64, &str); 5] = [
+        ("preload_n", op.preload_n, "N"),
+        ("torque_nm", op.torque_nm, "N m"),
+        ("voltage_v", op.voltage_v, "V"),
+        ("frequency_hz", op.frequency_hz, "Hz"),
+        ("elapsed_s", op.elapsed_s, "s"),
+    ];
+    if a.json {
+        let mut q = Map::new();
+        let mut units = Map::new();
+        for qu in QUANTITIES {
+            let v = (qu.get)(&s);
+            // JSON has no NaN: invalid numbers are null, like the empty CSV cells.
+            let v = if valid && v.is_finite() { json!(v) } else { Value::Null };
+            q.insert(qu.name.into(), v);
+            units.insert(qu.name.into(), json!(qu.unit));
+        }
+        let mut inp = Map::new();
+        for (n, v, _) in inputs {
+            inp.insert(n.into(), json!(v));
+        }
+        let doc = json!({
+            "motor": { "name": motor.name, "preset": motor.preset, "source": a.motor.motor, "effects": motor.effects.to_string() },
+            "inputs": inp,
+            "status": s.status.as_str(),
+            "valid": valid,
+            "full_contact": s.full_contact,
+            "iterations": s.iterations,
+            "quantities": q,
+            "units": units,
+        });
+        writeln!(out, "{}", serde_json::to_string_pretty(&doc)?)?;
+    } else {
+        let preset = motor.preset.as_deref().map(|p| format!(" (preset {p})")).unwrap_or_default();
+        writeln!(out, "motor    {}{}", motor.name, preset)?;
+        writeln!(out, "effects  {}", motor.effects)?;
+        writeln!(out, "status   {}{}", s.status, status_note(s.status, s.full_contact))?;
+        writeln!(out)?;
+        let mut rows = Vec::new();
+        for (n, v, u) in inputs {
+            rows.push(vec![n.to_string(), fmt_sig(v, 6), u.to_string(), "input".to_string()]);
+        }
+        for qu in QUANTITIES {
+            let v = if valid { (qu.get)(&s) } else { f64::NAN };
+            rows.push(vec![qu.name.to_string(), fmt_sig(v, 6), qu.unit.to_string(), qu.doc.to_string()]);
+        }
+        write_table(out, &["quantity", "value", "unit", "meaning"], &[Align::Left, Align::Right, Align::Left], &rows)?;
+    }
+    if !valid {
+        // The numbers are not a steady state; say so and fail, but after printing the status.
+        writeln!(err, "error: no valid steady state at this point (status {})", s.status)?;
+        return Ok(1);
+    }
+    Ok(0)
+}
+
+fn status_note(s: Status, full: bool) -> &'static str {
+    match s {
+        Status::Ok if full => " (rotor turning, full contact)",
+        Status::Ok => " (rotor turning)",
+        Status::Stall => " (load torque at or above the stall torque: rotor at rest)",
+        Status::Clamped => " (friction clamps the stator: no vibration at this drive)",
+        Status::NoConvergence => " (the solver did not converge; numbers withheld)",
+        Status::InvalidInput => " (invalid operating point)",
+    }
+}

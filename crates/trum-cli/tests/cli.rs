@@ -1,0 +1,428 @@
+//! End-to-end tests of the real `trum` binary: output, files, error messages, exit codes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn trum(args: &[&str]) -> Output {
+    trum_env(args, &[])
+}
+
+fn trum_env(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_trum"));
+    c.args(args);
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("run trum")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Runs and expects failure with `code`; returns stderr.
+fn fails(args: &[&str], code: i32) -> String {
+    let o = trum(args);
+    assert_eq!(o.status.code(), Some(code), "{args:?}: stdout {} stderr {}", stdout(&o), stderr(&o));
+    stderr(&o)
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = trum(args);
+    assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+    stdout(&o)
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).expect("write test file");
+    p.to_string_lossy().into_owned()
+}
+
+fn snapshot(name: &str, actual: &str) {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots").join(name);
+    if std::env::var_os("UPDATE_SNAPSHOTS").is_some() {
+        std::fs::write(&path, actual).expect("write snapshot");
+        return;
+    }
+    let expected = std::fs::read_to_string(&path)
+        .unwrap_or_else(|_| panic!("missing snapshot {}; run with UPDATE_SNAPSHOTS=1", path.display()));
+    assert_eq!(actual, expected, "snapshot {name} differs; if intended, rerun with UPDATE_SNAPSHOTS=1");
+}
+
+#[test]
+fn point_snapshot_trum60a() {
+    let out = ok(&[
+        "point",
+        "--motor",
+        "trum60a",
+        "--preload-n",
+        "250",
+        "--torque-nm",
+        "0.3",
+        "--voltage-v",
+        "200",
+        "--frequency-hz",
+        "43000",
+    ]);
+    snapshot("point_trum60a_250n_0.3nm.txt", &out);
+}
+
+#[test]
+fn point_json_has_every_quantity_and_unit() {
+    let out = ok(&["point", "--motor", "trum60a", "--preload-n", "250", "--torque-nm", "0.3", "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    assert_eq!(v["status"], "ok");
+    for q in trum_core::quantities::QUANTITIES {
+        assert!(v["quantities"][q.name].is_number(), "{}", q.name);
+        assert_eq!(v["units"][q.name], q.unit);
+    }
+}
+
+#[test]
+fn presets_show_reads_back_to_the_same_numbers() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for p in trum_core::presets::PRESETS {
+        let toml = ok(&["presets", "show", p.name]);
+        let file = write(dir.path(), &format!("{}.toml", p.name), &toml);
+        let args = |m: &str| {
+            ok(&["point", "--motor", m, "--preload-n", "250", "--torque-nm", "0.3", "--json"])
+                .parse::<serde_json::Value>()
+                .expect("JSON")
+        };
+        let (a, b) = (args(p.name), args(&file));
+        assert_eq!(a["quantities"], b["quantities"], "{}", p.name);
+        assert_eq!(a["status"], b["status"]);
+        // the text table too, apart from nothing: both name the same motor and preset
+        let t = |m: &str| ok(&["point", "--motor", m, "--preload-n", "250", "--torque-nm", "0.3"]);
+        assert_eq!(t(p.name), t(&file), "{}", p.name);
+    }
+    let list = ok(&["presets"]);
+    for p in trum_core::presets::PRESETS {
+        assert!(list.contains(p.name) && list.contains(p.sources), "{list}");
+    }
+}
+
+#[test]
+fn example_files_match_presets_show() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    for p in ["trum60a", "trum60-qut", "generic60"] {
+        let file = std::fs::read_to_string(root.join(format!("examples/{p}.toml"))).expect("example file");
+        assert_eq!(
+            file,
+            ok(&["presets", "show", p]),
+            "examples/{p}.toml is stale: regenerate with `trum presets show`"
+        );
+    }
+    let custom = root.join("examples/custom-motor.toml");
+    let out = ok(&["map", "--motor", custom.to_str().unwrap_or_default(), "--columns", "speed_rpm", "-o", "-"]);
+    assert_eq!(out.lines().count(), 1 + 6 * 31, "custom-motor [sweep] is 6 preloads x 31 torques");
+}
+
+fn parse_csv(text: &str) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut r = csv::Reader::from_reader(text.as_bytes());
+    let h = r.headers().expect("header").iter().map(String::from).collect();
+    let rows = r.records().map(|x| x.expect("row").iter().map(String::from).collect()).collect();
+    (h, rows)
+}
+
+#[test]
+fn map_columns_rows_and_defaults() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("m.csv");
+    let o = out.to_str().unwrap_or_default();
+    ok(&["map", "--motor", "trum60a", "--preload-n", "100:300:3", "--torque-nm", "0:1.5:4", "-o", o, "-q"]);
+    let (h, rows) = parse_csv(&std::fs::read_to_string(&out).expect("map written"));
+    let mut want = vec!["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status"];
+    want.extend(trum_core::quantities::QUANTITIES.iter().map(|q| q.name));
+    assert_eq!(h, want);
+    assert_eq!(rows.len(), 12);
+    // torque fastest, defaults 200 V and 43 kHz
+    assert_eq!(&rows[1][..4], ["100", "0.5", "200", "43000"]);
+    assert_eq!(&rows[11][..2], ["300", "1.5"]);
+    // numbers are Rust's shortest round-trip form
+    let speed: f64 = rows[0][5].parse().expect("number");
+    assert_eq!(format!("{speed}"), rows[0][5]);
+
+    let sel = ok(&["map", "--motor", "generic60", "--columns", "speed_rpm,efficiency", "-o", "-"]);
+    let (h, rows) = parse_csv(&sel);
+    assert_eq!(h, ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status", "speed_rpm", "efficiency"]);
+    assert_eq!(rows.len(), 1);
+    assert_eq!(&rows[0][..4], ["250", "0", "200", "43000"]);
+}
+
+#[test]
+fn invalid_points_have_empty_cells_and_a_status() {
+    let out = ok(&["map", "--motor", "trum60a", "--preload-n", "0:200:3", "--torque-nm", "-0.5:0.5:3", "-o", "-"]);
+    assert!(!out.to_lowercase().contains("nan"), "{out}");
+    let (h, rows) = parse_csv(&out);
+    assert_eq!(rows.len(), 9);
+    for r in &rows {
+        let invalid = r[0] == "0" || r[1] == "-0.5";
+        assert_eq!(r[4], if invalid { "invalid_input" } else { "ok" }, "{r:?}");
+        for (name, cell) in h.iter().zip(r).skip(5) {
+            assert_eq!(cell.is_empty(), invalid, "{name} in {r:?}");
+        }
+    }
+}
+
+#[test]
+fn map_output_does_not_depend_on_thread_count() {
+    // a small chunk size makes many chunks, so the parallel order is really exercised
+    let args = [
+        "map",
+        "--motor",
+        "trum60a",
+        "--preload-n",
+        "100:500:9",
+        "--torque-nm",
+        "0:1.6:23",
+        "--chunk-points",
+        "7",
+        "-o",
+        "-",
+    ];
+    let one = trum_env(&args, &[("RAYON_NUM_THREADS", "1")]);
+    let two = trum_env(&args, &[("RAYON_NUM_THREADS", "2")]);
+    let three = trum(&[&args[..], &["--threads", "3"]].concat());
+    assert!(one.status.success() && two.status.success() && three.status.success());
+    assert_eq!(stdout(&one).lines().count(), 1 + 9 * 23);
+    assert_eq!(one.stdout, two.stdout);
+    assert_eq!(one.stdout, three.stdout);
+}
+
+#[test]
+fn failed_map_leaves_no_file() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("big.csv");
+    let o = out.to_str().unwrap_or_default();
+    let r = trum_env(
+        &[
+            "map",
+            "--motor",
+            "trum60a",
+            "--preload-n",
+            "100:300:50",
+            "--torque-nm",
+            "0:1:50",
+            "--chunk-points",
+            "64",
+            "-o",
+            o,
+        ],
+        &[("TRUM_TEST_FAIL_AFTER_POINTS", "500")],
+    );
+    assert_eq!(r.status.code(), Some(1));
+    assert!(stderr(&r).contains("injected failure"), "{}", stderr(&r));
+    let left: Vec<_> = std::fs::read_dir(dir.path()).expect("dir").collect();
+    assert!(left.is_empty(), "files left behind: {left:?}");
+    // a failed run does not touch an existing output either
+    std::fs::write(&out, "old").expect("write");
+    let r = trum_env(
+        &["map", "--motor", "trum60a", "--preload-n", "100:300:50", "--torque-nm", "0:1:50", "-o", o],
+        &[("TRUM_TEST_FAIL_AFTER_POINTS", "1")],
+    );
+    assert_eq!(r.status.code(), Some(1));
+    assert_eq!(std::fs::read_to_string(&out).expect("read"), "old");
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 1);
+    // bad input fails before anything is created
+    std::fs::remove_file(&out).expect("rm");
+    fails(&["map", "--motor", "trum60a", "--columns", "nope", "-o", o], 1);
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0);
+}
+
+#[test]
+fn motor_file_errors_name_file_line_and_key() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let cases = [
+        (
+            "unknown.toml",
+            "preset = \"trum60a\"\n\n[stator]\nmodal_masss_kg = 1\n",
+            "line 4, key 'stator.modal_masss_kg': unknown key",
+        ),
+        (
+            "negative.toml",
+            "preset = \"trum60a\"\n[rotor]\nmass_kg = -0.03\n",
+            "line 3, key 'rotor.mass_kg': -0.03 must be > 0",
+        ),
+        (
+            "nan.toml",
+            "preset = \"trum60a\"\n[rotor]\nmass_kg = nan\n",
+            "line 3, key 'rotor.mass_kg': NaN is not a finite number",
+        ),
+        (
+            "wave.toml",
+            "preset = \"trum60a\"\n[geometry]\nwave_number = 9.5\n",
+            "line 3, key 'geometry.wave_number': 9.5 must be a positive whole number",
+        ),
+        (
+            "preset.toml",
+            "preset = \"trum60x\"\n",
+            "line 1, key 'preset': unknown preset 'trum60x'; valid presets are: trum60a",
+        ),
+        (
+            "effect.toml",
+            "preset = \"trum60a\"\n[effects]\nradial = 0.5\n",
+            "unknown effect 'radial'; valid effects are: radial_friction",
+        ),
+    ];
+    for (name, text, want) in cases {
+        let f = write(d, name, text);
+        let err = fails(&["point", "--motor", &f, "--preload-n", "250"], 1);
+        assert!(err.contains(&f), "{err}");
+        assert!(err.contains(want), "{name}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
+fn command_line_errors_and_exit_codes() {
+    let e = fails(&["point", "--motor", "trum61", "--preload-n", "250"], 1);
+    assert!(e.contains("unknown preset 'trum61'") && e.contains("trum60a, trum60-qut, generic60"), "{e}");
+    let e = fails(&["point", "--motor", "missing/motor.toml", "--preload-n", "250"], 1);
+    assert!(e.contains("motor file 'missing/motor.toml' does not exist"), "{e}");
+    let e = fails(&["map", "--motor", "trum60a", "--preload-n", "100:200", "-o", "-"], 2);
+    assert!(e.contains("START:STOP:N"), "{e}");
+    let e = fails(&["map", "--motor", "trum60a", "--preload-n", "100:200:x", "-o", "-"], 2);
+    assert!(e.contains("whole number"), "{e}");
+    let e = fails(&["point", "--motor", "trum60a", "--preload-n", "250", "--effect", "radial=0.5"], 1);
+    assert!(e.contains("unknown effect 'radial'"), "{e}");
+    for name in trum_core::effects::EFFECTS.iter().map(|e| e.name) {
+        assert!(e.contains(name), "{e}");
+    }
+    let e = fails(&["point", "--motor", "trum60a", "--preload-n", "250", "--effect", "eccentricity=1"], 1);
+    assert!(e.contains("outside the valid range"), "{e}");
+    let e = fails(&["point", "--motor", "trum60a", "--preload-n", "-5"], 1);
+    assert!(e.contains("preload_n = -5 must be > 0"), "{e}");
+    let e = fails(&["point", "--motor", "trum60a", "--preload-n", "nan"], 1);
+    assert!(e.contains("not a finite number"), "{e}");
+    fails(&["point", "--motor", "trum60a"], 2);
+    fails(&["frobnicate"], 2);
+    fails(&[], 2);
+    let e = fails(&["map", "--motor", "trum60a", "--columns", "speed", "-o", "-"], 1);
+    assert!(e.contains("unknown quantity 'speed'") && e.contains("speed_rpm"), "{e}");
+    let e = fails(&["presets", "show", "nope"], 1);
+    assert!(e.contains("unknown preset 'nope'"), "{e}");
+    let e = fails(&["plot", "--motor", "trum60a", "--kind", "speed-torque", "-o", "x.jpg"], 1);
+    assert!(e.contains(".png or .svg"), "{e}");
+    assert!(ok(&["--help"]).contains("Usage"));
+}
+
+#[test]
+fn effects_lists_the_registry() {
+    let out = ok(&["effects"]);
+    for e in trum_core::effects::EFFECTS.iter() {
+        assert!(out.contains(e.name) && out.contains(e.source), "{}", e.name);
+        for p in e.params {
+            assert!(out.contains(p.name), "{}", p.name);
+        }
+    }
+}
+
+#[test]
+fn optimize_table_and_summary() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let csv_path = dir.path().join("opt.csv");
+    let out = ok(&[
+        "optimize",
+        "--motor",
+        "trum60a",
+        "--preload-n",
+        "150:450:7",
+        "-o",
+        csv_path.to_str().unwrap_or_default(),
+    ]);
+    assert!(out.contains("optimum preload") && out.contains("260-320 N"), "{out}");
+    let (h, rows) = parse_csv(&std::fs::read_to_string(&csv_path).expect("csv"));
+    assert_eq!(h.len(), 10);
+    assert_eq!(h[0], "preload_n");
+    assert_eq!(h[9], "in_region");
+    assert_eq!(rows.len(), 7);
+    let g = ok(&["optimize", "--motor", "generic60", "--preload-n", "150:450:4"]);
+    assert!(!g.contains("260-320"), "{g}");
+}
+
+#[test]
+fn plots_png_and_svg() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let png = d.join("st.png");
+    ok(&[
+        "plot",
+        "--motor",
+        "trum60a",
+        "--kind",
+        "speed-torque",
+        "--preload-n",
+        "150:350:3",
+        "-o",
+        png.to_str().unwrap_or_default(),
+    ]);
+    let bytes = std::fs::read(&png).expect("png");
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    let svg = d.join("em.svg");
+    ok(&[
+        "plot",
+        "--motor",
+        "generic60",
+        "--kind",
+        "efficiency-map",
+        "--preload-n",
+        "100:400:7",
+        "--torque-nm",
+        "0:1:11",
+        "-o",
+        svg.to_str().unwrap_or_default(),
+    ]);
+    let text = std::fs::read_to_string(&svg).expect("svg");
+    assert!(text.starts_with("<svg") && text.contains("<rect"), "{}", &text[..200.min(text.len())]);
+    // from a map CSV
+    let map = d.join("m.csv");
+    ok(&[
+        "map",
+        "--motor",
+        "trum60a",
+        "--preload-n",
+        "100:300:3",
+        "--torque-nm",
+        "0:1.5:16",
+        "-o",
+        map.to_str().unwrap_or_default(),
+    ]);
+    let from_csv = d.join("c.svg");
+    let m = map.to_str().unwrap_or_default();
+    ok(&[
+        "plot",
+        "--map",
+        m,
+        "--x",
+        "torque_nm",
+        "--y",
+        "speed_rpm",
+        "--group",
+        "preload_n",
+        "-o",
+        from_csv.to_str().unwrap_or_default(),
+    ]);
+    let text = std::fs::read_to_string(&from_csv).expect("svg");
+    assert!(text.contains("torque_nm [N·m]") || !text.contains("<text"), "axis label with unit");
+    let e = fails(
+        &["plot", "--map", m, "--x", "torque", "--y", "speed_rpm", "-o", from_csv.to_str().unwrap_or_default()],
+        1,
+    );
+    assert!(e.contains("column 'torque' does not exist") && e.contains("torque_nm"), "{e}");
+}
+
+#[test]
+fn motor_file_doc_lists_every_key() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let doc = std::fs::read_to_string(root.join("docs/MOTOR_FILE.md")).expect("docs/MOTOR_FILE.md");
+    for k in trum_core::Motor::all_keys() {
+        assert!(doc.contains(&format!("| `[{}]` | `{}` |", k.section, k.key)), "{}.{} missing", k.section, k.key);
+    }
+}
