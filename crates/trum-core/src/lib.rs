@@ -36,3 +36,4 @@ pub use effects::{Effect, Effects};
 pub use error::{ParamError, TrumError};
 pub use params::Motor;
 pub use solve::{solve, OperatingPoint, Solution, Status};
+pub mod bench;
