@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# The whole test suite: Rust (every crate, cross-crate tests, doc tests) and Python.
+# Works on a fresh machine with the Rust toolchain and python3; installs what else it needs.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export CARGO_TERM_COLOR=${CARGO_TERM_COLOR:-never}
+echo "== cargo test (trum-core, trum-cli, cross-crate tests)"
+cargo test --workspace --exclude trum-py
+echo "== criterion smoke run (one short pass of every benchmark, not timed)"
+cargo bench --bench solve -- --test
+if [ -x scripts/test-python.sh ]; then
+  echo "== Python"
+  bash scripts/test-python.sh
+fi
