@@ -238,7 +238,10 @@ impl PyMotor {
             .into_iter()
             .map(|e| {
                 let vals = self.inner.effects.get(e).unwrap_or(&[]);
-                (e.name().to_string(), e.info().params.iter().zip(vals).map(|(p, v)| (p.name.to_string(), *v)).collect())
+                (
+                    e.name().to_string(),
+                    e.info().params.iter().zip(vals).map(|(p, v)| (p.name.to_string(), *v)).collect(),
+                )
             })
             .collect()
     }
@@ -255,7 +258,10 @@ impl PyMotor {
     }
 
     fn __repr__(&self) -> String {
-        format!("<trum._trum.Motor {:?} preset={:?} effects={}>", self.inner.name, self.inner.preset, self.inner.effects)
+        format!(
+            "<trum._trum.Motor {:?} preset={:?} effects={}>",
+            self.inner.name, self.inner.preset, self.inner.effects
+        )
     }
 
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
@@ -279,8 +285,9 @@ fn column<'a>(a: &'a PyReadonlyArrayDyn<'_, f64>, shape: &[usize]) -> Column<'a>
     if b.is_empty() || b.strides().iter().all(|&s| s == 0) {
         return Column::Scalar(b.iter().next().copied().unwrap_or(0.0));
     }
-    match (v.shape() == shape, a.as_slice()) {
-        (true, Ok(s)) => Column::Slice(s),
+    // Zero-copy only for C order (NumPy's `as_slice` also accepts Fortran order).
+    match (v.shape() == shape, v.to_slice()) {
+        (true, Some(s)) => Column::Slice(s),
         _ => Column::Owned(b.iter().copied().collect()),
     }
 }
@@ -310,7 +317,8 @@ fn solve_arrays<'py>(
     let arrays = [&preload_n, &torque_nm, &voltage_v, &frequency_hz, &elapsed_s];
     let shapes: Vec<&[usize]> = arrays.iter().map(|a| a.shape()).collect();
     let shape = vector::broadcast_shape(&vector::INPUTS, &shapes).map_err(|m| input_err(py, m))?;
-    let n = shape.iter().try_fold(1usize, |acc, &d| acc.checked_mul(d)).ok_or_else(|| input_err(py, "too many points"))?;
+    let n =
+        shape.iter().try_fold(1usize, |acc, &d| acc.checked_mul(d)).ok_or_else(|| input_err(py, "too many points"))?;
     let cols: [Column<'_>; 5] = std::array::from_fn(|k| column(arrays[k], &shape));
     let par = parallel.unwrap_or(n >= vector::PARALLEL_MIN_POINTS);
     let m = &motor.get().inner;
@@ -481,7 +489,9 @@ type EffectRow = (&'static str, &'static str, &'static str, Vec<(&'static str, &
 fn effects_list() -> Vec<EffectRow> {
     EFFECTS
         .iter()
-        .map(|e| (e.name, e.summary, e.source, e.params.iter().map(|p| (p.name, p.doc, p.typical, p.min, p.max)).collect()))
+        .map(|e| {
+            (e.name, e.summary, e.source, e.params.iter().map(|p| (p.name, p.doc, p.typical, p.min, p.max)).collect())
+        })
         .collect()
 }
 

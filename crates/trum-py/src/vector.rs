@@ -238,8 +238,13 @@ mod tests {
     fn parallel_equals_serial_equals_core() {
         let m = trum_core::presets::preset("trum60a").unwrap();
         let pre: Vec<f64> = (0..5000).map(|i| 100.0 + (i % 300) as f64).collect();
-        let cols =
-            [Column::Slice(&pre), Column::Scalar(0.1), Column::Scalar(200.0), Column::Scalar(43e3), Column::Scalar(0.0)];
+        let cols = [
+            Column::Slice(&pre),
+            Column::Scalar(0.1),
+            Column::Scalar(200.0),
+            Column::Scalar(43e3),
+            Column::Scalar(0.0),
+        ];
         let a = solve_points(&m, &cols, pre.len(), false);
         let b = solve_points(&m, &cols, pre.len(), true);
         assert_eq!(a.status, b.status);
