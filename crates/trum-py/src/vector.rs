@@ -222,6 +222,7 @@ pub fn grid_inputs(grid: &Grid, n: usize) -> [Vec<f64>; 4] {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 
