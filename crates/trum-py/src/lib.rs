@@ -7,7 +7,7 @@ pub mod vector;
 
 use numpy::ndarray::{Array, IxDyn};
 use numpy::{PyArray, PyArrayDyn, PyReadonlyArrayDyn, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyMemoryError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -46,6 +46,10 @@ fn param_err(py: Python<'_>, e: &ParamError) -> PyErr {
 
 fn input_err(py: Python<'_>, msg: impl Into<String>) -> PyErr {
     raise(py, "InputError", msg.into(), &[])
+}
+
+fn no_memory(n: usize) -> PyErr {
+    PyMemoryError::new_err(format!("not enough memory for the outputs of {n} operating points; solve in chunks"))
 }
 
 fn trum_err(py: Python<'_>, e: TrumError) -> PyErr {
@@ -277,19 +281,22 @@ fn _motor_from_toml(py: Python<'_>, text: &str) -> PyResult<PyMotor> {
 
 // ---------------------------------------------------------------------------- solve
 
-fn column<'a>(a: &'a PyReadonlyArrayDyn<'_, f64>, shape: &[usize]) -> Column<'a> {
+/// Input column `a` broadcast to `shape`: zero-copy for C-contiguous input of that shape,
+/// a scalar for stride-0 views, else gathered (`None` when memory runs out).
+fn column<'a>(a: &'a PyReadonlyArrayDyn<'_, f64>, shape: &[usize]) -> Option<Column<'a>> {
     let v = a.as_array();
-    let Some(b) = v.broadcast(IxDyn(shape)) else {
-        return Column::Owned(vec![]); // unreachable: the shape was checked
-    };
+    let b = v.broadcast(IxDyn(shape))?; // the shape was checked, so this succeeds
     if b.is_empty() || b.strides().iter().all(|&s| s == 0) {
-        return Column::Scalar(b.iter().next().copied().unwrap_or(0.0));
+        return Some(Column::Scalar(b.iter().next().copied().unwrap_or(0.0)));
     }
     // Zero-copy only for C order (NumPy's `as_slice` also accepts Fortran order).
-    match (v.shape() == shape, v.to_slice()) {
-        (true, Some(s)) => Column::Slice(s),
-        _ => Column::Owned(b.iter().copied().collect()),
+    if let (true, Some(s)) = (v.shape() == shape, v.to_slice()) {
+        return Some(Column::Slice(s));
     }
+    let mut g = Vec::new();
+    g.try_reserve_exact(b.len()).ok()?;
+    g.extend(b.iter().copied());
+    Some(Column::Owned(g))
 }
 
 fn shaped<'py>(py: Python<'py>, shape: &[usize], v: Vec<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
@@ -319,14 +326,17 @@ fn solve_arrays<'py>(
     let shape = vector::broadcast_shape(&vector::INPUTS, &shapes).map_err(|m| input_err(py, m))?;
     let n =
         shape.iter().try_fold(1usize, |acc, &d| acc.checked_mul(d)).ok_or_else(|| input_err(py, "too many points"))?;
-    let cols: [Column<'_>; 5] = std::array::from_fn(|k| column(arrays[k], &shape));
+    let cols: Vec<Column<'_>> =
+        arrays.iter().map(|a| column(a, &shape)).collect::<Option<_>>().ok_or_else(|| no_memory(n))?;
+    let cols: [Column<'_>; 5] = cols.try_into().map_err(|_| PyValueError::new_err("five inputs expected"))?;
     let par = parallel.unwrap_or(n >= vector::PARALLEL_MIN_POINTS);
     let m = &motor.get().inner;
     let (out, reasons) = detached(py, || {
-        let out = vector::solve_points(m, &cols, n, par);
+        let out = vector::solve_points(m, &cols, n, par)?;
         let r = vector::reasons(&cols, &out.status);
-        (out, r)
-    })?;
+        Some((out, r))
+    })?
+    .ok_or_else(|| no_memory(n))?;
     let d = PyDict::new(py);
     d.set_item("shape", PyTuple::new(py, &shape)?)?;
     for (q, v) in QUANTITIES.iter().zip(out.values) {
@@ -380,6 +390,7 @@ fn map_grid<'py>(
     let par = parallel.unwrap_or(n >= vector::PARALLEL_MIN_POINTS);
     let m = &motor.get().inner;
     let (inputs, out) = detached(py, || (vector::grid_inputs(&grid, n), vector::solve_grid(m, &grid, n, par)))?;
+    let out = out.ok_or_else(|| no_memory(n))?;
     let reasons: Vec<(usize, String)> = out
         .status
         .iter()

@@ -107,8 +107,17 @@ impl ChunkOut<'_> {
 }
 
 impl Columns {
-    fn new(n: usize) -> Columns {
-        Columns { values: vec![vec![0.0; n]; QUANTITIES.len()], status: vec![0; n] }
+    /// Zeroed buffers for `n` points; `None` when the memory cannot be had (a huge
+    /// broadcast must not abort the process).
+    fn try_new(n: usize) -> Option<Columns> {
+        fn zeros<T: Clone + Default>(n: usize) -> Option<Vec<T>> {
+            let mut v = Vec::new();
+            v.try_reserve_exact(n).ok()?;
+            v.resize(n, T::default());
+            Some(v)
+        }
+        let values = (0..QUANTITIES.len()).map(|_| zeros(n)).collect::<Option<Vec<_>>>()?;
+        Some(Columns { values, status: zeros(n)? })
     }
 
     /// Splits every column into chunks of `chunk` points.
@@ -142,9 +151,9 @@ where
 
 /// Solves `n` points whose inputs are `cols` (in [`INPUTS`] order), each from a cold
 /// start, so a point's result does not depend on its neighbours.
-pub fn solve_points(motor: &Motor, cols: &[Column<'_>; 5], n: usize, parallel: bool) -> Columns {
+pub fn solve_points(motor: &Motor, cols: &[Column<'_>; 5], n: usize, parallel: bool) -> Option<Columns> {
     let p = Prepared::new(motor);
-    let mut out = Columns::new(n);
+    let mut out = Columns::try_new(n)?;
     run(out.chunks(CHUNK), parallel, |c| {
         for j in 0..c.status.len() {
             let i = c.start + j;
@@ -158,7 +167,7 @@ pub fn solve_points(motor: &Motor, cols: &[Column<'_>; 5], n: usize, parallel: b
             c.write(j, &solve_prepared(&p, motor, &op, None));
         }
     });
-    out
+    Some(out)
 }
 
 /// Why the point `i` of a solve is not valid (`None` when it is).
@@ -192,11 +201,11 @@ pub fn reasons(cols: &[Column<'_>; 5], status: &[u8]) -> Vec<(usize, String)> {
 /// Solves a validated grid. Rows along the torque axis (the fastest) are warm-started
 /// from their previous point like the core's sweeps; each row starts cold, so the result
 /// does not depend on the chunking.
-pub fn solve_grid(motor: &Motor, grid: &Grid, n: usize, parallel: bool) -> Columns {
+pub fn solve_grid(motor: &Motor, grid: &Grid, n: usize, parallel: bool) -> Option<Columns> {
     let p = Prepared::new(motor);
     let row = grid.torque_nm.n.max(1);
     let rows_per_chunk = (CHUNK / row).max(1);
-    let mut out = Columns::new(n);
+    let mut out = Columns::try_new(n)?;
     run(out.chunks(rows_per_chunk * row), parallel, |c| {
         let (start, end) = (c.start, c.start + c.status.len());
         let mut r0 = start;
@@ -206,7 +215,7 @@ pub fn solve_grid(motor: &Motor, grid: &Grid, n: usize, parallel: bool) -> Colum
             r0 = r1;
         }
     });
-    out
+    Some(out)
 }
 
 /// The input columns of a grid, in [`trum_core::sweep::AXES`] order.
@@ -246,8 +255,8 @@ mod tests {
             Column::Scalar(43e3),
             Column::Scalar(0.0),
         ];
-        let a = solve_points(&m, &cols, pre.len(), false);
-        let b = solve_points(&m, &cols, pre.len(), true);
+        let a = solve_points(&m, &cols, pre.len(), false).unwrap();
+        let b = solve_points(&m, &cols, pre.len(), true).unwrap();
         assert_eq!(a.status, b.status);
         for (x, y) in a.values.iter().zip(&b.values) {
             assert!(x.iter().zip(y).all(|(u, v)| u.to_bits() == v.to_bits()));
