@@ -32,7 +32,7 @@ __all__ = [
     "Motor",
     "Result",
     "Optimum",
-    "map",
+    # `map` is left out of __all__ so `from trum import *` does not shadow the builtin.
     "optimize",
     "presets",
     "preset_toml",
