@@ -1,0 +1,54 @@
+"""trum: steady-state model of traveling-wave rotary ultrasonic motors (TRUMs).
+
+>>> import trum
+>>> m = trum.Motor("trum60a")
+>>> res = m.solve(preload_n=260.0, torque_nm=[0.0, 0.2], voltage_v=200.0, frequency_hz=43e3)
+>>> res.status.tolist()
+['ok', 'ok']
+
+SI units everywhere; every name carries its unit (``speed_rpm``, ``preload_n``).
+"""
+from ._errors import InputError, ParameterError, ParameterKeyError, TrumError
+from ._registry import (
+    QUANTITY_NAMES,
+    STATUS_NAMES,
+    EffectInfo,
+    EffectParam,
+    ParameterInfo,
+    PresetInfo,
+    QuantityInfo,
+    effects,
+    parameters,
+    preset_toml,
+    presets,
+    quantities,
+)
+from ._result import Result
+from ._motor import Motor
+from ._api import Optimum, map, optimize
+from ._trum import __version__
+
+__all__ = [
+    "Motor",
+    "Result",
+    "Optimum",
+    # `map` is left out of __all__ so `from trum import *` does not shadow the builtin.
+    "optimize",
+    "presets",
+    "preset_toml",
+    "effects",
+    "quantities",
+    "parameters",
+    "PresetInfo",
+    "EffectInfo",
+    "EffectParam",
+    "QuantityInfo",
+    "ParameterInfo",
+    "STATUS_NAMES",
+    "QUANTITY_NAMES",
+    "TrumError",
+    "ParameterError",
+    "ParameterKeyError",
+    "InputError",
+    "__version__",
+]

@@ -1,0 +1,77 @@
+"""Registries of the core: presets, effects, output quantities, motor parameter keys."""
+from __future__ import annotations
+
+from typing import List, NamedTuple, Tuple
+
+from . import _trum
+
+
+class PresetInfo(NamedTuple):
+    """A built-in motor."""
+
+    name: str
+    summary: str
+    sources: str
+
+
+class EffectParam(NamedTuple):
+    """One strength parameter of an effect (name carries its unit)."""
+
+    name: str
+    doc: str
+    typical: float
+    min: float
+    max: float
+
+
+class EffectInfo(NamedTuple):
+    """A named, switchable unmodelled effect; ``params[0]`` is the primary strength."""
+
+    name: str
+    summary: str
+    source: str
+    params: Tuple[EffectParam, ...]
+
+
+class QuantityInfo(NamedTuple):
+    """An output quantity: column name (with unit suffix), unit, meaning."""
+
+    name: str
+    unit: str
+    doc: str
+
+
+class ParameterInfo(NamedTuple):
+    """A motor parameter: dotted key (with unit suffix) and meaning."""
+
+    key: str
+    doc: str
+
+
+def presets() -> List[PresetInfo]:
+    """The built-in motors (``Motor(info.name)`` builds one)."""
+    return [PresetInfo(*p) for p in _trum.presets_list()]
+
+
+def preset_toml(name: str) -> str:
+    """A preset as a commented TOML motor file, with each value's provenance."""
+    return _trum.preset_toml(name)
+
+
+def effects() -> List[EffectInfo]:
+    """The registry of switchable effects (``Motor.with_effects``)."""
+    return [EffectInfo(n, s, src, tuple(EffectParam(*p) for p in ps)) for n, s, src, ps in _trum.effects_list()]
+
+
+def quantities() -> List[QuantityInfo]:
+    """Every output quantity, in the column order of ``Result.to_dict`` and ``map``."""
+    return [QuantityInfo(*q) for q in _trum.quantities_list()]
+
+
+def parameters() -> List[ParameterInfo]:
+    """Every motor parameter key, in motor-file order."""
+    return [ParameterInfo(*k) for k in _trum.parameter_keys()]
+
+
+STATUS_NAMES: Tuple[str, ...] = tuple(_trum.STATUS_NAMES)
+QUANTITY_NAMES: Tuple[str, ...] = tuple(q[0] for q in _trum.quantities_list())

@@ -1,0 +1,80 @@
+# Type stubs of the private native module trum._trum (crates/trum-py/src/lib.rs).
+# The public API is in trum/__init__.py; these are its building blocks.
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+STATUS_NAMES: List[str]
+INPUTS: List[str]
+AXES: List[str]
+PARALLEL_MIN_POINTS: int
+
+_Axis = Tuple[float, float, int]
+
+class Motor:
+    def __init__(self, preset: str) -> None: ...
+    @staticmethod
+    def from_toml_str(text: str, source: str = "<string>") -> Motor: ...
+    @staticmethod
+    def from_parts(
+        preset: Optional[str],
+        name: Optional[str],
+        params: Sequence[Tuple[str, float]],
+        effects: Sequence[str],
+        source: str = "dict",
+    ) -> Motor: ...
+    def with_params(self, params: Sequence[Tuple[str, float]], source: str = "with_params") -> Motor: ...
+    def with_effects(self, specs: Sequence[str], source: str = "with_effects") -> Motor: ...
+    def get(self, key: str) -> float: ...
+    def params(self) -> List[Tuple[str, float]]: ...
+    def overrides(self) -> List[Tuple[str, float, float]]: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def preset(self) -> Optional[str]: ...
+    @property
+    def active_effects(self) -> List[Tuple[str, List[Tuple[str, float]]]]: ...
+    @property
+    def effects(self) -> str: ...
+    def to_toml(self) -> str: ...
+    def __eq__(self, other: object) -> bool: ...
+    def __reduce__(self) -> Tuple[Any, Tuple[str]]: ...
+
+def _motor_from_toml(text: str) -> Motor: ...
+def solve_arrays(
+    motor: Motor,
+    preload_n: npt.NDArray[np.float64],
+    torque_nm: npt.NDArray[np.float64],
+    voltage_v: npt.NDArray[np.float64],
+    frequency_hz: npt.NDArray[np.float64],
+    elapsed_s: npt.NDArray[np.float64],
+    parallel: Optional[bool] = None,
+) -> Dict[str, Any]: ...
+def map_grid(
+    motor: Motor,
+    preload_n: _Axis,
+    voltage_v: _Axis,
+    frequency_hz: _Axis,
+    torque_nm: _Axis,
+    max_points: int = 20_000_000,
+    parallel: Optional[bool] = None,
+) -> Dict[str, Any]: ...
+def criterion(
+    motor: Motor,
+    voltage_v: Optional[float] = None,
+    frequency_hz: Optional[float] = None,
+    preload_n: Optional[_Axis] = None,
+    weights: Optional[Sequence[float]] = None,
+    run_time_s: Optional[float] = None,
+    run_torque_nm: Optional[float] = None,
+    runout_m: Optional[float] = None,
+    region_tolerance: Optional[float] = None,
+    torque_samples: Optional[int] = None,
+) -> Dict[str, Any]: ...
+def presets_list() -> List[Tuple[str, str, str]]: ...
+def preset_toml(name: str) -> str: ...
+def effects_list() -> List[Tuple[str, str, str, List[Tuple[str, str, float, float, float]]]]: ...
+def quantities_list() -> List[Tuple[str, str, str]]: ...
+def parameter_keys() -> List[Tuple[str, str]]: ...

@@ -1,0 +1,154 @@
+"""Motor construction, errors, pickling, registries, map and optimize."""
+import pickle
+
+import numpy as np
+import pytest
+
+import trum
+
+
+def test_constructors_agree(motor, tmp_path):
+    assert trum.Motor.preset("trum60a") == motor
+    assert trum.Motor.from_toml_str('preset = "trum60a"\n') == motor
+    f = tmp_path / "m.toml"
+    f.write_text(motor.to_toml())
+    assert trum.Motor.from_toml(f) == motor
+    assert trum.Motor.from_toml(str(f)) == motor
+    assert trum.Motor.from_dict(motor.to_dict()) == motor
+
+
+def test_from_dict_forms(motor):
+    flat = trum.Motor.from_dict({"preset": "trum60a", "stator.modal_damping_ns_per_m": 12})
+    nested = trum.Motor.from_dict({"preset": "trum60a", "stator": {"modal_damping_ns_per_m": 12.0}})
+    assert flat == nested
+    assert flat["stator.modal_damping_ns_per_m"] == 12.0
+    assert flat == motor.with_params({"stator.modal_damping_ns_per_m": 12})
+    assert flat == motor.with_params(stator__modal_damping_ns_per_m=12)
+    assert flat.overrides() == {"stator.modal_damping_ns_per_m": 12.0}
+    fx = trum.Motor.from_dict({"preset": "trum60a", "effects": {"radial_friction": 0.5}})
+    assert fx == motor.with_effects("radial_friction=0.5") == motor.with_effects(radial_friction=0.5)
+    assert fx.active_effects == {"radial_friction": {"radial_velocity_ratio": 0.5}}
+    hs = {"beta_n_per_m3": 1e19, "preload_gain_per_n": 0.001}
+    a = trum.Motor.from_dict({"preset": "trum60a", "effects": {"hertz_softening": hs}})
+    b = motor.with_effects("hertz_softening:beta_n_per_m3=1e19,preload_gain_per_n=0.001")
+    assert a == b and a.active_effects["hertz_softening"] == hs
+    # Without a preset every key is required.
+    full = {k: motor[k] for k in motor.keys()}
+    m2 = trum.Motor.from_dict(full)
+    assert m2.preset_name is None and [m2[k] for k in m2.keys()] == [motor[k] for k in motor.keys()]
+    del full["rotor.mass_kg"]
+    with pytest.raises(trum.ParameterError, match=r"^dict, key 'rotor.mass_kg': missing key"):
+        trum.Motor.from_dict(full)
+
+
+def test_repr_shows_preset_effects_overrides(motor):
+    assert repr(motor) == "Motor(preset='trum60a', effects='none')"
+    m = motor.with_effects("radial_friction=0.5").with_params({"stator.modal_damping_ns_per_m": 12})
+    r = repr(m)
+    assert "preset='trum60a'" in r and "radial_friction(radial_velocity_ratio=0.5)" in r
+    assert "'stator.modal_damping_ns_per_m': 12.0" in r
+
+
+def test_pickle_round_trip(motor):
+    m = motor.with_effects("hertz_softening=3e19", "radial_friction=0.25").with_params(
+        {"friction_layer.friction_coefficient": 0.2123456789012345}
+    )
+    m2 = pickle.loads(pickle.dumps(m))
+    assert m2 == m and m2.to_toml() == m.to_toml() and repr(m2) == repr(m)
+    res = m.solve(preload_n=[150.0, 300.0], torque_nm=0.1, voltage_v=200, frequency_hz=43e3)
+    res2 = pickle.loads(pickle.dumps(res))
+    np.testing.assert_array_equal(res2.speed_rpm, res.speed_rpm)
+    assert res2.status.tolist() == res.status.tolist()
+
+
+def test_unknown_preset_lists_valid_names():
+    with pytest.raises(trum.ParameterError) as e:
+        trum.Motor("nope")
+    names = ", ".join(p.name for p in trum.presets())
+    assert str(e.value) == f"presets, key 'preset': unknown preset 'nope'; valid presets are: {names}"
+    assert e.value.key == "preset" and isinstance(e.value, ValueError) and isinstance(e.value, trum.TrumError)
+
+
+def test_unknown_key_names_the_key(motor):
+    with pytest.raises(trum.ParameterError) as e:
+        trum.Motor.from_dict({"preset": "trum60a", "stator.modal_mas_kg": 1.0})
+    msg = str(e.value)
+    assert msg.startswith("dict, key 'stator.modal_mas_kg': unknown parameter; valid keys are: geometry.wave_number")
+    assert e.value.key == "stator.modal_mas_kg"
+    with pytest.raises(KeyError, match="unknown parameter"):
+        motor["stator.nope"]
+    assert "stator.modal_mass_kg" in motor and "stator.nope" not in motor
+
+
+def test_invalid_values_use_core_messages(motor):
+    with pytest.raises(trum.ParameterError, match=r"^dict, key 'stator.modal_mass_kg': -1 must be > 0$"):
+        trum.Motor.from_dict({"preset": "trum60a", "stator.modal_mass_kg": -1})
+    with pytest.raises(trum.ParameterError, match="expected a number, got str"):
+        trum.Motor.from_dict({"preset": "trum60a", "stator.modal_mass_kg": "heavy"})
+    with pytest.raises(trum.ParameterError, match=r"^with_effects, key 'effects.radial': unknown effect 'radial'"):
+        motor.with_effects("radial=0.5")
+    with pytest.raises(trum.ParameterError, match="outside the valid range"):
+        motor.with_effects("eccentricity=-1")
+    toml = 'preset = "trum60a"\n[stator]\nmodal_mass_kg = -2\n'
+    with pytest.raises(trum.ParameterError, match=r"^m.toml: line 3, key 'stator.modal_mass_kg': -2 must be > 0$") as e:
+        trum.Motor.from_toml_str(toml, "m.toml")
+    assert e.value.line == 3 and e.value.reason == "-2 must be > 0"
+
+
+def test_registries():
+    names = [p.name for p in trum.presets()]
+    assert "trum60a" in names and all(trum.Motor(n).preset_name == n for n in names)
+    assert "preset 'trum60a'" in trum.preset_toml("trum60a")
+    fx = {e.name: e for e in trum.effects()}
+    assert fx["radial_friction"].params[0].name == "radial_velocity_ratio"
+    q = trum.quantities()
+    assert [x.name for x in q] == list(trum.QUANTITY_NAMES) and q[0].name == "speed_rpm" and q[0].unit == "rpm"
+    assert [p.key for p in trum.parameters()] == trum.Motor("trum60a").keys()
+    # Every quantity has a typed attribute on Result.
+    assert set(trum.QUANTITY_NAMES) <= set(trum.Result.__annotations__)
+
+
+def test_map_columns_and_values(motor):
+    d = trum.map(motor, preload_n=(150, 300, 4), voltage_v=200, frequency_hz=43e3, torque_nm=(0.0, 0.3, 7))
+    assert list(d)[:5] == ["preload_n", "voltage_v", "frequency_hz", "torque_nm", "status"]
+    assert list(d)[5:] == list(trum.QUANTITY_NAMES)
+    assert all(len(v) == 28 for v in d.values())
+    assert d["torque_nm"][:7].tolist() == pytest.approx(np.linspace(0, 0.3, 7).tolist())
+    res = motor.solve(preload_n=d["preload_n"], torque_nm=d["torque_nm"], voltage_v=200, frequency_hz=43e3)
+    assert d["status"].tolist() == res.status.tolist()
+    # warm starts along torque rows: equal to the cold solve within the solver tolerance
+    np.testing.assert_allclose(d["speed_rpm"], res.speed_rpm, rtol=1e-8, atol=1e-9)
+    par = trum.map(motor, preload_n=(150, 300, 4), voltage_v=200, frequency_hz=43e3, torque_nm=(0.0, 0.3, 7), parallel=True)
+    for k in trum.QUANTITY_NAMES:
+        np.testing.assert_array_equal(par[k], d[k])
+    pd = pytest.importorskip("pandas")
+    assert pd.DataFrame(d).shape == (28, 5 + len(trum.QUANTITY_NAMES))
+
+
+def test_map_errors(motor):
+    with pytest.raises(trum.InputError, match=r"^preload_n: 0 must be > 0$"):
+        trum.map(motor, preload_n=(0, 100, 3), voltage_v=200, frequency_hz=43e3)
+    with pytest.raises(trum.InputError, match="must be a positive whole number"):
+        trum.map(motor, preload_n=(100, 200, 2.5), voltage_v=200, frequency_hz=43e3)
+    with pytest.raises(trum.InputError, match="at least one point"):
+        trum.map(motor, preload_n=(100, 200, 0), voltage_v=200, frequency_hz=43e3)
+    with pytest.raises(trum.InputError, match="max_points"):
+        trum.map(motor, preload_n=(100, 200, 10**5), voltage_v=200, frequency_hz=43e3, torque_nm=(0, 1, 10**4))
+    with pytest.raises(trum.InputError, match="expected a value or"):
+        trum.map(motor, preload_n=(100, 200), voltage_v=200, frequency_hz=43e3)
+
+
+def test_optimize(motor):
+    o = trum.optimize(motor, preload_n=(150, 500, 8), torque_samples=8)
+    t = o.table
+    assert len(t["preload_n"]) == 8 and o.optimum_preload_n in t["preload_n"]
+    assert o.region_n[0] <= o.optimum_preload_n <= o.region_n[1]
+    assert o.config["weights"] == {"stall_torque": 1.0, "efficiency": 1.0, "temperature_rise": 2.0, "speed_fluctuation": 2.0}
+    o2 = trum.optimize(motor, preload_n=(150, 500, 8), torque_samples=8, weights={"stall_torque": 5})
+    assert o2.config["weights"]["stall_torque"] == 5.0
+    with pytest.raises(trum.InputError, match="weights must be finite"):
+        trum.optimize(motor, weights=[0, 0, 0, 0])
+    with pytest.raises(trum.InputError, match="unknown weight"):
+        trum.optimize(motor, weights={"speed": 1})
+    pytest.importorskip("pandas")
+    assert o.to_pandas().shape[0] == 8
