@@ -8,7 +8,7 @@
 use crate::effects::Effect;
 use crate::error::TrumError;
 use crate::params::Motor;
-use crate::solve::{solve_prepared, OperatingPoint, Prepared, Solution, Status};
+use crate::solve::{solve_prepared, OperatingPoint, Prepared, Solution};
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
 
@@ -199,14 +199,19 @@ fn fit_rel(motor: &Motor, key: &str, lo: f64, hi: f64) -> FitParam {
     FitParam { param: ParamRef::Motor(key.into()), lo: nominal * lo, hi: nominal * hi, log: true }
 }
 
-/// The fit parameters of an effect (all its strength parameters, over their valid range).
+/// The fit parameters of an effect: all its strength parameters, bounded to eight times
+/// their typical magnitude inside the valid range (beyond that an effect would dominate
+/// the motor's behaviour rather than perturb it, and the solves get needlessly hard).
 pub fn effect_params(effect: Effect) -> Vec<FitParam> {
     effect
         .info()
         .params
         .iter()
         .enumerate()
-        .map(|(i, p)| FitParam { param: ParamRef::Effect(effect, i), lo: p.min, hi: p.max, log: false })
+        .map(|(i, p)| {
+            let span = 8.0 * p.typical.abs();
+            FitParam { param: ParamRef::Effect(effect, i), lo: p.min.max(-span), hi: p.max.min(span), log: false }
+        })
         .collect()
 }
 
@@ -264,9 +269,10 @@ pub struct Calibration {
 pub fn residuals(motor: &Motor, rows: &[ObservedRow]) -> Vec<f64> {
     let p = Prepared::new(motor);
     let mut out = Vec::new();
-    let mut prev: Option<Solution> = None;
     for r in rows {
-        let s = solve_prepared(&p, motor, &r.op, prev.as_ref().filter(|g| g.status == Status::Ok));
+        // Cold starts: a warm start from a neighbouring row could settle on another
+        // fixed point where the amplitude map has several, and the fit must see one model.
+        let s = solve_prepared(&p, motor, &r.op, None);
         for &(o, v, sigma) in &r.readings {
             if s.status.is_valid() {
                 out.push((o.predict(&s, r.ambient_c) - v) / sigma);
@@ -274,7 +280,6 @@ pub fn residuals(motor: &Motor, rows: &[ObservedRow]) -> Vec<f64> {
                 out.push(50.0);
             }
         }
-        prev = Some(s);
     }
     out
 }
@@ -388,12 +393,16 @@ pub fn calibrate(
     if r.iter().any(|x| *x == 50.0) {
         warnings.push("the model has no solution at some measured points (counted as 50-sigma misses)".into());
     }
-    // Uncertainties: cov(p) = s²·(JᵀJ)⁻¹ with J in p-coordinates.
+    // Uncertainties: cov(p) = s²·(JᵀJ)⁻¹ with J in p-coordinates, computed on relative
+    // parameters p/scale so that parameters of very different magnitude (E_f ~ 1e8 Pa,
+    // C0 ~ 1e-9 F) do not make the matrix numerically singular.
     let j = problem.jacobian().unwrap_or_else(|| DMatrix::zeros(n_read, params.len()));
     let mut jp = j.clone();
+    let mut scale = vec![1.0; params.len()];
     for (k, fp) in params.iter().enumerate() {
         let d = fp.dp_du(problem.u[k]);
-        let col = jp.column(k) / d;
+        scale[k] = fp.param.get(&fitted).abs().max(1e-3 * (fp.hi - fp.lo));
+        let col = jp.column(k) * (scale[k] / d);
         jp.set_column(k, &col);
     }
     let dof = (n_read - params.len()).max(1) as f64;
@@ -401,13 +410,11 @@ pub fn calibrate(
     let jtj = jp.transpose() * &jp;
     let svd = jtj.clone().svd(true, true);
     let smax = svd.singular_values.max();
-    let cov = svd
-        .pseudo_inverse(smax * 1e-12)
-        .unwrap_or_else(|_| DMatrix::from_element(params.len(), params.len(), f64::NAN));
+    let cov = svd.pseudo_inverse(smax * 1e-14).unwrap_or_else(|_| DMatrix::from_element(params.len(), params.len(), f64::NAN));
     let mut out = Vec::new();
     for (k, fp) in params.iter().enumerate() {
         let value = fp.param.get(&fitted);
-        let var = cov[(k, k)] * s2;
+        let var = cov[(k, k)] * s2 * scale[k] * scale[k];
         let se = if var.is_finite() && var >= 0.0 { var.sqrt() } else { f64::NAN };
         let span = if fp.log {
             (value / fp.lo).ln().min((fp.hi / value).ln()) / (fp.hi / fp.lo).ln()

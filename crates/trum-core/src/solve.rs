@@ -401,7 +401,7 @@ fn general_interface(
     // Illinois regula falsi: superlinear, and never leaves the bracket.
     let mut u = hi;
     let mut side = 0i8;
-    for _ in 0..100 {
+    for _ in 0..60 {
         u = lo - flo * (hi - lo) / (fhi - flo);
         if !(u > lo && u < hi) {
             u = 0.5 * (lo + hi);
@@ -421,7 +421,7 @@ fn general_interface(
             }
             side = -1;
         }
-        if hi - lo < 1e-11 || fu.abs() <= 1e-13 * tscale {
+        if hi - lo < 1e-14 || fu.abs() <= 1e-14 * tscale {
             break;
         }
     }
@@ -661,7 +661,9 @@ fn add_solution(a: &Solution, b: &Solution) -> Solution {
 }
 
 fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
-    const RTOL: f64 = 1e-12;
+    // The generalised interface integrates numerically (and solves its stick point to
+    // 1e-13), so its amplitude map carries ~1e-12 of noise: converge to 1e-10 there.
+    let rtol = if p.law.radial_ratio == 0.0 && p.compliance == 0.0 { 1e-12 } else { 1e-10 };
     // Upper bound: |Z| ≥ ω·c, so W' ≤ Θ·V/(ω·c). Softening could in principle exceed it;
     // the bracket is then grown below.
     let w_hi0 = p.theta * d.v / (d.omega * p.c);
@@ -688,9 +690,9 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
     let mut converged = false;
     let mut side_lo = 0; // Illinois bookkeeping
     let mut side_hi = 0;
-    for _ in 0..200 {
+    for _ in 0..80 {
         let r = cur.w - cur.w_next;
-        if r.abs() <= RTOL * cur.w.max(1e-300) {
+        if r.abs() <= rtol * cur.w.max(1e-300) {
             converged = true;
             break;
         }
