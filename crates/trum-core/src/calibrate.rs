@@ -408,9 +408,20 @@ pub fn calibrate(
     let dof = (n_read - params.len()).max(1) as f64;
     let s2 = (chi2 / dof).max(1e-300);
     let jtj = jp.transpose() * &jp;
-    let svd = jtj.clone().svd(true, true);
-    let smax = svd.singular_values.max();
-    let cov = svd.pseudo_inverse(smax * 1e-14).unwrap_or_else(|_| DMatrix::from_element(params.len(), params.len(), f64::NAN));
+    // nalgebra's plain `svd` iterates without bound on non-finite input; `try_svd` with an
+    // iteration cap returns None instead.
+    let nan = || DMatrix::from_element(params.len(), params.len(), f64::NAN);
+    let cov = if jtj.iter().all(|x| x.is_finite()) {
+        match jtj.clone().try_svd(true, true, 1e-15, 500) {
+            Some(svd) => {
+                let smax = svd.singular_values.max();
+                svd.pseudo_inverse(smax * 1e-14).unwrap_or_else(|_| nan())
+            }
+            None => nan(),
+        }
+    } else {
+        nan()
+    };
     let mut out = Vec::new();
     for (k, fp) in params.iter().enumerate() {
         let value = fp.param.get(&fitted);

@@ -227,10 +227,19 @@ fn cross_validate(
             continue;
         }
         let (s0, params) = fit_params(motor, start, &train, effects, reduced);
-        let fitted = match calibrate(&s0, &train, &params, &opts.fit) {
-            Ok(c) => c.motor,
-            Err(_) => s0,
-        };
+        let mut fitted = calibrate(&s0, &train, &params, &opts.fit).ok();
+        if !effects.is_empty() {
+            // Nested models: the effect at zero strength is the baseline, so a fit that ends
+            // worse than the baseline's is a local minimum; use the baseline fit instead.
+            let (b0, bp) = fit_params(motor, start, &train, &[], reduced);
+            let base = calibrate(&b0, &train, &bp, &opts.fit).ok();
+            if let Some(b) = base {
+                if fitted.as_ref().is_none_or(|f| f.chi2 > b.chi2) {
+                    fitted = Some(b);
+                }
+            }
+        }
+        let fitted = fitted.map(|c| c.motor).unwrap_or(s0);
         let test: Vec<&ObservedRow> = test_idx.iter().map(|&i| &rows[i]).collect();
         for (i, p) in test_idx.iter().zip(predict(&fitted, &test)) {
             preds[*i] = p;
@@ -333,7 +342,8 @@ pub fn diagnose(motor: &Motor, rows: &[ObservedRow], groups: &[String], opts: &D
         let (after, _, e2) = errors(rows, &cv.preds, &sc);
         let (s0, params) = fit_params(motor, &start, rows, effects, reduced);
         let (evidence, fitted) = match calibrate(&s0, rows, &params, &opts.fit) {
-            Ok(c) => (0.5 * (base_bic - bic(c.chi2, params.len())), c.params),
+            // nested: never worse than the baseline's χ² (the effect at zero strength)
+            Ok(c) => (0.5 * (base_bic - bic(c.chi2.min(base_cal.chi2), params.len())), c.params),
             Err(_) => (f64::NEG_INFINITY, Vec::new()),
         };
         let shrink = 1.0 - after / base_nrmse.max(1e-300);
