@@ -23,10 +23,13 @@ fn main() {
         frequency_hz: arg(3, 43e3),
         phase_difference_rad: arg(4, 90.0).to_radians(),
         tangential_stiffness_ratio: arg(5, TransientConfig::default().tangential_stiffness_ratio),
-        snapshot_times_s: vec![0.02e-3, 0.1e-3, 3e-3, 9.9e-3],
+        snapshot_times_s: vec![0.02e-3, 0.1e-3, 3e-3],
         ..TransientConfig::default()
     };
     cfg.load_torque_nm = arg(6, 0.0);
+    cfg.steps_per_period = arg(7, 64.0) as usize;
+    cfg.duration_s = arg(8, 10e-3);
+    cfg.nodes_per_wavelength = arg(9, 256.0) as usize;
     let t0 = Instant::now();
     let r = match step_response(&motor, &cfg) {
         Ok(r) => r,
@@ -71,7 +74,11 @@ fn main() {
     );
     for sn in &r.snapshots {
         let (nc, st, sl) = sn.counts();
-        println!("snapshot t = {:.3} ms: {:.2} rpm, no contact {nc}, stick {st}, slip {sl}", sn.time_s * 1e3, sn.speed_rpm);
+        println!(
+            "snapshot t = {:.3} ms: {:.2} rpm, no contact {nc}, stick {st}, slip {sl}",
+            sn.time_s * 1e3,
+            sn.speed_rpm
+        );
     }
     let n = r.series.time_s.len();
     for i in (0..n).step_by((n / 40).max(1)) {

@@ -20,9 +20,7 @@
 //! * Stability: ω_max·h < 1.5 for the stiffest contact mode (all nodes sticking, the
 //!   tangential springs between stator modes and rotor), checked before the run.
 
-use super::{
-    NodeSample, NodeState, Snapshot, SteadyAverages, TimeSeries, TransientConfig, TransientError,
-};
+use super::{NodeSample, NodeState, Snapshot, SteadyAverages, TimeSeries, TransientConfig, TransientError};
 use crate::contact::layer_stiffness_n_per_m2;
 use crate::params::Motor;
 use crate::solve::RAD_S_TO_RPM;
@@ -49,7 +47,6 @@ struct Model {
     kf_node: f64,
     kt_node: f64,
     mu: f64,
-    m: f64,
     k_num: f64,
     c_num: f64,
     theta: f64,
@@ -186,7 +183,6 @@ pub(super) fn run(motor: &Motor, cfg: &TransientConfig) -> Result<RunOutput, Tra
         kf_node: kf * dx,
         kt_node: cfg.tangential_stiffness_ratio * kf * dx,
         mu: motor.friction_layer.friction_coefficient,
-        m,
         k_num: ks - m * omega * omega + m * omega_hat * omega_hat,
         c_num: st.modal_damping_ns_per_m * wh / wh.sin(),
         theta: st.force_factor_n_per_v,
@@ -306,14 +302,9 @@ pub(super) fn run(motor: &Motor, cfg: &TransientConfig) -> Result<RunOutput, Tra
         if i > avg_start {
             let amp = s.qa.hypot(s.qb);
             let nn = n_nodes as f64;
-            for (sum, v) in acc.iter_mut().zip([
-                s.om,
-                f.torque,
-                amp,
-                f.fz,
-                f.n_contact as f64 / nn,
-                f.n_stick as f64 / nn,
-            ]) {
+            for (sum, v) in
+                acc.iter_mut().zip([s.om, f.torque, amp, f.fz, f.n_contact as f64 / nn, f.n_stick as f64 / nn])
+            {
                 *sum += v;
             }
         }
