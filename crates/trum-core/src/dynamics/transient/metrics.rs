@@ -31,7 +31,7 @@ pub fn step_metrics(time_s: &[f64], speed_rpm: &[f64], final_speed_rpm: f64) -> 
         overshoot: None,
         settling_time_s: None,
     };
-    if n < 2 || !(final_speed_rpm > 0.0) || !final_speed_rpm.is_finite() {
+    if n < 2 || final_speed_rpm.is_nan() || final_speed_rpm <= 0.0 || final_speed_rpm.is_infinite() {
         return m;
     }
     let f = final_speed_rpm;

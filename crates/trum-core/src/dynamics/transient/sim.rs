@@ -210,7 +210,7 @@ pub(super) fn run(motor: &Motor, cfg: &TransientConfig) -> Result<RunOutput, Tra
         (((model.k_num + model.coupling * 0.5 * kf * ring) / m).sqrt() * h, "stator modes"),
     ];
     for (omega_h, what) in checks {
-        if !(omega_h < STABILITY_LIMIT) {
+        if omega_h.is_nan() || omega_h >= STABILITY_LIMIT {
             return Err(TransientError::StepTooLarge { omega_h, limit: STABILITY_LIMIT, what });
         }
     }
