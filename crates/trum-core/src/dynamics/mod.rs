@@ -11,3 +11,4 @@
 //! `docs/DYNAMICS.md`, section "Hertzian oscillator".
 
 pub mod hertz;
+pub mod transient;

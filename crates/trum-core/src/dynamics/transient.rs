@@ -1,0 +1,337 @@
+//! Transient (step) response of a TRUM with a discretised stick-slip contact (seed 004).
+//!
+//! Degrees of freedom (seed 000 Appendix A, eq. A1-A4 with ε = 0; seed 004 eq. 3-5):
+//!
+//! ```text
+//! stator modes  m·q̈_A + c·q̇_A + k_s·q_A = Θ·V·cos ωt        + Q_A
+//!               m·q̈_B + c·q̇_B + k_s·q_B = Θ·V·cos(ωt − Δφ) + Q_B
+//! rotor, axial  m_r·z̈ + d_z·ż + k_sp·(z − z₀) = F_c − F_N      (seed 004 eq. 5)
+//! rotor, turn   J_r·Ω̇ + d_r·Ω = T_c − T_load                   (seed 004 eq. 4)
+//! ```
+//!
+//! The surface displacement is w(x, t) = q_A·cos kx + q_B·sin kx (k = N/R0); Δφ = +90°
+//! gives a wave travelling towards +x. One wavelength is cut into `nodes_per_wavelength`
+//! nodes (256 in seed 004); all N waves are identical, so every sum is multiplied by N.
+//! Node j carries a Winkler spring (seed 000 eq. 3, seed 001 eq. 5)
+//! p_j = k_f·Δx·max(0, w(x_j) − z) with k_f = E_f·b_f/h_f, and a tangential spring of
+//! stiffness k_t·Δx (the rotor-side springs of seed 004, Fig. 7) whose deflection δ_j
+//! follows the relative surface displacement u_s − u_r. The stator surface moves
+//! tangentially by u_s = h0·∂w/∂x, i.e. with speed h0·∂²w/∂x∂t, counted positive in the
+//! rotor's positive sense (the surface at a crest moves against the wave, so the
+//! rotor turns opposite to the wave; for Δφ = +90° its speed is positive).
+//!
+//! **Coulomb stick-slip per node (seed 004 eq. 1-2), by return mapping.** Each step the
+//! trial force f* = k_t·Δx·(δ_j + Δu_s − Δu_r) is the tangential force that keeps the node
+//! from slipping over the step. If |f*| ≤ μ·p_j the node sticks (f = f*, eq. 2 not
+//! satisfied); otherwise it slips with f = μ·p_j·sign(f*) (eq. 1; the sign of f* is the
+//! sign of the slip v_s − v_r once the node slips) and δ_j is reset to f/(k_t·Δx). This
+//! is Coulomb's law exactly, for a friction layer with tangential compliance 1/k_t; no
+//! velocity threshold or smoothing is involved. As k_t → ∞ the stick zones shrink to
+//! the two stick points of the rigid steady model ([`crate::contact`]) and the result
+//! converges to [`crate::solve`]; seed 004's wide stick zones appear for a soft layer
+//! (k_t ≈ G·b_f/h_f ≈ k_f/2.6). See [`TransientConfig::tangential_stiffness_ratio`].
+//!
+//! Generalised contact forces (virtual work, mode shapes cos kx and sin kx at the
+//! surface, so the same modal mass as [`crate::stator`]):
+//! Q_A = N·Σ f_j·h0·k·sin kx_j, Q_B = −N·Σ f_j·h0·k·cos kx_j, torque T_c = N·R0·Σ f_j,
+//! axial force F_c = N·Σ p_j. The normal forces' modal projection −N·Σ p_j·(cos, sin) is
+//! left out by default, as in the steady model (it is a contact stiffening, the
+//! `preload_stiffening` effect); [`TransientConfig::normal_modal_coupling`] adds it.
+//!
+//! Integrator: see [`sim`](self) (kick-drift-kick Verlet with implicit linear damping and
+//! exact kinematic slip increments). Effects in `Motor::effects` are not modelled here.
+
+use crate::params::Motor;
+use thiserror::Error;
+
+mod metrics;
+mod sim;
+#[cfg(test)]
+mod tests;
+
+pub use metrics::step_metrics;
+
+/// Default axial damping of the rotor d_z [N·s/m] (seed 000 Table A1).
+pub const DEFAULT_AXIAL_DAMPING_NS_PER_M: f64 = 1.5e4;
+
+/// Default tangential penalty stiffness of a node, as a multiple of the Winkler stiffness k_f.
+pub const DEFAULT_TANGENTIAL_STIFFNESS_RATIO: f64 = 300.0;
+
+/// Settings of one step-response run. All fields SI. The drive (both phases, amplitude
+/// `voltage_v`) is switched on at t = 0 with the stator at rest and the rotor at rest on
+/// its preloaded equilibrium.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TransientConfig {
+    /// Simulated time [s], > 0.
+    pub duration_s: f64,
+    /// Time steps per drive period (≥ 16; 64-128 recommended).
+    pub steps_per_period: usize,
+    /// Contact nodes over one wavelength (≥ 8; 256 in seed 004).
+    pub nodes_per_wavelength: usize,
+    /// Phase of phase B behind phase A [rad]; π/2 = travelling wave, 0 = standing wave.
+    pub phase_difference_rad: f64,
+    /// Load torque on the rotor [N·m], ≥ 0.
+    pub load_torque_nm: f64,
+    /// Drive voltage amplitude per phase, zero-to-peak [V], > 0.
+    pub voltage_v: f64,
+    /// Drive frequency [Hz], > 0.
+    pub frequency_hz: f64,
+    /// Axial preload F_N [N], > 0.
+    pub preload_n: f64,
+    /// Record the time series every this many steps (≥ 1).
+    pub record_every: usize,
+    /// Times [s] at which to return the contact state per node (each in [0, duration]).
+    pub snapshot_times_s: Vec<f64>,
+    /// Axial damping of the rotor d_z [N·s/m], > 0 (default 1.5e4, seed 000 Table A1).
+    pub axial_damping_ns_per_m: f64,
+    /// Tangential stiffness of the contact layer per unit length as a multiple of
+    /// k_f = E_f·b_f/h_f, > 0. The default 300 is a penalty stiffness: the settled speed
+    /// then lies ≈ 100/√300 ≈ 6 % above the rigid-Coulomb steady model (error ∝ ratio^(-1/2)); ≈ 0.38 (G = E/2.6) is the
+    /// physical shear stiffness of a solid layer.
+    pub tangential_stiffness_ratio: f64,
+    /// Project the normal contact forces on the stator modes (contact stiffening,
+    /// seed 000 eq. A4 F_dn). Off by default, like the steady model.
+    pub normal_modal_coupling: bool,
+}
+
+impl Default for TransientConfig {
+    /// 10 ms at 200 V, 43 kHz, 260 N, no load, 90°, 64 steps/period, 256 nodes.
+    fn default() -> Self {
+        TransientConfig {
+            duration_s: 10e-3,
+            steps_per_period: 64,
+            nodes_per_wavelength: 256,
+            phase_difference_rad: 0.5 * std::f64::consts::PI,
+            load_torque_nm: 0.0,
+            voltage_v: 200.0,
+            frequency_hz: 43e3,
+            preload_n: 260.0,
+            record_every: 16,
+            snapshot_times_s: Vec::new(),
+            axial_damping_ns_per_m: DEFAULT_AXIAL_DAMPING_NS_PER_M,
+            tangential_stiffness_ratio: DEFAULT_TANGENTIAL_STIFFNESS_RATIO,
+            normal_modal_coupling: false,
+        }
+    }
+}
+
+/// Errors of [`step_response`].
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum TransientError {
+    /// A configuration value is out of range or not finite.
+    #[error("invalid `{name}` = {value}: {reason}")]
+    InvalidConfig {
+        /// Field name.
+        name: &'static str,
+        /// Offending value.
+        value: f64,
+        /// Why it is rejected.
+        reason: &'static str,
+    },
+    /// The motor parameters do not validate.
+    #[error("invalid motor: {0}")]
+    InvalidMotor(String),
+    /// The explicit scheme would be unstable: ω_max·h exceeds the limit.
+    #[error("time step too large: ω_max·h = {omega_h:.3} > {limit} (stiffest mode {what}); raise steps_per_period")]
+    StepTooLarge {
+        /// Estimated ω_max·h of the stiffest contact mode.
+        omega_h: f64,
+        /// Accepted limit.
+        limit: f64,
+        /// Which mode.
+        what: &'static str,
+    },
+    /// The run would take more steps than the limit.
+    #[error("too many steps: {steps} > {limit}")]
+    TooManySteps {
+        /// Requested steps.
+        steps: u64,
+        /// Limit.
+        limit: u64,
+    },
+    /// The state became non-finite.
+    #[error("the simulation diverged at t = {time_s} s")]
+    Diverged {
+        /// Time of the first non-finite state [s].
+        time_s: f64,
+    },
+}
+
+/// Recorded time series (every `record_every` steps, starting at t = 0).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TimeSeries {
+    /// Time [s].
+    pub time_s: Vec<f64>,
+    /// Instantaneous rotor speed [rev/min].
+    pub speed_rpm: Vec<f64>,
+    /// Rotor speed averaged over the last drive period [rev/min] (zero before t = 0).
+    pub speed_period_mean_rpm: Vec<f64>,
+    /// Wave amplitude √(q_A² + q_B²) [m].
+    pub amplitude_m: Vec<f64>,
+    /// Rotor axial position z relative to its rest position before the drive starts [m].
+    pub axial_position_m: Vec<f64>,
+    /// Contact (friction) torque on the rotor T_c [N·m].
+    pub torque_nm: Vec<f64>,
+    /// Axial contact force F_c [N].
+    pub axial_force_n: Vec<f64>,
+}
+
+/// Contact state of one node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum NodeState {
+    /// The stator surface is below the rotor: no force.
+    NoContact,
+    /// In contact and not slipping: |f| ≤ μ·p (seed 004 eq. 2 not satisfied).
+    Stick,
+    /// In contact and slipping: f = μ·p·sign(slip) (seed 004 eq. 1).
+    Slip,
+}
+
+/// One contact node at a snapshot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeSample {
+    /// Position along the wavelength x_j ∈ [0, λ) [m].
+    pub position_m: f64,
+    /// Contact pressure per unit circumferential length [N/m].
+    pub pressure_n_per_m: f64,
+    /// Tangential friction force on the rotor per unit length, positive driving [N/m].
+    pub tangential_force_n_per_m: f64,
+    /// Slip speed v_s − v_r of the stator surface over the rotor [m/s].
+    pub slip_speed_m_s: f64,
+    /// Stick, slip or no contact.
+    pub state: NodeState,
+}
+
+/// Distribution of the contact forces over one wavelength at one instant (seed 004 Fig. 10).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    /// Requested time [s].
+    pub requested_time_s: f64,
+    /// Time of the step the snapshot was taken at (the step nearest the request) [s].
+    pub time_s: f64,
+    /// Rotor speed at that instant [rev/min].
+    pub speed_rpm: f64,
+    /// The nodes, in order of position.
+    pub nodes: Vec<NodeSample>,
+}
+
+impl Snapshot {
+    /// Number of nodes in each state: (no contact, stick, slip).
+    pub fn counts(&self) -> (usize, usize, usize) {
+        let c = |s| self.nodes.iter().filter(|n| n.state == s).count();
+        (c(NodeState::NoContact), c(NodeState::Stick), c(NodeState::Slip))
+    }
+}
+
+/// Step-response figures of the period-averaged speed (control-textbook definitions).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepMetrics {
+    /// Final speed: mean over the averaging window at the end of the run [rev/min].
+    pub final_speed_rpm: f64,
+    /// Largest period-averaged speed [rev/min].
+    pub peak_speed_rpm: f64,
+    /// Delay time: first time the speed reaches 50 % of the final speed [s].
+    pub delay_s: Option<f64>,
+    /// Rise time from 10 % to 90 % of the final speed [s].
+    pub rise_time_s: Option<f64>,
+    /// Overshoot (peak − final)/final, ≥ 0 [-].
+    pub overshoot: Option<f64>,
+    /// Time after which the speed stays within ±2 % of the final speed [s]
+    /// (`None` if it is still outside the band at the end of the record).
+    pub settling_time_s: Option<f64>,
+}
+
+/// Means over the last whole drive periods of the run (at least 20 % of it), taken at
+/// every step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SteadyAverages {
+    /// Length of the averaging window [s].
+    pub window_s: f64,
+    /// Mean rotor speed [rev/min].
+    pub speed_rpm: f64,
+    /// Mean contact torque on the rotor [N·m].
+    pub contact_torque_nm: f64,
+    /// Mean wave amplitude √(q_A² + q_B²) [m].
+    pub amplitude_m: f64,
+    /// Mean axial contact force [N].
+    pub axial_force_n: f64,
+    /// Mean fraction of the wavelength in contact [-].
+    pub contact_fraction: f64,
+    /// Mean fraction of the wavelength sticking [-].
+    pub stick_fraction: f64,
+}
+
+/// Result of [`step_response`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepResponse {
+    /// Recorded time series.
+    pub series: TimeSeries,
+    /// Step-response metrics.
+    pub metrics: StepMetrics,
+    /// Means at the end of the run.
+    pub averages: SteadyAverages,
+    /// Snapshots, in the order of `snapshot_times_s`.
+    pub snapshots: Vec<Snapshot>,
+    /// Time step used [s].
+    pub time_step_s: f64,
+    /// Steps taken.
+    pub steps: u64,
+}
+
+/// Largest number of steps accepted.
+pub const MAX_STEPS: u64 = 50_000_000;
+
+fn check(name: &'static str, value: f64, ok: bool, reason: &'static str) -> Result<(), TransientError> {
+    if value.is_finite() && ok {
+        Ok(())
+    } else {
+        Err(TransientError::InvalidConfig { name, value, reason })
+    }
+}
+
+impl TransientConfig {
+    /// Checks every field; the error names the first offending one.
+    pub fn validate(&self) -> Result<(), TransientError> {
+        check("duration_s", self.duration_s, self.duration_s > 0.0, "must be finite and > 0")?;
+        let spp = self.steps_per_period as f64;
+        check("steps_per_period", spp, self.steps_per_period >= 16, "must be >= 16")?;
+        let npw = self.nodes_per_wavelength as f64;
+        check("nodes_per_wavelength", npw, self.nodes_per_wavelength >= 8, "must be >= 8")?;
+        check("phase_difference_rad", self.phase_difference_rad, true, "must be finite")?;
+        check("load_torque_nm", self.load_torque_nm, self.load_torque_nm >= 0.0, "must be finite and >= 0")?;
+        check("voltage_v", self.voltage_v, self.voltage_v > 0.0, "must be finite and > 0")?;
+        check("frequency_hz", self.frequency_hz, self.frequency_hz > 0.0, "must be finite and > 0")?;
+        check("preload_n", self.preload_n, self.preload_n > 0.0, "must be finite and > 0")?;
+        check("record_every", self.record_every as f64, self.record_every >= 1, "must be >= 1")?;
+        for &t in &self.snapshot_times_s {
+            check("snapshot_times_s", t, t >= 0.0 && t <= self.duration_s, "must lie in [0, duration_s]")?;
+        }
+        let dz = self.axial_damping_ns_per_m;
+        check("axial_damping_ns_per_m", dz, dz > 0.0, "must be finite and > 0")?;
+        let kt = self.tangential_stiffness_ratio;
+        check("tangential_stiffness_ratio", kt, kt > 0.0, "must be finite and > 0")?;
+        let steps = (self.duration_s * self.frequency_hz * spp).ceil();
+        if steps > MAX_STEPS as f64 {
+            return Err(TransientError::TooManySteps { steps: steps as u64, limit: MAX_STEPS });
+        }
+        Ok(())
+    }
+}
+
+/// Simulates the start-up of the motor after a voltage step and returns the time series,
+/// the step metrics, the end-of-run averages and the requested contact snapshots.
+/// Never panics: invalid settings, an unstable time step or divergence are errors.
+pub fn step_response(motor: &Motor, cfg: &TransientConfig) -> Result<StepResponse, TransientError> {
+    cfg.validate()?;
+    motor.validate("motor", None).map_err(|e| TransientError::InvalidMotor(e.to_string()))?;
+    let out = sim::run(motor, cfg)?;
+    let metrics = step_metrics(&out.series.time_s, &out.series.speed_period_mean_rpm, out.averages.speed_rpm);
+    Ok(StepResponse {
+        series: out.series,
+        metrics,
+        averages: out.averages,
+        snapshots: out.snapshots,
+        time_step_s: out.time_step_s,
+        steps: out.steps,
+    })
+}

@@ -1,0 +1,206 @@
+use super::*;
+use crate::presets::preset;
+use crate::solve::{solve, OperatingPoint, Status};
+
+fn motor() -> Motor {
+    preset("trum60a").expect("preset")
+}
+
+/// Short, coarse run used by most tests (64 nodes, 3-4 ms).
+fn cfg(ratio: f64, spp: usize) -> TransientConfig {
+    TransientConfig {
+        duration_s: 4e-3,
+        steps_per_period: spp,
+        nodes_per_wavelength: 64,
+        tangential_stiffness_ratio: ratio,
+        record_every: 8,
+        ..TransientConfig::default()
+    }
+}
+
+fn run(c: &TransientConfig) -> StepResponse {
+    step_response(&motor(), c).expect("run")
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+/// The transient model converges to the rigid-Coulomb steady model as the layer's
+/// tangential stiffness k_t → ∞, with error ∝ k_t^(-1/2) (stick bands of width
+/// ∝ √(μ·k_f/k_t) at the two stick points). Checked with and without load.
+#[test]
+fn settles_on_the_steady_solution_as_the_layer_stiffens() {
+    for load in [0.0, 0.3] {
+        let op = OperatingPoint::new(260.0, load, 200.0, 43e3);
+        let s = solve(&motor(), &op);
+        assert_eq!(s.status, Status::Ok);
+        let soft = run(&TransientConfig { load_torque_nm: load, ..cfg(300.0, 128) }).averages;
+        let stiff = run(&TransientConfig { load_torque_nm: load, ..cfg(1200.0, 256) }).averages;
+        let (e_soft, e_stiff) = (rel(soft.speed_rpm, s.speed_rpm), rel(stiff.speed_rpm, s.speed_rpm));
+        // direct agreement of the stiff layer: 5 % on speed and amplitude
+        assert!(e_stiff < 0.05, "load {load}: speed {} vs steady {}", stiff.speed_rpm, s.speed_rpm);
+        assert!(rel(stiff.amplitude_m, s.amplitude_m) < 0.05, "{} vs {}", stiff.amplitude_m, s.amplitude_m);
+        // the error halves when k_t is quadrupled (k_t^(-1/2)) ...
+        let ratio = e_soft / e_stiff;
+        assert!((1.5..2.6).contains(&ratio), "load {load}: error ratio {ratio}");
+        // ... so the extrapolated rigid limit 2·v(4k) − v(k) matches the steady model to 1.5 %
+        let limit = 2.0 * stiff.speed_rpm - soft.speed_rpm;
+        assert!(rel(limit, s.speed_rpm) < 0.015, "load {load}: limit {limit} vs {}", s.speed_rpm);
+        // the contact's mean torque balances load + rotor viscous torque of the steady speed
+        let steady_torque = load + motor().rotor.viscous_damping_nms * s.speed_rad_s;
+        assert!(rel(stiff.contact_torque_nm, steady_torque) < 0.05, "{} vs {steady_torque}", stiff.contact_torque_nm);
+        // axial equilibrium: mean contact force = preload (+ k_sp·Δz, < 0.1 %)
+        assert!(rel(stiff.axial_force_n, 260.0) < 2e-3, "{}", stiff.axial_force_n);
+    }
+}
+
+/// Time-step and node-count study at the default stiffness ratio: halving h or doubling
+/// the node count moves the settled speed by < 0.5 %.
+#[test]
+fn converges_in_time_step_and_node_count() {
+    let base = run(&cfg(300.0, 128)).averages.speed_rpm;
+    let fine_t = run(&cfg(300.0, 256)).averages.speed_rpm;
+    let fine_x = run(&TransientConfig { nodes_per_wavelength: 128, ..cfg(300.0, 128) }).averages.speed_rpm;
+    assert!(rel(fine_t, base) < 5e-3, "{fine_t} vs {base}");
+    assert!(rel(fine_x, base) < 5e-3, "{fine_x} vs {base}");
+}
+
+/// 0° phase difference drives a standing wave: no net rotation (seed 004, section III.C);
+/// −90° reverses the rotor.
+#[test]
+fn standing_wave_does_not_turn_the_rotor_and_minus_90_reverses() {
+    let fwd = run(&TransientConfig { duration_s: 3e-3, ..cfg(300.0, 64) });
+    let standing = run(&TransientConfig { duration_s: 3e-3, phase_difference_rad: 0.0, ..cfg(300.0, 64) });
+    let back =
+        run(&TransientConfig { duration_s: 3e-3, phase_difference_rad: -0.5 * std::f64::consts::PI, ..cfg(300.0, 64) });
+    let v = fwd.averages.speed_rpm;
+    assert!(v > 50.0, "{v}");
+    let peak = standing.series.speed_rpm.iter().fold(0.0f64, |m, s| m.max(s.abs()));
+    assert!(peak < 1e-3 * v, "standing wave moved the rotor: peak {peak} rpm");
+    assert!(standing.averages.amplitude_m > 0.5 * fwd.averages.amplitude_m, "the stator still vibrates");
+    assert!(rel(-back.averages.speed_rpm, v) < 1e-6, "{} vs {v}", back.averages.speed_rpm);
+    assert!(standing.metrics.delay_s.is_none());
+}
+
+/// Trends of seed 004 Fig. 3-5: speed grows with voltage and near resonance; the
+/// response is a lightly damped second-order-like step with overshoot, settling in a few ms.
+#[test]
+fn step_metrics_follow_voltage_and_frequency() {
+    let c = TransientConfig { duration_s: 5e-3, ..cfg(300.0, 64) };
+    let base = run(&c);
+    let m = base.metrics;
+    let (delay, rise, over, settle) = (
+        m.delay_s.expect("delay"),
+        m.rise_time_s.expect("rise"),
+        m.overshoot.expect("os"),
+        m.settling_time_s.expect("ts"),
+    );
+    assert!(delay > 0.0 && delay < 1e-3, "{delay}");
+    assert!(rise > 0.0 && rise < 1e-3, "{rise}");
+    assert!(over > 0.05, "{over}");
+    assert!(settle > delay && settle < 4e-3, "{settle}");
+    let low_v = run(&TransientConfig { voltage_v: 150.0, ..c.clone() });
+    assert!(low_v.averages.speed_rpm < 0.9 * base.averages.speed_rpm);
+    let near = run(&TransientConfig { frequency_hz: 42.5e3, ..c.clone() });
+    assert!(near.averages.speed_rpm > base.averages.speed_rpm);
+    // each final speed lies above its own steady solution by the layer-compliance error
+    // (k_t = 300·k_f: 6 % at 200 V, 13 % at 150 V where the stick bands are wider), < 15 %
+    for (r, v, f) in [(&base, 200.0, 43e3), (&low_v, 150.0, 43e3), (&near, 200.0, 42.5e3)] {
+        let s = solve(&motor(), &OperatingPoint::new(260.0, 0.0, v, f));
+        let e = r.averages.speed_rpm / s.speed_rpm - 1.0;
+        assert!(e > 0.0 && e < 0.15, "{v} V {f} Hz: {} vs {}", r.averages.speed_rpm, s.speed_rpm);
+    }
+}
+
+/// Snapshots: full contact right after the step, stick/slip/no-contact zones once running,
+/// Coulomb's bound everywhere, and the pressure integrates to the axial force.
+#[test]
+fn snapshots_show_the_contact_zones() {
+    let c = TransientConfig { duration_s: 3e-3, snapshot_times_s: vec![2.9e-3, 0.02e-3], ..cfg(300.0, 64) };
+    let r = run(&c);
+    assert_eq!(r.snapshots.len(), 2);
+    let (early, late) = (&r.snapshots[1], &r.snapshots[0]);
+    assert!((early.requested_time_s - 0.02e-3).abs() < 1e-12);
+    assert!((early.time_s - 0.02e-3).abs() <= 0.5 * r.time_step_s + 1e-15);
+    assert_eq!(early.counts().0, 0, "full contact at start-up");
+    let (nc, st, sl) = late.counts();
+    assert!(nc > 0 && st > 0 && sl > 0, "{nc} {st} {sl}");
+    let m = motor();
+    let mu = m.friction_layer.friction_coefficient;
+    let dx = late.nodes[1].position_m - late.nodes[0].position_m;
+    let mut fz = 0.0;
+    for n in &late.nodes {
+        let bound = mu * n.pressure_n_per_m;
+        assert!(n.tangential_force_n_per_m.abs() <= bound * (1.0 + 1e-9) + 1e-9, "{n:?}");
+        match n.state {
+            NodeState::NoContact => assert_eq!(n.pressure_n_per_m, 0.0),
+            NodeState::Slip => {
+                assert!(rel(n.tangential_force_n_per_m.abs(), bound) < 1e-9);
+                // the friction force on the rotor follows the slip v_s − v_r (seed 004 eq. 1);
+                // within one step of a slip reversal the node re-sticks first, so a mismatch
+                // is only possible at slip speeds below |d(slip)/dt|·h ≈ 5 mm/s
+                let agrees = n.tangential_force_n_per_m * n.slip_speed_m_s >= 0.0;
+                assert!(agrees || n.slip_speed_m_s.abs() < 5e-3, "{n:?}");
+            }
+            NodeState::Stick => {}
+        }
+        fz += n.pressure_n_per_m * dx;
+    }
+    fz *= m.geometry.wave_number;
+    assert!(rel(fz, 260.0) < 0.01, "{fz}");
+}
+
+#[test]
+fn invalid_configurations_are_errors_not_panics() {
+    let m = motor();
+    let bad = [
+        TransientConfig { voltage_v: -1.0, ..TransientConfig::default() },
+        TransientConfig { frequency_hz: f64::NAN, ..TransientConfig::default() },
+        TransientConfig { steps_per_period: 4, ..TransientConfig::default() },
+        TransientConfig { nodes_per_wavelength: 2, ..TransientConfig::default() },
+        TransientConfig { record_every: 0, ..TransientConfig::default() },
+        TransientConfig { snapshot_times_s: vec![1.0], ..TransientConfig::default() },
+        TransientConfig { preload_n: 0.0, ..TransientConfig::default() },
+        TransientConfig { load_torque_nm: -0.1, ..TransientConfig::default() },
+        TransientConfig { duration_s: 0.0, ..TransientConfig::default() },
+        TransientConfig { tangential_stiffness_ratio: 0.0, ..TransientConfig::default() },
+    ];
+    for c in bad {
+        assert!(matches!(step_response(&m, &c), Err(TransientError::InvalidConfig { .. })), "{c:?}");
+    }
+    let stiff = TransientConfig { tangential_stiffness_ratio: 1e5, ..TransientConfig::default() };
+    assert!(matches!(step_response(&m, &stiff), Err(TransientError::StepTooLarge { .. })));
+    let long = TransientConfig { duration_s: 1e4, ..TransientConfig::default() };
+    assert!(matches!(step_response(&m, &long), Err(TransientError::TooManySteps { .. })));
+    let mut bad_motor = m.clone();
+    bad_motor.rotor.mass_kg = -1.0;
+    assert!(matches!(step_response(&bad_motor, &TransientConfig::default()), Err(TransientError::InvalidMotor(_))));
+}
+
+/// Metrics against the closed forms of an underdamped second-order step
+/// y = 1 − e^{−ζω t}/√(1−ζ²)·sin(ω_d t + acos ζ).
+#[test]
+fn metrics_match_second_order_closed_forms() {
+    let (zeta, wn) = (0.3f64, 2.0e3f64);
+    let wd = wn * (1.0 - zeta * zeta).sqrt();
+    let t: Vec<f64> = (0..200_000).map(|i| i as f64 * 1e-7).collect();
+    let y: Vec<f64> = t
+        .iter()
+        .map(|&t| 100.0 * (1.0 - (-zeta * wn * t).exp() / (1.0 - zeta * zeta).sqrt() * (wd * t + zeta.acos()).sin()))
+        .collect();
+    let m = step_metrics(&t, &y, 100.0);
+    let os = (-zeta * std::f64::consts::PI / (1.0 - zeta * zeta).sqrt()).exp();
+    assert!((m.overshoot.expect("os") - os).abs() < 1e-6, "{:?} vs {os}", m.overshoot);
+    // delay: y(t_d) = 50
+    let td = m.delay_s.expect("delay");
+    let yd = 1.0 - (-zeta * wn * td).exp() / (1.0 - zeta * zeta).sqrt() * (wd * td + zeta.acos()).sin();
+    assert!((yd - 0.5).abs() < 1e-6, "{yd}");
+    // settling: the envelope bound 4/(ζω_n) is an upper bound; the true 2 % time lies below it
+    let ts = m.settling_time_s.expect("ts");
+    assert!(ts < 4.0 / (zeta * wn) && ts > 2.0 / (zeta * wn), "{ts}");
+    assert!(m.rise_time_s.expect("rise") > 0.0);
+    let none = step_metrics(&t, &y, 0.0);
+    assert!(none.delay_s.is_none() && none.settling_time_s.is_none() && none.overshoot.is_none());
+    assert!(step_metrics(&[], &[], 1.0).delay_s.is_none());
+}
