@@ -9,11 +9,17 @@ use std::ffi::OsString;
 use std::io::Write;
 
 mod args;
+mod calib;
+mod data;
+mod diagnose;
 mod info;
 mod map;
 mod optimize;
 mod plot;
 mod point;
+mod report;
+mod svg;
+mod synth;
 mod table;
 
 pub use args::parse_axis;
@@ -44,6 +50,13 @@ enum Command {
     /// Plot curves or heat maps from a motor or from a map CSV (.png or .svg).
     #[command(allow_negative_numbers = true)]
     Plot(plot::PlotArgs),
+    /// Simulate a bench measurement campaign (with known effects) and write it as a measurement CSV.
+    #[command(allow_negative_numbers = true)]
+    Synth(synth::SynthArgs),
+    /// Calibrate the uncertain motor parameters to a measurement CSV; write the calibrated motor file.
+    Calibrate(calib::CalibrateArgs),
+    /// Diagnose the sim-to-real gap: where the model misses, which effect causes it, how far it shrinks.
+    Diagnose(diagnose::DiagnoseArgs),
 }
 
 /// Runs the CLI with the given arguments (the first is the program name) and returns
@@ -111,5 +124,8 @@ fn run(cli: Cli, out: &mut dyn Write, err: &mut dyn Write) -> anyhow::Result<i32
         Command::Presets(a) => info::presets(&a, out),
         Command::Effects => info::effects(out),
         Command::Plot(a) => plot::run(&a, err),
+        Command::Synth(a) => synth::run(&a, out, err),
+        Command::Calibrate(a) => calib::run(&a, out, err),
+        Command::Diagnose(a) => diagnose::run(&a, out, err),
     }
 }

@@ -1,0 +1,229 @@
+//! `trum calibrate`: fits the uncertain baseline parameters of a motor to a measurement
+//! file and writes the calibrated motor file.
+
+use crate::args::{fmt_sig, MotorArgs};
+use crate::data::{num, read_data, write_atomic};
+use crate::table::{write_table, Align};
+use anyhow::{anyhow, Result};
+use clap::Args;
+use serde_json::json;
+use std::io::Write;
+use std::path::PathBuf;
+use trum_core::calibrate::{baseline_params, calibrate, residuals, Calibration, FitOptions, ObservedRow};
+
+#[derive(Args, Debug)]
+pub struct CalibrateArgs {
+    #[command(flatten)]
+    motor: MotorArgs,
+    /// Measurement CSV (shared/spec/measurements.md; `trum synth` writes one).
+    #[arg(long, value_name = "FILE")]
+    data: String,
+    /// Write the calibrated motor file here (TOML; `-` for stdout instead of the table).
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: Option<PathBuf>,
+    /// Write the fit result as JSON here (`-` for stdout instead of the table).
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+}
+
+pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
+    let to_stdout = |p: &Option<PathBuf>| p.as_ref().is_some_and(|p| p.as_os_str() == "-");
+    if to_stdout(&a.output) && to_stdout(&a.json) {
+        anyhow::bail!("-o - and --json - cannot both go to stdout");
+    }
+    let (motor, _) = a.motor.load()?;
+    let (_, bench) = read_data(&a.data, &motor, err)?;
+    let params = baseline_params(&motor, &bench.rows);
+    let mut cal =
+        calibrate(&motor, &bench.rows, &params, &FitOptions::default()).map_err(|e| anyhow!("{}: {e}", a.data))?;
+    rescale_uncertainties(&mut cal, &bench.rows);
+    let chi2_per = cal.chi2 / cal.n_readings.max(1) as f64;
+    if let Some(path) = &a.json {
+        let doc = json!({
+            "motor": { "name": motor.name, "source": a.motor.motor, "effects": motor.effects.to_string() },
+            "data": a.data,
+            "n_rows": bench.rows.len(),
+            "n_readings": cal.n_readings,
+            "chi2": num(cal.chi2),
+            "chi2_per_reading": num(chi2_per),
+            "evaluations": cal.evaluations,
+            "params": cal.params.iter().map(|p| json!({
+                "name": p.name,
+                "nominal": num(motor.param(&p.name).unwrap_or(f64::NAN)),
+                "value": num(p.value),
+                "std_error": num(p.std_error),
+                "at_bound": p.at_bound,
+                "identifiable": p.identifiable,
+            })).collect::<Vec<_>>(),
+            "warnings": cal.warnings,
+        });
+        write_atomic(path, ".json", &(serde_json::to_string_pretty(&doc)? + "\n"), out)?;
+    }
+    if let Some(path) = &a.output {
+        write_atomic(path, ".toml", &calibrated_toml(&cal, &motor, &a.data, chi2_per), out)?;
+    }
+    if !to_stdout(&a.output) && !to_stdout(&a.json) {
+        print_table(&cal, &motor, &a.data, chi2_per, out)?;
+    }
+    for w in &cal.warnings {
+        writeln!(err, "warning: {w}")?;
+    }
+    Ok(0)
+}
+
+/// The calibrated motor file, with the fit recorded in comments.
+fn calibrated_toml(cal: &Calibration, nominal: &trum_core::Motor, data: &str, chi2_per: f64) -> String {
+    let header = format!(
+        "trum motor file: {}\ncalibrated by `trum calibrate` to {data} ({} readings, chi2/reading {})",
+        cal.motor.name,
+        cal.n_readings,
+        fmt_sig(chi2_per, 4)
+    );
+    cal.motor.to_toml_annotated(&header, &|key| {
+        cal.params.iter().find(|p| p.name == key).map(|p| {
+            let nom = nominal.param(key).map(|v| fmt_sig(v, 6)).unwrap_or_else(|| "-".into());
+            let flag = if !p.identifiable {
+                ", not identifiable from this data"
+            } else if p.at_bound {
+                ", at a bound"
+            } else {
+                ""
+            };
+            format!("calibrated, std error {}, nominal {nom}{flag}", fmt_sig(p.std_error, 3))
+        })
+    })
+}
+
+fn print_table(
+    cal: &Calibration,
+    motor: &trum_core::Motor,
+    data: &str,
+    chi2_per: f64,
+    out: &mut dyn Write,
+) -> Result<()> {
+    writeln!(out, "motor     {}", motor.name)?;
+    writeln!(out, "data      {data} ({} readings, {} residual evaluations)", cal.n_readings, cal.evaluations)?;
+    writeln!(out, "chi2      {} per reading (1 = fits to within the assumed noise)", fmt_sig(chi2_per, 4))?;
+    writeln!(out)?;
+    let rows: Vec<Vec<String>> = cal
+        .params
+        .iter()
+        .map(|p| {
+            let nom = motor.param(&p.name).unwrap_or(f64::NAN);
+            let change = if nom != 0.0 { 100.0 * (p.value / nom - 1.0) } else { f64::NAN };
+            let mut flags = Vec::new();
+            if p.at_bound {
+                flags.push("at bound");
+            }
+            if !p.identifiable {
+                flags.push("not identifiable");
+            }
+            vec![
+                p.name.clone(),
+                fmt_sig(nom, 5),
+                fmt_sig(p.value, 5),
+                fmt_sig(p.std_error, 2),
+                if change.is_finite() { format!("{change:+.1}%") } else { "-".into() },
+                flags.join(", "),
+            ]
+        })
+        .collect();
+    write_table(
+        out,
+        &["parameter", "nominal", "fitted", "std error", "change", "note"],
+        &[Align::Left, Align::Right, Align::Right, Align::Right, Align::Right, Align::Left],
+        &rows,
+    )?;
+    Ok(())
+}
+
+/// Standard errors recomputed with the Jacobian taken against *relative* parameter
+/// changes and the normal matrix equilibrated before inversion. (trum-core's values come
+/// from a pseudo-inverse of the unscaled JᵀJ, whose entries span ~30 decades between the
+/// friction coefficient and the Young's modulus, so its cutoff zeroes real variances.)
+/// Identifiable = relative standard error below 1 and a well-conditioned column.
+fn rescale_uncertainties(cal: &mut Calibration, rows: &[ObservedRow]) {
+    let n = cal.params.len();
+    let r0 = residuals(&cal.motor, rows);
+    let m = r0.len();
+    if n == 0 || m <= n {
+        return;
+    }
+    let h = 1e-5;
+    // columns: d r / d ln p (forward differences)
+    let mut cols: Vec<Vec<f64>> = Vec::with_capacity(n);
+    for p in &cal.params {
+        let mut mm = cal.motor.clone();
+        match mm.param_mut(&p.name) {
+            Some(v) if v.is_finite() && *v != 0.0 => *v *= 1.0 + h,
+            _ => return, // not a motor parameter: keep core's numbers
+        }
+        let r1 = residuals(&mm, rows);
+        cols.push(r1.iter().zip(&r0).map(|(a, b)| (a - b) / h).collect());
+    }
+    let mut a = vec![vec![0.0; n]; n];
+    for i in 0..n {
+        for j in 0..n {
+            a[i][j] = cols[i].iter().zip(&cols[j]).map(|(x, y)| x * y).sum();
+        }
+    }
+    let d: Vec<f64> = (0..n).map(|i| a[i][i].max(0.0).sqrt()).collect();
+    for i in 0..n {
+        for j in 0..n {
+            a[i][j] = if d[i] > 0.0 && d[j] > 0.0 { a[i][j] / (d[i] * d[j]) } else { 0.0 };
+        }
+    }
+    let inv = invert(a);
+    let s2 = (cal.chi2 / (m - n) as f64).max(1e-300);
+    let mut warn = Vec::new();
+    for (k, p) in cal.params.iter_mut().enumerate() {
+        let var_rel = match &inv {
+            Some(inv) if d[k] > 0.0 => inv[k][k] / (d[k] * d[k]) * s2,
+            _ => f64::NAN,
+        };
+        let rel = if var_rel.is_finite() && var_rel >= 0.0 { var_rel.sqrt() } else { f64::NAN };
+        p.std_error = rel * p.value.abs();
+        p.identifiable = rel.is_finite() && rel < 1.0;
+        if !p.identifiable {
+            warn.push(format!(
+                "{} is not identifiable from these data (relative standard error {})",
+                p.name,
+                fmt_sig(rel, 2)
+            ));
+        }
+    }
+    cal.warnings.retain(|w| !w.contains("is not identifiable"));
+    cal.warnings.extend(warn);
+}
+
+/// Gauss-Jordan inverse with partial pivoting of an equilibrated (unit-diagonal) matrix;
+/// `None` when it is singular to working precision.
+fn invert(mut a: Vec<Vec<f64>>) -> Option<Vec<Vec<f64>>> {
+    let n = a.len();
+    let mut inv: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| f64::from(u8::from(i == j))).collect()).collect();
+    for c in 0..n {
+        let p = (c..n).max_by(|&x, &y| a[x][c].abs().total_cmp(&a[y][c].abs()))?;
+        if a[p][c].abs() < 1e-13 {
+            return None;
+        }
+        a.swap(c, p);
+        inv.swap(c, p);
+        let piv = a[c][c];
+        for j in 0..n {
+            a[c][j] /= piv;
+            inv[c][j] /= piv;
+        }
+        for r in 0..n {
+            if r != c {
+                let f = a[r][c];
+                if f != 0.0 {
+                    for j in 0..n {
+                        a[r][j] -= f * a[c][j];
+                        inv[r][j] -= f * inv[c][j];
+                    }
+                }
+            }
+        }
+    }
+    Some(inv)
+}

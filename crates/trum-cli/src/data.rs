@@ -1,0 +1,53 @@
+//! Shared by `synth`, `calibrate` and `diagnose`: reading a measurement file (its
+//! warnings go to stderr), JSON numbers without NaN, and writing a small file atomically.
+
+use crate::args::OutputTarget;
+use anyhow::{anyhow, bail, Context, Result};
+use serde_json::{json, Value};
+use std::io::Write;
+use std::path::Path;
+use trum_core::bench::{observations, BenchData};
+use trum_core::measurements::{parse_measurements, Measurements};
+use trum_core::Motor;
+
+/// Reads and checks a measurement file (shared/spec/measurements.md); warnings (ignored
+/// columns, ...) are printed to `err`.
+pub fn read_data(path: &str, motor: &Motor, err: &mut dyn Write) -> Result<(Measurements, BenchData)> {
+    let p = Path::new(path);
+    if p.is_dir() {
+        bail!("--data '{path}' is a directory, not a measurement file");
+    }
+    if !p.exists() {
+        bail!("measurement file '{path}' does not exist");
+    }
+    let bytes = std::fs::read(p).with_context(|| format!("cannot read measurement file '{path}'"))?;
+    // MeasurementError's message names the file, line and column; show it unchanged.
+    let m = parse_measurements(&bytes, path).map_err(|e| anyhow!("{e}"))?;
+    for w in &m.warnings {
+        writeln!(err, "warning: {w}")?;
+    }
+    let bench = observations(&m, motor);
+    Ok((m, bench))
+}
+
+/// A JSON number, or `null` when not finite (JSON has no NaN).
+pub fn num(v: f64) -> Value {
+    if v.is_finite() {
+        json!(v)
+    } else {
+        Value::Null
+    }
+}
+
+/// Writes `text` to `path` through a temporary file renamed at the end (`-`: stdout).
+pub fn write_atomic(path: &Path, suffix: &str, text: &str, out: &mut dyn Write) -> Result<()> {
+    let target = OutputTarget::create(path, suffix)?;
+    match &target {
+        OutputTarget::Stdout => out.write_all(text.as_bytes())?,
+        OutputTarget::File(tmp, p) => {
+            let mut f = tmp.reopen().with_context(|| format!("cannot write '{}'", p.display()))?;
+            f.write_all(text.as_bytes()).with_context(|| format!("writing '{}'", p.display()))?;
+        }
+    }
+    target.finish()
+}

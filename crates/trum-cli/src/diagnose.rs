@@ -1,0 +1,234 @@
+//! `trum diagnose`: the sim-to-real gap diagnosis of shared/spec/diagnose.md — where the
+//! calibrated baseline misses, which unmodelled effect causes it, and how far the
+//! held-out gap shrinks once that effect is added. Summary to stdout, JSON and an HTML
+//! report on request.
+
+use crate::args::{fmt_sig, load_motor};
+use crate::data::{num, read_data, write_atomic};
+use crate::table::{write_table, Align};
+use anyhow::{anyhow, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget};
+use serde_json::{json, Value};
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::time::Duration;
+use trum_core::bench::BenchData;
+use trum_core::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
+use trum_core::measurements::Column;
+use trum_core::Motor;
+
+/// How to read `evidence` (also in the JSON and the report).
+pub const EVIDENCE_SCALE: &str =
+    "evidence = ½·ΔBIC vs the calibrated baseline (log Bayes factor): > 3 strong, > 5 very strong";
+
+#[derive(Args, Debug)]
+pub struct DiagnoseArgs {
+    /// Nominal motor: a TOML motor file or a preset name.
+    #[arg(long, value_name = "MOTOR.toml|PRESET")]
+    motor: String,
+    /// Measurement CSV (shared/spec/measurements.md).
+    #[arg(long, value_name = "DATA.csv")]
+    data: String,
+    /// Write the diagnosis as JSON here (`-`: JSON to stdout instead of the summary).
+    #[arg(long, value_name = "OUT.json")]
+    json: Option<PathBuf>,
+    /// Write a self-contained HTML report (plots, tables, method) here.
+    #[arg(long, value_name = "OUT.html")]
+    report: Option<PathBuf>,
+}
+
+pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
+    let (motor, _) = load_motor(&a.motor)?;
+    let (_, bench) = read_data(&a.data, &motor, err)?;
+    // Check the output paths before the long run, so a typo fails at once.
+    for p in [&a.json, &a.report].into_iter().flatten() {
+        drop(crate::args::OutputTarget::create(p, ".tmp")?);
+    }
+    let spinner = spinner();
+    let d = diagnose(&motor, &bench.rows, &bench.groups, &DiagnoseOptions::default());
+    spinner.finish_and_clear();
+    let d = d.map_err(|e| anyhow!("cannot diagnose '{}': {e}", a.data))?;
+    let json_stdout = a.json.as_ref().is_some_and(|p| p.as_os_str() == "-");
+    if let Some(p) = &a.json {
+        let doc = to_json(&d, &motor, &a.motor, &a.data, &bench);
+        write_atomic(p, ".json", &(serde_json::to_string_pretty(&doc)? + "\n"), out)?;
+    }
+    if let Some(p) = &a.report {
+        let html = crate::report::html(&d, &motor, &a.data, &bench);
+        write_atomic(p, ".html", &html, out)?;
+    }
+    if !json_stdout {
+        write_summary(&d, &motor, &a.data, out)?;
+    }
+    Ok(0)
+}
+
+/// A spinner on stderr while the diagnosis runs (only on a terminal).
+fn spinner() -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    b.set_message("diagnosing: calibrating the baseline and every candidate effect on held-out regions");
+    b.enable_steady_tick(Duration::from_millis(120));
+    b
+}
+
+/// Unit of a measured column (empty when dimensionless or unknown).
+pub fn unit(column: &str) -> &'static str {
+    Column::from_name(column).map(|c| c.spec().unit).unwrap_or("")
+}
+
+/// The spec's JSON plus extras; non-finite numbers are `null`.
+pub fn to_json(d: &Diagnosis, motor: &Motor, motor_arg: &str, data: &str, bench: &BenchData) -> Value {
+    let pairs =
+        |v: &[(String, f64)]| -> Vec<Value> { v.iter().map(|(n, x)| json!({"name": n, "value": num(*x)})).collect() };
+    json!({
+        "verdict": d.verdict,
+        "confounded_with": d.confounded_with,
+        "gap": {
+            "baseline_heldout_nrmse": num(d.baseline_heldout_nrmse),
+            "noise_nrmse": num(d.noise_nrmse),
+            "baseline_heldout_chi2_per_reading": num(d.baseline_heldout_chi2_per_reading),
+            "where": d.gap_where.iter().map(|g| json!({
+                "quantity": g.quantity,
+                "region": g.region,
+                "mean_residual": num(g.mean_residual),
+                "unit": unit(&g.quantity),
+                "n": g.n,
+                "z": num(g.z),
+            })).collect::<Vec<_>>(),
+        },
+        "ranking": d.ranking.iter().map(|r| json!({
+            "effect": r.effect,
+            "evidence": num(r.evidence),
+            "heldout_nrmse_after": num(r.heldout_nrmse_after),
+            "shrink": num(r.shrink),
+            "shrink_interval": [num(r.shrink_interval.0), num(r.shrink_interval.1)],
+            "params": pairs(&r.params),
+        })).collect::<Vec<_>>(),
+        "evidence_scale": EVIDENCE_SCALE,
+        "notes": d.notes,
+        "n_rows": d.n_rows,
+        "n_readings": d.n_readings,
+        "folds": d.folds,
+        "baseline_params": pairs(&d.baseline_params),
+        "motor": { "name": motor.name, "source": motor_arg },
+        "data": data,
+        "heldout": d.heldout.iter().map(|h| json!({
+            "row": h.row,
+            "line": bench.lines.get(h.row),
+            "quantity": h.observable.column(),
+            "measured": num(h.measured),
+            "baseline": num(h.baseline),
+            "after": num(h.after),
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// `0.1234` as `12.3 %`.
+fn pct(x: f64) -> String {
+    if x.is_finite() {
+        format!("{:.1} %", 100.0 * x)
+    } else {
+        "-".into()
+    }
+}
+
+/// The held-out NRMSE after adding the verdict's effect(s), when there is a verdict effect.
+pub fn after_nrmse(d: &Diagnosis) -> Option<f64> {
+    d.ranking.iter().find(|r| r.effect == d.verdict).map(|r| r.heldout_nrmse_after)
+}
+
+/// Verdict in words.
+pub fn verdict_words(d: &Diagnosis) -> String {
+    match d.verdict.as_str() {
+        "none" => "none (the calibrated baseline is adequate within the noise)".into(),
+        "unexplained" => "unexplained (a real gap that no candidate effect closes)".into(),
+        v if v.contains('+') => format!("{v} (both effects together are needed to close the gap)"),
+        v => v.to_string(),
+    }
+}
+
+pub fn write_summary(d: &Diagnosis, motor: &Motor, data: &str, out: &mut dyn Write) -> Result<()> {
+    writeln!(out, "motor       {}", motor.name)?;
+    writeln!(
+        out,
+        "data        {data} ({} rows, {} readings, {} cross-validation folds over operating regions)",
+        d.n_rows, d.n_readings, d.folds
+    )?;
+    writeln!(out, "verdict     {}", verdict_words(d))?;
+    let conf = if d.confounded_with.is_empty() { "none".to_string() } else { d.confounded_with.join(", ") };
+    writeln!(out, "confounded  {conf}")?;
+    let after = match after_nrmse(d) {
+        Some(x) => format!(" -> {} with {}", fmt_sig(x, 3), d.verdict),
+        None => String::new(),
+    };
+    writeln!(
+        out,
+        "gap         held-out NRMSE {} (baseline){after}; noise alone {}",
+        fmt_sig(d.baseline_heldout_nrmse, 3),
+        fmt_sig(d.noise_nrmse, 3)
+    )?;
+    writeln!(
+        out,
+        "            held-out chi2 per reading {} (1 = at the noise level)",
+        fmt_sig(d.baseline_heldout_chi2_per_reading, 3)
+    )?;
+    writeln!(out)?;
+    if d.gap_where.is_empty() {
+        writeln!(out, "where: no quantity and region where the baseline misses by more than the noise explains")?;
+    } else {
+        writeln!(out, "where the baseline misses (mean residual = measured - model, full-data fit)")?;
+        let rows: Vec<Vec<String>> = d
+            .gap_where
+            .iter()
+            .map(|g| {
+                vec![
+                    g.quantity.clone(),
+                    g.region.clone(),
+                    fmt_sig(g.mean_residual, 3),
+                    unit(&g.quantity).to_string(),
+                    g.n.to_string(),
+                    format!("{:.1}", g.z),
+                ]
+            })
+            .collect();
+        write_table(
+            out,
+            &["quantity", "region", "mean residual", "unit", "n", "z"],
+            &[Align::Left, Align::Left, Align::Right, Align::Left, Align::Right, Align::Right],
+            &rows,
+        )?;
+    }
+    writeln!(out)?;
+    writeln!(out, "ranking ({EVIDENCE_SCALE})")?;
+    let rows: Vec<Vec<String>> = d
+        .ranking
+        .iter()
+        .map(|r| {
+            vec![
+                r.effect.clone(),
+                fmt_sig(r.evidence, 3),
+                fmt_sig(r.heldout_nrmse_after, 3),
+                pct(r.shrink),
+                format!("[{}, {}]", pct(r.shrink_interval.0), pct(r.shrink_interval.1)),
+            ]
+        })
+        .collect();
+    write_table(
+        out,
+        &["effect", "evidence", "NRMSE after", "shrink", "90 % interval"],
+        &[Align::Left, Align::Right, Align::Right, Align::Right, Align::Left],
+        &rows,
+    )?;
+    if !d.notes.is_empty() {
+        writeln!(out)?;
+        writeln!(out, "notes")?;
+        for n in &d.notes {
+            writeln!(out, "- {n}")?;
+        }
+    }
+    Ok(())
+}

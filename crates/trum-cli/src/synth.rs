@@ -1,0 +1,135 @@
+//! `trum synth`: a synthetic bench campaign with known effects, written as a measurement
+//! file (shared/spec/measurements.md) for `trum calibrate` and `trum diagnose`.
+
+use crate::args::MotorArgs;
+use crate::data::write_atomic;
+use anyhow::{anyhow, bail, Result};
+use clap::{Args, ValueEnum};
+use std::io::Write;
+use std::path::PathBuf;
+use trum_core::bench::to_measurements;
+use trum_core::calibrate::Observable;
+use trum_core::synth::{synthesize, Campaign, SynthConfig};
+
+/// Campaign kinds (the names of `trum_core::synth::Campaign::NAMES`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum CampaignArg {
+    /// Preloads 100-400 N in 50 N steps × load torque from zero to 90 % of stall (56 rows).
+    PreloadTorque,
+    /// No-load frequency sweeps ±1.5 kHz at 0.75, 1 and 1.25 × the voltage, 250 N (45 rows).
+    FrequencySweep,
+    /// A 10 min warm-up time series at 250 N, 0.3 N m, 20 s samples, with temperatures (31 rows).
+    WarmUp,
+    /// Speed stability (speed_std_rpm) at no load, preloads 150-500 N (8 rows).
+    Stability,
+    /// All four together.
+    Combined,
+}
+
+impl CampaignArg {
+    fn campaign(self) -> Result<Campaign> {
+        let name = self.to_possible_value().map(|v| v.get_name().to_string()).unwrap_or_default();
+        Campaign::from_name(&name).map_err(|e| anyhow!("{e}"))
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct SynthArgs {
+    #[command(flatten)]
+    motor: MotorArgs,
+    /// Measurement campaign to simulate.
+    #[arg(long, value_enum)]
+    campaign: CampaignArg,
+    /// Noise level: 0 = exact readings, 1 = the nominal bench noise (docs/SYNTH.md).
+    #[arg(long, value_name = "LEVEL")]
+    noise: f64,
+    /// Random seed (the same seed gives the same file, byte for byte).
+    #[arg(long, value_name = "N")]
+    seed: u64,
+    /// Relative standard deviation of the perturbation of the uncertain motor parameters
+    /// (what calibration must absorb).
+    #[arg(long, default_value_t = 0.03, value_name = "REL")]
+    perturbation: f64,
+    /// Drive voltage amplitude of the fixed-drive runs, zero-to-peak per phase [V].
+    #[arg(long, default_value_t = 200.0)]
+    voltage_v: f64,
+    /// Drive frequency of the fixed-drive runs [Hz].
+    #[arg(long, default_value_t = 43_000.0)]
+    frequency_hz: f64,
+    /// Simulate the effects in their candidate forms (the forms the diagnosis fits). By
+    /// default effects use their truth forms, which differ in form from the candidates, as
+    /// a real motor would.
+    #[arg(long)]
+    candidate_forms: bool,
+    /// Optional columns to leave out, comma-separated (to mimic a poorer bench), e.g. feedback_v,current_a.
+    #[arg(long, value_name = "col1,col2")]
+    omit: Option<String>,
+    /// Output CSV file (`-` for stdout). Written to a temporary file and renamed at the end.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: PathBuf,
+}
+
+/// Parses `--omit`: optional measured columns only.
+pub fn parse_omit(spec: Option<&str>) -> Result<Vec<Observable>> {
+    let Some(spec) = spec else { return Ok(Vec::new()) };
+    let optional: Vec<&str> =
+        Observable::ALL.iter().filter(|o| **o != Observable::SpeedRpm).map(|o| o.column()).collect();
+    let mut v = Vec::new();
+    for name in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        if name == "speed_rpm" {
+            bail!("--omit: speed_rpm is a required column and cannot be left out");
+        }
+        let o = Observable::ALL.into_iter().find(|o| o.column() == name).ok_or_else(|| {
+            anyhow!("--omit: '{name}' is not an optional measured column; valid columns are: {}", optional.join(", "))
+        })?;
+        if !v.contains(&o) {
+            v.push(o);
+        }
+    }
+    Ok(v)
+}
+
+pub fn run(a: &SynthArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
+    let (motor, _) = a.motor.load()?;
+    for (flag, v) in [("--voltage-v", a.voltage_v), ("--frequency-hz", a.frequency_hz)] {
+        if !(v.is_finite() && v > 0.0) {
+            bail!("{flag} {v} must be a finite number > 0");
+        }
+    }
+    let cfg = SynthConfig {
+        campaign: a.campaign.campaign()?,
+        noise: a.noise,
+        seed: a.seed,
+        perturbation: a.perturbation,
+        voltage_v: a.voltage_v,
+        frequency_hz: a.frequency_hz,
+        truth_forms: !a.candidate_forms,
+        omit: parse_omit(a.omit.as_deref())?,
+    };
+    let rows = synthesize(&motor, &cfg).map_err(|e| anyhow!("{e}"))?;
+    if rows.is_empty() {
+        bail!("the motor has no valid steady state at any point of this campaign; nothing to write");
+    }
+    let m = to_measurements(&rows).map_err(|e| anyhow!("{e}"))?;
+    write_atomic(&a.output, ".csv", &m.to_csv_string(), out)?;
+    if a.output.as_os_str() != "-" {
+        let forms = if motor.effects.is_none() {
+            ""
+        } else if a.candidate_forms {
+            " (candidate forms)"
+        } else {
+            " (truth forms)"
+        };
+        writeln!(
+            err,
+            "wrote {} rows to '{}': campaign {}, noise {}, seed {}, effects {}{forms}",
+            rows.len(),
+            a.output.display(),
+            a.campaign.to_possible_value().map(|v| v.get_name().to_string()).unwrap_or_default(),
+            a.noise,
+            a.seed,
+            motor.effects,
+        )?;
+    }
+    Ok(0)
+}
