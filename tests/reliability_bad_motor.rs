@@ -87,7 +87,11 @@ fn every_bad_motor_file_fails_with_its_expected_message() {
                 Ok(Ok(text)) => Motor::from_toml_str_with_sweep(&text, &source).err().map(|e| e.to_string()),
                 _ => {
                     let (mut out, mut err) = (Vec::new(), Vec::new());
-                    trum_cli::run_with_io(["trum", "point", "--motor", &source, "--preload-n", "100"], &mut out, &mut err);
+                    trum_cli::run_with_io(
+                        ["trum", "point", "--motor", &source, "--preload-n", "100"],
+                        &mut out,
+                        &mut err,
+                    );
                     String::from_utf8_lossy(&err).trim_end().strip_prefix("error: ").map(str::to_string)
                 }
             };

@@ -18,7 +18,12 @@ const N_PRELOAD: usize = 60;
 const N_TORQUE: usize = 40;
 
 fn check(m: &Motor, op: &OperatingPoint, s: &Solution, how: &str) -> Result<(), String> {
-    let at = || format!("{} {how} at F={} N T={} N·m V={} V f={} Hz", m.name, op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz);
+    let at = || {
+        format!(
+            "{} {how} at F={} N T={} N·m V={} V f={} Hz",
+            m.name, op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz
+        )
+    };
     match s.status {
         Status::InvalidInput => return Err(format!("invalid_input for a valid point: {}", at())),
         Status::NoConvergence => return Ok(()),

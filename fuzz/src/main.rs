@@ -105,7 +105,8 @@ fn parse_opts() -> Opts {
     let mut i = 0;
     while i < args.len() {
         let val = |i: usize| args.get(i + 1).cloned().unwrap_or_else(|| usage());
-        let num = |i: usize| val(i).parse::<f64>().ok().filter(|v| v.is_finite() && *v >= 0.0).unwrap_or_else(|| usage());
+        let num =
+            |i: usize| val(i).parse::<f64>().ok().filter(|v| v.is_finite() && *v >= 0.0).unwrap_or_else(|| usage());
         match args[i].as_str() {
             "--seconds" => o.seconds = num(i),
             "--seed" => o.seed = val(i).parse().unwrap_or_else(|_| usage()),
@@ -202,6 +203,40 @@ fn shape(s: &str, n: usize) -> String {
     s.chars().map(|c| if c.is_ascii_digit() { '#' } else { c }).take(n).collect()
 }
 
+/// A coarse outcome class for corpus feedback: quoted text and numbers dropped, so
+/// that a fuzzed token inside a message does not make every input "new".
+fn outcome(s: &str, n: usize) -> String {
+    let mut out = String::new();
+    let mut quote: Option<char> = None;
+    for c in s.chars() {
+        match quote {
+            Some(q) if c == q => quote = None,
+            Some(_) => {}
+            None if matches!(c, '`' | '\'' | '"') => {
+                quote = Some(c);
+                out.push('_');
+            }
+            None if c.is_ascii_digit() || c == '.' || c == '-' => {}
+            None => out.push(c),
+        }
+    }
+    out.chars().take(n).collect()
+}
+
+/// A key as a signature: known dotted keys and sections stay, anything else is "other".
+fn key_class(key: &str) -> String {
+    let known = Motor::all_keys().iter().any(|k| key == format!("{}.{}", k.section, k.key) || key == k.section)
+        || key.starts_with("effects.")
+        || key.starts_with("sweep.")
+        || key.is_empty()
+        || key == "preset";
+    if known && key.len() < 64 {
+        key.to_string()
+    } else {
+        "other".into()
+    }
+}
+
 // ------------------------------------------------------------------ targets
 
 enum Verdict {
@@ -236,7 +271,7 @@ fn check_toml(input: &[u8]) -> Verdict {
                 }
                 Err(_) => {}
             }
-            Verdict::Fine(format!("err {} {}", e.key, shape(&e.reason, 48)))
+            Verdict::Fine(format!("err {} line={} {}", key_class(&e.key), e.line.is_some(), outcome(&e.reason, 40)))
         }
         (Ok(m), b) => {
             if let Err(e) = m.validate(SRC_TOML, None) {
@@ -256,7 +291,7 @@ fn check_toml(input: &[u8]) -> Verdict {
                     if !msg.starts_with(SRC_TOML) {
                         return Verdict::Violation(format!("sweep error does not name the source: {msg}"));
                     }
-                    format!("sweep-err {} {}", e.key, shape(&e.reason, 40))
+                    format!("sweep-err {} {}", key_class(&e.key), outcome(&e.reason, 30))
                 }
             };
             let back = m.to_toml();
@@ -269,7 +304,12 @@ fn check_toml(input: &[u8]) -> Verdict {
                 }
                 Err(e) => return Verdict::Violation(format!("to_toml output does not read back: {e}\ntext:\n{back}")),
             }
-            Verdict::Fine(format!("ok preset={:?} effects={} {sweep_sig}", m.preset, m.effects))
+            let fx: String = ALL_EFFECTS.iter().map(|e| if m.effects.is_on(*e) { '1' } else { '0' }).collect();
+            Verdict::Fine(format!(
+                "ok preset={:?} effects={fx} truth={} {sweep_sig}",
+                m.preset,
+                m.effects.truth_forms()
+            ))
         }
     }
 }
@@ -292,7 +332,8 @@ fn check_csv(input: &[u8]) -> Verdict {
             }
             let kind = format!("{:?}", e.kind);
             let variant: String = kind.chars().take_while(|c| c.is_alphanumeric()).collect();
-            Verdict::Fine(format!("err {variant} {:?} line={}", e.column, e.line.is_some()))
+            let col = e.column.as_deref().filter(|c| COLUMNS.iter().any(|k| k.name == *c)).unwrap_or("other");
+            Verdict::Fine(format!("err {variant} {col} line={}", e.line.is_some()))
         }
         Ok(m) => {
             let text = m.to_csv_string();
@@ -326,8 +367,13 @@ struct Case {
 impl Case {
     fn parse(input: &[u8]) -> Case {
         let text = String::from_utf8_lossy(input);
-        let mut c =
-            Case { preset: "trum60a".into(), op: [250.0, 0.0, 200.0, 43_000.0, 0.0], params: vec![], effects: vec![], truth: false };
+        let mut c = Case {
+            preset: "trum60a".into(),
+            op: [250.0, 0.0, 200.0, 43_000.0, 0.0],
+            params: vec![],
+            effects: vec![],
+            truth: false,
+        };
         for line in text.lines() {
             let w: Vec<&str> = line.split_whitespace().collect();
             let f = |i: usize| w.get(i).and_then(|t| t.parse::<f64>().ok()).unwrap_or(0.0);
@@ -352,7 +398,10 @@ impl Case {
     }
 
     fn to_text(&self) -> String {
-        let mut s = format!("preset {}\nop {:?} {:?} {:?} {:?} {:?}\n", self.preset, self.op[0], self.op[1], self.op[2], self.op[3], self.op[4]);
+        let mut s = format!(
+            "preset {}\nop {:?} {:?} {:?} {:?} {:?}\n",
+            self.preset, self.op[0], self.op[1], self.op[2], self.op[3], self.op[4]
+        );
         for (k, v) in &self.params {
             s.push_str(&format!("param {k} {v:?}\n"));
         }
@@ -383,7 +432,13 @@ impl Case {
 fn check_solver(c: &Case) -> Verdict {
     let m = c.motor();
     let motor_ok = m.validate("fuzz", None).is_ok();
-    let op = OperatingPoint { preload_n: c.op[0], torque_nm: c.op[1], voltage_v: c.op[2], frequency_hz: c.op[3], elapsed_s: c.op[4] };
+    let op = OperatingPoint {
+        preload_n: c.op[0],
+        torque_nm: c.op[1],
+        voltage_v: c.op[2],
+        frequency_hz: c.op[3],
+        elapsed_s: c.op[4],
+    };
     let op_ok = op.invalid_reason().is_none();
     let s = solve(&m, &op);
     if !op_ok && s.status != Status::InvalidInput {
@@ -550,9 +605,35 @@ fn dictionary(target: Target) -> Vec<Vec<u8>> {
                 d.push(format!("{}\n", c.name));
             }
             for s in [
-                ",", "\"", "\"\"", "\r", "\r\n", "\n", "\n\n", "\u{feff}", ";", "\t", " ", "run_id", "Preload_N",
-                "torque_mnm", "speed_rad_s", "efficiency_percent", "nan", "inf", "1e400", "-0", "0x10", "1,5", "é",
-                "\u{0}", "\u{7f}", "\u{2028}", "a\"b", "\"a,b\"", "\"  x  \"",
+                ",",
+                "\"",
+                "\"\"",
+                "\r",
+                "\r\n",
+                "\n",
+                "\n\n",
+                "\u{feff}",
+                ";",
+                "\t",
+                " ",
+                "run_id",
+                "Preload_N",
+                "torque_mnm",
+                "speed_rad_s",
+                "efficiency_percent",
+                "nan",
+                "inf",
+                "1e400",
+                "-0",
+                "0x10",
+                "1,5",
+                "é",
+                "\u{0}",
+                "\u{7f}",
+                "\u{2028}",
+                "a\"b",
+                "\"a,b\"",
+                "\"  x  \"",
             ] {
                 d.push(s.into());
             }
@@ -600,7 +681,11 @@ fn mutate_bytes(data: &mut Vec<u8>, rng: &mut ChaCha8Rng, pool: &[Vec<u8>], dict
             }
             1 => {
                 let i = rng.random_range(0..=len);
-                let b = if rng.random_bool(0.5) { rng.random::<u8>() } else { *pick(rng, b"[]=\"',.#{}\n\r\t \\0123456789-+eE\x7f\xff\xc3\xa9") };
+                let b = if rng.random_bool(0.5) {
+                    rng.random::<u8>()
+                } else {
+                    *pick(rng, b"[]=\"',.#{}\n\r\t \\0123456789-+eE\x7f\xff\xc3\xa9")
+                };
                 data.insert(i, b);
             }
             2 if len > 0 => {
@@ -636,11 +721,7 @@ fn mutate_bytes(data: &mut Vec<u8>, rng: &mut ChaCha8Rng, pool: &[Vec<u8>], dict
             }
             7 | 8 if !dict.is_empty() => {
                 let tok = pick(rng, dict).clone();
-                let at = if rng.random_bool(0.5) {
-                    *pick(rng, &line_starts(data))
-                } else {
-                    rng.random_range(0..=len)
-                };
+                let at = if rng.random_bool(0.5) { *pick(rng, &line_starts(data)) } else { rng.random_range(0..=len) };
                 data.splice(at..at, tok);
             }
             9 => {
@@ -787,7 +868,14 @@ fn execute(target: Target, input: &[u8], o: &Opts, st: &mut Stats, pool: &mut Ve
         st.execs += 1;
         dt = dt.min(dt2);
         if dt > limit {
-            fail(st, target, o, format!("slow: over {} ms", o.slow_ms), format!("took {:.1} ms", dt.as_secs_f64() * 1e3), input);
+            fail(
+                st,
+                target,
+                o,
+                format!("slow: over {} ms", o.slow_ms),
+                format!("took {:.1} ms", dt.as_secs_f64() * 1e3),
+                input,
+            );
         }
     }
     if dt > st.slowest {
@@ -801,7 +889,8 @@ fn execute(target: Target, input: &[u8], o: &Opts, st: &mut Stats, pool: &mut Ve
             }
             if !st.signatures.contains(&sig) {
                 st.signatures.insert(sig);
-                if pool.len() < MAX_POOL {
+                // slow inputs are not bred from: they would eat the time budget
+                if pool.len() < MAX_POOL && dt < limit / 4 {
                     pool.push(input.to_vec());
                 }
             }
@@ -913,7 +1002,12 @@ fn main() {
         }
         for (bucket, (n, input, msg)) in &st.failures {
             failed = true;
-            println!("  FAIL [{}] {n} x {bucket}\n       {}\n       input: {}", t.name(), msg.replace('\n', "\n       "), show(input));
+            println!(
+                "  FAIL [{}] {n} x {bucket}\n       {}\n       input: {}",
+                t.name(),
+                msg.replace('\n', "\n       "),
+                show(input)
+            );
         }
     }
     std::process::exit(if failed { 1 } else { 0 });
