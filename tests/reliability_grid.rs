@@ -81,7 +81,7 @@ fn dense_grid_has_valid_finite_numbers_or_an_explicit_status() {
                         if let Err(e) = check(&m, &op, &s, "warm") {
                             failures.push(e);
                         }
-                        if (i * N_TORQUE + j) % 5 == 0 {
+                        if (i * N_TORQUE + j).is_multiple_of(5) {
                             let c = solve(&m, &op);
                             points += 1;
                             if let Err(e) = check(&m, &op, &c, "cold") {

@@ -177,3 +177,29 @@ fn known_bug_valid_status_with_non_finite_numbers() {
     }
     assert!(bad.is_empty(), "{} case(s):\n{}", bad.len(), bad.join("\n"));
 }
+
+/// solve.rs `solve_effects` (candidate form of `thermal_drift`): μ·(1 + b·ΔT) and
+/// k·(1 + a·ΔT) are not kept positive. With b = -0.05 /K (inside the effect's valid range
+/// [-0.05, 0.05]) the friction coefficient turns negative past 20 K of heating, and the
+/// solver reports status `stall` (valid) with a negative stall torque at zero load:
+/// `trum point --motor trum60a --effect
+/// thermal_drift:stiffness_coefficient_per_k=-0.0004,friction_coefficient_per_k=-0.05
+/// --preload-n 250 --voltage-v 400 --elapsed-s 3600` prints stall, stall_torque_nm
+/// -2.42349, temperature rise 46.2 K, exit 0. Found by
+/// `effects_keep_status_and_numbers_consistent` (tests/reliability_props.rs).
+#[test]
+fn known_bug_thermal_drift_makes_friction_negative() {
+    let mut m = preset("trum60a").expect("preset");
+    m.effects.set(trum_core::Effect::ThermalDrift, &[-0.0004, -0.05]);
+    assert!(m.validate("x", None).is_ok());
+    let mut op = OperatingPoint::new(250.0, 0.0, 400.0, 43_000.0);
+    op.elapsed_s = 3600.0;
+    let s = solve(&m, &op);
+    assert!(
+        !s.status.is_valid() || s.stall_torque_nm >= 0.0,
+        "status {} with stall torque {} N·m (temperature rise {} K)",
+        s.status,
+        s.stall_torque_nm,
+        s.temperature_rise_at_elapsed_k
+    );
+}

