@@ -44,10 +44,8 @@ pub fn observations(m: &Measurements, motor: &Motor) -> BenchData {
     for i in 0..m.len() {
         let mut op = OperatingPoint::new(m.preload_n[i], m.torque_nm[i], m.voltage_v[i], m.frequency_hz[i]);
         op.elapsed_s = m.value(Column::ElapsedS, i).unwrap_or(0.0);
-        let readings = present
-            .iter()
-            .filter_map(|&o| m.value(column_of(o), i).map(|v| (o, v, o.default_sigma(v))))
-            .collect();
+        let readings =
+            present.iter().filter_map(|&o| m.value(column_of(o), i).map(|v| (o, v, o.default_sigma(v)))).collect();
         let ambient_c = m.value(Column::AmbientC, i).unwrap_or(motor.thermal.ambient_c);
         rows.push(ObservedRow { op, readings, ambient_c });
     }
@@ -60,7 +58,8 @@ pub fn to_measurements(rows: &[SynthRow]) -> Result<Measurements, TrumError> {
     let mut b = Measurements::builder();
     for r in rows {
         let speed = r.readings.iter().find(|x| x.0 == Observable::SpeedRpm).map(|x| x.1).unwrap_or(0.0);
-        let mut row = Row::new(r.op.preload_n, r.op.voltage_v, r.op.frequency_hz, r.op.torque_nm, speed).with_run_id(&r.run_id);
+        let mut row =
+            Row::new(r.op.preload_n, r.op.voltage_v, r.op.frequency_hz, r.op.torque_nm, speed).with_run_id(&r.run_id);
         for &(o, v) in &r.readings {
             row = match o {
                 Observable::SpeedRpm => row,

@@ -137,12 +137,7 @@ pub struct HeldOut {
 /// window (120 s).
 fn region_key(r: &ObservedRow, group: &str) -> String {
     let t = if r.op.elapsed_s > 0.0 { (r.op.elapsed_s / 120.0).floor() as i64 } else { -1 };
-    format!(
-        "{group}|{}|{}|{}",
-        (r.op.preload_n / 25.0).round() as i64,
-        (r.op.frequency_hz / 500.0).round() as i64,
-        t
-    )
+    format!("{group}|{}|{}|{}", (r.op.preload_n / 25.0).round() as i64, (r.op.frequency_hz / 500.0).round() as i64, t)
 }
 
 /// Scale of each observable for the NRMSE: the spread (standard deviation) of its
@@ -186,14 +181,22 @@ struct CvResult {
 
 /// Start point and parameters of a fit: bounds around the nominal `motor`, starting from
 /// `start` (the full-data baseline calibration, which saves most LM iterations).
-fn fit_params(motor: &Motor, start: &Motor, rows: &[ObservedRow], effects: &[Effect], reduced: bool) -> (Motor, Vec<FitParam>) {
+fn fit_params(
+    motor: &Motor,
+    start: &Motor,
+    rows: &[ObservedRow],
+    effects: &[Effect],
+    reduced: bool,
+) -> (Motor, Vec<FitParam>) {
     let mut m = start.clone();
     let mut params = baseline_params(motor, rows);
     if reduced {
         // few readings: keep friction, damping and force factor only
         params.retain(|fp| {
             let n = fp.param.name();
-            n.ends_with("friction_coefficient") || n.ends_with("modal_damping_ns_per_m") || n.ends_with("force_factor_n_per_v")
+            n.ends_with("friction_coefficient")
+                || n.ends_with("modal_damping_ns_per_m")
+                || n.ends_with("force_factor_n_per_v")
         });
     }
     for &e in effects {
@@ -266,13 +269,25 @@ fn errors(rows: &[ObservedRow], preds: &[Vec<f64>], sc: &BTreeMap<Observable, f6
 
 /// Diagnoses `rows` (with `groups[i]` the run of row i; empty strings are fine) against
 /// `motor`. Errors on data that cannot support any held-out test.
-pub fn diagnose(motor: &Motor, rows: &[ObservedRow], groups: &[String], opts: &DiagnoseOptions) -> Result<Diagnosis, TrumError> {
+pub fn diagnose(
+    motor: &Motor,
+    rows: &[ObservedRow],
+    groups: &[String],
+    opts: &DiagnoseOptions,
+) -> Result<Diagnosis, TrumError> {
     let n_read: usize = rows.iter().map(|r| r.readings.len()).sum();
     if rows.len() < 4 {
-        return Err(TrumError::input(format!("{} rows are too few to diagnose anything; need at least 4 operating points", rows.len())));
+        return Err(TrumError::input(format!(
+            "{} rows are too few to diagnose anything; need at least 4 operating points",
+            rows.len()
+        )));
     }
     // regions → folds
-    let keys: Vec<String> = rows.iter().zip(groups.iter().chain(std::iter::repeat(&String::new()))).map(|(r, g)| region_key(r, g)).collect();
+    let keys: Vec<String> = rows
+        .iter()
+        .zip(groups.iter().chain(std::iter::repeat(&String::new())))
+        .map(|(r, g)| region_key(r, g))
+        .collect();
     let mut uniq: Vec<&String> = keys.iter().collect();
     uniq.sort();
     uniq.dedup();
@@ -330,10 +345,16 @@ pub fn diagnose(motor: &Motor, rows: &[ObservedRow], groups: &[String], opts: &D
         notes.push("no speed_std_rpm column: eccentricity shows only through the mean speed".into());
     }
     if !has(Observable::InputPowerW) && !has(Observable::CurrentA) {
-        notes.push("no electrical readings (input_power_w, current_a): voltage_sag and the losses are weakly constrained".into());
+        notes.push(
+            "no electrical readings (input_power_w, current_a): voltage_sag and the losses are weakly constrained"
+                .into(),
+        );
     }
     if !varies(&|r| r.op.torque_nm) {
-        notes.push("load torque never varies: the speed-torque curve (radial_friction, tangential_compliance) is not observed".into());
+        notes.push(
+            "load torque never varies: the speed-torque curve (radial_friction, tangential_compliance) is not observed"
+                .into(),
+        );
     }
 
     // candidates in parallel
@@ -367,7 +388,9 @@ pub fn diagnose(motor: &Motor, rows: &[ObservedRow], groups: &[String], opts: &D
     let mut confounded = Vec::new();
     if !adequate {
         let best_single = ranking.first().cloned();
-        let closes = best_single.as_ref().is_some_and(|b| b.shrink > 0.0 && close_nrmse(b.heldout_nrmse_after) && b.evidence > 3.0);
+        let closes = best_single
+            .as_ref()
+            .is_some_and(|b| b.shrink > 0.0 && close_nrmse(b.heldout_nrmse_after) && b.evidence > 3.0);
         if closes {
             verdict = best_single.as_ref().map(|b| b.effect.clone()).unwrap_or_default();
         } else if opts.try_pairs && ranking.len() >= 2 {
@@ -387,7 +410,9 @@ pub fn diagnose(motor: &Motor, rows: &[ObservedRow], groups: &[String], opts: &D
                 Some(bp) if close_nrmse(bp.heldout_nrmse_after) && bp.evidence > 3.0 => {
                     // name the stronger single effect first
                     let names: Vec<&str> = bp.effect.split('+').collect();
-                    let ev = |n: &str| ranking.iter().find(|r| r.effect == n).map(|r| r.evidence).unwrap_or(f64::NEG_INFINITY);
+                    let ev = |n: &str| {
+                        ranking.iter().find(|r| r.effect == n).map(|r| r.evidence).unwrap_or(f64::NEG_INFINITY)
+                    };
                     let mut ns = names.clone();
                     ns.sort_by(|a, b| ev(b).total_cmp(&ev(a)));
                     let joined = ns.join("+");
@@ -427,8 +452,11 @@ pub fn diagnose(motor: &Motor, rows: &[ObservedRow], groups: &[String], opts: &D
 
     // where the gap lies: baseline full-fit residuals by quantity and region
     let gap_where = locate_gap(&base_cal.motor, rows);
-    let after_motor_effects: Vec<Effect> =
-        if verdict == "none" || verdict == "unexplained" { Vec::new() } else { verdict.split('+').filter_map(|n| Effect::from_name(n).ok()).collect() };
+    let after_motor_effects: Vec<Effect> = if verdict == "none" || verdict == "unexplained" {
+        Vec::new()
+    } else {
+        verdict.split('+').filter_map(|n| Effect::from_name(n).ok()).collect()
+    };
     let after_preds = if after_motor_effects.is_empty() {
         base_cv.preds.clone()
     } else {
@@ -437,7 +465,13 @@ pub fn diagnose(motor: &Motor, rows: &[ObservedRow], groups: &[String], opts: &D
     let mut heldout = Vec::new();
     for (i, r) in rows.iter().enumerate() {
         for (j, &(o, v, _)) in r.readings.iter().enumerate() {
-            heldout.push(HeldOut { row: i, observable: o, measured: v, baseline: base_cv.preds[i][j], after: after_preds[i][j] });
+            heldout.push(HeldOut {
+                row: i,
+                observable: o,
+                measured: v,
+                baseline: base_cv.preds[i][j],
+                after: after_preds[i][j],
+            });
         }
     }
     Ok(Diagnosis {
@@ -540,7 +574,13 @@ fn locate_gap(motor: &Motor, rows: &[ObservedRow]) -> Vec<GapRegion> {
                 mean_z /= n;
                 let z = mean_z * n.sqrt();
                 if z.abs() > 3.5 {
-                    out.push(GapRegion { quantity: o.column().into(), region: label.clone(), mean_residual: mean_raw, n: sel.len(), z });
+                    out.push(GapRegion {
+                        quantity: o.column().into(),
+                        region: label.clone(),
+                        mean_residual: mean_raw,
+                        n: sel.len(),
+                        z,
+                    });
                 }
             }
         }

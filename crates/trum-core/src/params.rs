@@ -443,13 +443,29 @@ impl Motor {
             let token = e.span().map(|s| text.get(s.clone()).unwrap_or("").trim().to_string()).unwrap_or_default();
             let msg = e.message().trim().to_string();
             let msg = msg.replace("unknown field", "unknown key").replace("field", "key");
+            // serde's untagged-enum message names a Rust type; say what the key accepts.
+            if msg.contains("untagged enum AxisSpec") {
+                let line = e.span().map(|s| line_of_offset(text, s.start));
+                let key = line
+                    .and_then(|l| text.lines().nth(l - 1))
+                    .and_then(|l| l.split('=').next())
+                    .map(|k| format!("sweep.{}", k.trim()))
+                    .unwrap_or_else(|| "sweep".into());
+                return ParamError {
+                    source_name: source_name.into(),
+                    line,
+                    key,
+                    reason: "expected a number or [start, stop, n]".into(),
+                };
+            }
             let key = if token.len() < 64 && !token.contains('\n') && !token.is_empty() && msg.starts_with("unknown") {
                 // qualify the key with the section header above it
                 let start = e.span().map(|s| s.start).unwrap_or(0).min(text.len());
                 let section = text[..start]
                     .lines()
                     .rev()
-                    .find_map(|l| l.trim().strip_prefix('[').map(|h| h.trim_end_matches(']').trim().to_string()));
+                    .find_map(|l| l.trim().strip_prefix('[').map(|h| h.trim_end_matches(']').trim().to_string()))
+                    .filter(|sec| !sec.is_empty());
                 match section {
                     Some(sec) if sec != token => format!("{sec}.{token}"),
                     _ => token,

@@ -533,7 +533,9 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
             (d.ks, d.mu) = if p.truth {
                 (p.ks * (a * rise).exp(), p.mu * (b * rise).exp())
             } else {
-                (p.ks * (1.0 + a * rise), p.mu * (1.0 + b * rise))
+                // linear laws, floored at 5 % of nominal so a large drift cannot make the
+                // stiffness or the friction coefficient non-physical
+                (p.ks * (1.0 + a * rise).max(0.05), p.mu * (1.0 + b * rise).max(0.05))
             };
         }
         let prev = s.clone();
@@ -684,16 +686,11 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
     }
     let mut lo: Option<Trial> = None;
     // Start: warm guess if it lies inside the bracket, else one fixed-point step from the top.
-    // A warm amplitude is used only by the baseline, whose amplitude map has one fixed
-    // point in practice (tests/model_reference.rs); effects that add stiffness or a
-    // numerical interface can create several, and the descent from the bound then picks
-    // the running branch deterministically.
-    let baseline = p.law.radial_ratio == 0.0 && p.compliance == 0.0 && p.stiffening == 0.0 && p.beta == 0.0;
-    let start = guess
-        .filter(|_| baseline)
-        .map(|g| g.amplitude_m)
-        .filter(|w| w.is_finite() && *w > 0.0 && *w < hi.w)
-        .unwrap_or(hi.w_next);
+    // The amplitude always descends from the bound onto the largest fixed point: a warm
+    // amplitude from a neighbouring point can sit below the middle one of several fixed
+    // points and fall onto another branch (found by tests/reliability_known_bugs.rs). The
+    // guess still warm-starts the inner stick-angle solves.
+    let start = hi.w_next;
     let mut cur = eval(start, &mut ts_guess);
     let mut prev: Option<Trial> = None;
     let mut converged = false;
@@ -790,6 +787,16 @@ fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {
 }
 
 fn finish(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, status: Status, evals: u32) -> Solution {
+    let mut s = finish_unchecked(p, d, op, t, status, evals);
+    // Extreme but valid inputs (1e-300 V, 1e200 Hz resonance, ...) can overflow; such a
+    // point has no trustworthy solution and must say so rather than report NaN as ok.
+    if s.status.is_valid() && crate::quantities::QUANTITIES.iter().any(|q| !(q.get)(&s).is_finite()) {
+        s.status = Status::NoConvergence;
+    }
+    s
+}
+
+fn finish_unchecked(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, status: Status, evals: u32) -> Solution {
     let w = t.w;
     let ct = &t.contact;
     let clamped = status == Status::Clamped;

@@ -77,7 +77,7 @@ def test_sweep_table_values_are_not_checked_by_the_python_reader(path):
 
 
 @pytest.mark.parametrize("path", NOT_UTF8, ids=lambda p: p.name)
-def test_known_bug_non_utf8_motor_file_raises_trum_error(path):
+def test_non_utf8_motor_file_raises_trum_error(path):
     # KNOWN BUG (docs/RELIABILITY.md): Motor.from_toml opens the file with
     # encoding="utf-8" and lets UnicodeDecodeError escape; it must raise a TrumError that
     # names the file, like the CLI ("cannot read motor file ...: ... UTF-8").

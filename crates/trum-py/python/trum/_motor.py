@@ -8,7 +8,7 @@ from typing import Any, Dict, Iterable, List, Mapping, Optional, Tuple, Union
 import numpy as np
 
 from . import _trum
-from ._errors import InputError, ParameterError, ParameterKeyError
+from ._errors import InputError, ParameterError, ParameterKeyError, TrumError
 from ._result import Result
 
 ArrayLike = Any  # scalar or array of real numbers
@@ -108,8 +108,13 @@ class Motor:
     @classmethod
     def from_toml(cls, path: Union[str, "os.PathLike[str]"]) -> "Motor":
         """Reads a TOML motor file (``preset = "..."`` plus overrides, or every key)."""
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
+        with open(path, "rb") as f:
+            raw = f.read()
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError:
+            # same words as the CLI
+            raise TrumError(f"cannot read motor file '{os.fspath(path)}': stream did not contain valid UTF-8") from None
         return cls.from_toml_str(text, os.fspath(path))
 
     @classmethod
