@@ -10,5 +10,7 @@ cargo test --workspace --exclude trum-py
 cargo run --release --manifest-path fuzz/Cargo.toml -- --seconds 10 --target all --slow-ms 2000
 if [ -x scripts/test-python.sh ]; then
   echo "== Python"
+  # the CLI built by `cargo test` above: Python must agree with `trum point --json`
+  export TRUM_BIN="$PWD/target/debug/trum"
   bash scripts/test-python.sh
 fi
