@@ -436,7 +436,8 @@ impl Effects {
     /// `[effects]` section in TOML (empty string when none is on).
     pub fn to_toml(&self) -> String {
         if self.is_none() {
-            return "\n[effects]  # none switched on; see `trum effects`\n".into();
+            let form = if self.truth { "form = \"truth\"\n" } else { "" };
+            return format!("\n[effects]  # none switched on; see `trum effects`\n{form}");
         }
         let mut s = String::from("\n[effects]\n");
         if self.truth {
