@@ -1,0 +1,260 @@
+//! End-to-end tests of `trum synth`, `trum calibrate` and `trum diagnose`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn trum(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_trum")).args(args).output().expect("run trum")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = trum(args);
+    assert_eq!(o.status.code(), Some(0), "{args:?}: {}", text(&o.stderr));
+    text(&o.stdout)
+}
+
+/// Runs and expects failure with `code`; returns stderr.
+fn fails(args: &[&str], code: i32) -> String {
+    let o = trum(args);
+    assert_eq!(o.status.code(), Some(code), "{args:?}: stdout {} stderr {}", text(&o.stdout), text(&o.stderr));
+    let e = text(&o.stderr);
+    assert!(!e.contains("panicked"), "{e}");
+    e
+}
+
+fn path(dir: &Path, name: &str) -> String {
+    dir.join(name).to_string_lossy().into_owned()
+}
+
+fn synth(dir: &Path, name: &str, extra: &[&str]) -> String {
+    let p = path(dir, name);
+    let mut args = vec!["synth", "--motor", "trum60a", "-o", &p];
+    args.extend_from_slice(extra);
+    ok(&args);
+    p
+}
+
+fn snapshot(name: &str, actual: &str) {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots").join(name);
+    if std::env::var_os("UPDATE_SNAPSHOTS").is_some() {
+        std::fs::write(&path, actual).expect("write snapshot");
+        return;
+    }
+    let expected = std::fs::read_to_string(&path)
+        .unwrap_or_else(|_| panic!("missing snapshot {}; run with UPDATE_SNAPSHOTS=1", path.display()));
+    assert_eq!(actual, expected, "snapshot {name} differs; if intended, rerun with UPDATE_SNAPSHOTS=1");
+}
+
+#[test]
+fn synth_writes_a_valid_reproducible_file() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let base = ["--campaign", "stability", "--noise", "1", "--seed", "1"];
+    let a = synth(d, "a.csv", &base);
+    let b = synth(d, "b.csv", &base);
+    let c = synth(d, "c.csv", &["--campaign", "stability", "--noise", "1", "--seed", "2"]);
+    let (a, b, c) = (std::fs::read(a).expect("a"), std::fs::read(b).expect("b"), std::fs::read(c).expect("c"));
+    assert_eq!(a, b, "same seed, same bytes");
+    assert_ne!(a, c, "different seed, different data");
+    let m = trum_core::measurements::parse_measurements(&a, "a.csv").expect("the reader accepts synth output");
+    assert_eq!(m.len(), 8);
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+    assert!(m.has(trum_core::measurements::Column::SpeedStdRpm));
+    // stdout gives the same bytes
+    let o = trum(&["synth", "--motor", "trum60a", "-o", "-", &base[0], base[1], base[2], base[3], base[4], base[5]]);
+    assert_eq!(o.stdout, a);
+    // --omit drops columns; effects change the data; truth and candidate forms differ
+    let om = synth(d, "om.csv", &[&base[..], &["--omit", "feedback_v,current_a"]].concat());
+    let header = std::fs::read_to_string(om).expect("om").lines().next().unwrap_or_default().to_string();
+    assert!(!header.contains("feedback_v") && !header.contains("current_a") && header.contains("input_power_w"));
+    let eff = ["--campaign", "preload-torque", "--noise", "0", "--seed", "1", "--effect", "radial_friction=0.5"];
+    let truth = std::fs::read(synth(d, "t.csv", &eff)).expect("t");
+    let cand = std::fs::read(synth(d, "cf.csv", &[&eff[..], &["--candidate-forms"]].concat())).expect("cf");
+    let none = std::fs::read(synth(d, "n.csv", &eff[..6])).expect("n");
+    assert_ne!(truth, none);
+    assert_ne!(truth, cand);
+}
+
+#[test]
+fn synth_errors_list_the_valid_names() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = path(dir.path(), "x.csv");
+    let e = fails(&["synth", "--motor", "trum60a", "--campaign", "sweep", "--noise", "1", "--seed", "1", "-o", &o], 2);
+    for n in trum_core::synth::Campaign::NAMES {
+        assert!(e.contains(n), "{e}");
+    }
+    let e = fails(
+        &[
+            "synth",
+            "--motor",
+            "trum60a",
+            "--effect",
+            "radial=1",
+            "--campaign",
+            "stability",
+            "--noise",
+            "1",
+            "--seed",
+            "1",
+            "-o",
+            &o,
+        ],
+        1,
+    );
+    assert!(e.contains("unknown effect 'radial'"), "{e}");
+    for n in trum_core::effects::EFFECTS.iter().map(|e| e.name) {
+        assert!(e.contains(n), "{e}");
+    }
+    let e = fails(
+        &[
+            "synth",
+            "--motor",
+            "trum60a",
+            "--campaign",
+            "stability",
+            "--noise",
+            "1",
+            "--seed",
+            "1",
+            "--omit",
+            "speed",
+            "-o",
+            &o,
+        ],
+        1,
+    );
+    assert!(e.contains("'speed'") && e.contains("input_power_w") && e.contains("speed_std_rpm"), "{e}");
+    let e =
+        fails(&["synth", "--motor", "trum60a", "--campaign", "stability", "--noise", "-1", "--seed", "1", "-o", &o], 1);
+    assert!(e.contains("noise level -1"), "{e}");
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0, "a failed synth leaves no file");
+}
+
+#[test]
+fn calibrate_writes_a_motor_file_that_point_reads() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let data = synth(d, "pt.csv", &["--campaign", "preload-torque", "--noise", "1", "--seed", "4"]);
+    let (toml, json) = (path(d, "cal.toml"), path(d, "cal.json"));
+    let out = ok(&["calibrate", "--motor", "trum60a", "--data", &data, "-o", &toml, "--json", &json]);
+    assert!(out.contains("friction_layer.friction_coefficient") && out.contains("std error"), "{out}");
+    assert!(out.contains("chi2"), "{out}");
+    let p = ok(&["point", "--motor", &toml, "--preload-n", "250", "--torque-nm", "0.3", "--json"]);
+    let p: serde_json::Value = serde_json::from_str(&p).expect("point JSON");
+    assert_eq!(p["status"], "ok");
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("JSON");
+    let params = j["params"].as_array().expect("params");
+    assert!(params.len() >= 5);
+    for q in params {
+        let (v, se) = (q["value"].as_f64().expect("value"), q["std_error"].as_f64().expect("std error"));
+        // a plausible uncertainty: positive, and well below the value for this rich campaign
+        assert!(se > 1e-9 * v.abs() && se < 0.5 * v.abs(), "{q}");
+    }
+    assert!(j["chi2_per_reading"].as_f64().expect("chi2") > 0.0);
+}
+
+/// One diagnosis of a no-effect campaign: JSON fields and values, the report, the summary.
+#[test]
+fn diagnose_without_effect_says_none() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let data = synth(d, "st.csv", &["--campaign", "stability", "--noise", "1", "--seed", "3"]);
+    let (json, html) = (path(d, "d.json"), path(d, "d.html"));
+    let out = ok(&["diagnose", "--motor", "trum60a", "--data", &data, "--json", &json, "--report", &html]);
+    assert!(out.contains("verdict     none"), "{out}");
+    assert!(out.contains("ranking (evidence = ½·ΔBIC"), "{out}");
+    let raw = std::fs::read_to_string(&json).expect("json");
+    assert!(!raw.contains("NaN") && !raw.contains("Infinity"), "JSON has no NaN");
+    let j: serde_json::Value = serde_json::from_str(&raw).expect("JSON");
+    assert_eq!(j["verdict"], "none");
+    assert!(j["confounded_with"].as_array().expect("confounded_with").is_empty());
+    let before = j["gap"]["baseline_heldout_nrmse"].as_f64().expect("before");
+    assert!(before >= 0.0 && j["gap"]["noise_nrmse"].as_f64().expect("noise") >= 0.0);
+    for w in j["gap"]["where"].as_array().expect("where") {
+        assert!(w["quantity"].is_string() && w["region"].is_string() && w["mean_residual"].is_number(), "{w}");
+    }
+    let ranking = j["ranking"].as_array().expect("ranking");
+    let names: Vec<&str> = ranking.iter().filter_map(|r| r["effect"].as_str()).collect();
+    for e in trum_core::effects::EFFECTS.iter().map(|e| e.name) {
+        assert!(names.contains(&e), "{e} missing from {names:?}");
+    }
+    let ev: Vec<f64> = ranking.iter().map(|r| r["evidence"].as_f64().unwrap_or(f64::NEG_INFINITY)).collect();
+    assert!(ev.windows(2).all(|w| w[0] >= w[1]), "ranking sorted by evidence: {ev:?}");
+    for r in ranking {
+        let after = r["heldout_nrmse_after"].as_f64().expect("after");
+        let shrink = r["shrink"].as_f64().expect("shrink");
+        assert!(after >= 0.0);
+        assert!((shrink - (1.0 - after / before)).abs() < 1e-9, "{r}");
+        assert_eq!(r["shrink_interval"].as_array().map(Vec::len), Some(2));
+    }
+    assert!(j["evidence_scale"].as_str().expect("scale").contains("> 3 strong, > 5 very strong"));
+    assert_eq!(j["n_rows"], 8);
+    assert!(j["folds"].as_u64().expect("folds") >= 2 && j["baseline_params"].is_array() && j["notes"].is_array());
+    let page = std::fs::read_to_string(&html).expect("html");
+    assert!(page.starts_with("<!DOCTYPE html>") && page.contains("<svg") && page.contains("Verdict"), "html");
+    assert!(!page.contains("src=\"http") && !page.contains("href=\"http"), "self-contained");
+    // --json - sends only the JSON to stdout
+    let o = ok(&["diagnose", "--motor", "trum60a", "--data", &data, "--json", "-"]);
+    let again: serde_json::Value = serde_json::from_str(&o).expect("stdout JSON");
+    assert_eq!(again["ranking"], j["ranking"], "deterministic");
+}
+
+fn write(dir: &Path, name: &str, body: &str) -> String {
+    let p = path(dir, name);
+    std::fs::write(&p, body).expect("write");
+    p
+}
+
+#[test]
+fn diagnose_errors_are_clear() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let diag = |data: &str| fails(&["diagnose", "--motor", "trum60a", "--data", data], 1);
+    let f = write(d, "nospeed.csv", "preload_n,voltage_v,frequency_hz,torque_nm\n250,200,43000,0\n");
+    let e = diag(&f);
+    assert!(e.contains("nospeed.csv") && e.contains("'speed_rpm'"), "{e}");
+    let f = write(d, "header.csv", "preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n");
+    let e = diag(&f);
+    assert!(e.contains("header.csv") && e.contains("no data rows"), "{e}");
+    let mut one = String::from("preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n");
+    for k in 0..6 {
+        one.push_str(&format!("250,200,43000,{},{}\n", 0.1 * k as f64, 120.0 - 10.0 * k as f64));
+    }
+    let f = write(d, "one.csv", &one);
+    let e = diag(&f);
+    assert!(e.contains("one.csv") && e.contains("one operating region"), "{e}");
+    let f = write(
+        d,
+        "few.csv",
+        "preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n150,200,43000,0,120\n250,200,43000,0,110\n",
+    );
+    let e = diag(&f);
+    assert!(e.contains("too few"), "{e}");
+    let f = write(d, "bad.csv", "preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n250,200,43000,0,fast\n");
+    let e = diag(&f);
+    assert!(e.contains("line 2") && e.contains("'speed_rpm'") && e.contains("\"fast\""), "{e}");
+    let e = diag(&path(d, "missing.csv"));
+    assert!(e.contains("missing.csv") && e.contains("does not exist"), "{e}");
+    let e = fails(&["diagnose", "--motor", "trum61", "--data", &f], 1);
+    assert!(e.contains("unknown preset 'trum61'"), "{e}");
+    // an unwritable output fails at once, before the long run
+    let good = synth(d, "st.csv", &["--campaign", "stability", "--noise", "1", "--seed", "1"]);
+    let e = fails(&["diagnose", "--motor", "trum60a", "--data", &good, "--json", &path(d, "no/such/dir/x.json")], 1);
+    assert!(e.contains("does not exist"), "{e}");
+    fails(&["diagnose", "--motor", "trum60a"], 2);
+    let e = fails(
+        &[
+            "calibrate",
+            "--motor",
+            "trum60a",
+            "--data",
+            &write(d, "h2.csv", "preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n"),
+        ],
+        1,
+    );
+    assert!(e.contains("no data rows"), "{e}");
+}
