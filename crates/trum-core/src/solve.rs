@@ -488,10 +488,12 @@ pub fn solve_prepared(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: O
     if op.invalid_reason().is_some() {
         return Solution::invalid(Status::InvalidInput);
     }
-    if p.runout_m > 0.0 {
-        return eccentric_average(p, motor, op, guess);
+    let mut s = if p.runout_m > 0.0 { eccentric_average(p, motor, op, guess) } else { solve_effects(p, op, guess) };
+    // Every path (averaged ones too): non-finite numbers never carry a valid status.
+    if s.status.is_valid() && crate::quantities::QUANTITIES.iter().any(|q| !(q.get)(&s).is_finite()) {
+        s.status = Status::NoConvergence;
     }
-    solve_effects(p, op, guess)
+    s
 }
 
 /// Effects that depend on the solution itself (temperature from the losses, electrode
