@@ -91,6 +91,7 @@ pub fn to_json(d: &Diagnosis, motor: &Motor, motor_arg: &str, data: &str, bench:
             "baseline_heldout_nrmse": num(d.baseline_heldout_nrmse),
             "noise_nrmse": num(d.noise_nrmse),
             "baseline_heldout_chi2_per_reading": num(d.baseline_heldout_chi2_per_reading),
+            "noise_scale": d.noise_scale.iter().map(|(q, f, n)| json!({"quantity": q, "factor": num(*f), "residuals": n})).collect::<Vec<_>>(),
             "where": d.gap_where.iter().map(|g| json!({
                 "quantity": g.quantity,
                 "region": g.region,
@@ -104,6 +105,7 @@ pub fn to_json(d: &Diagnosis, motor: &Motor, motor_arg: &str, data: &str, bench:
             "effect": r.effect,
             "evidence": num(r.evidence),
             "heldout_nrmse_after": num(r.heldout_nrmse_after),
+            "heldout_chi2_after": num(r.heldout_chi2_after),
             "shrink": num(r.shrink),
             "shrink_interval": [num(r.shrink_interval.0), num(r.shrink_interval.1)],
             "params": pairs(&r.params),

@@ -262,6 +262,36 @@ pub struct Calibration {
     pub evaluations: usize,
     /// Warnings (bounds, identifiability, failed solves).
     pub warnings: Vec<String>,
+    /// The fit linearised at its optimum (for approximate leave-block-out refits).
+    pub(crate) lin: Linearisation,
+}
+
+/// A fit linearised at its optimum: the start motor the parameters are applied to, the
+/// transformed parameters u, the final Huber weights, the weighted residuals and their
+/// Jacobian with respect to u (one row per reading, rows in reading order).
+#[derive(Clone, Debug)]
+pub(crate) struct Linearisation {
+    pub(crate) base: Motor,
+    pub(crate) params: Vec<FitParam>,
+    pub(crate) u: DVector<f64>,
+    pub(crate) weights: Vec<f64>,
+    pub(crate) residuals: DVector<f64>,
+    pub(crate) jacobian: DMatrix<f64>,
+}
+
+impl Linearisation {
+    /// The motor at transformed parameters `u`.
+    pub(crate) fn motor_at(&self, u: &DVector<f64>) -> Motor {
+        motor_at(&self.base, &self.params, u)
+    }
+}
+
+fn motor_at(base: &Motor, params: &[FitParam], u: &DVector<f64>) -> Motor {
+    let mut m = base.clone();
+    for (fp, &ui) in params.iter().zip(u.iter()) {
+        fp.param.set(&mut m, fp.from_u(ui));
+    }
+    m
 }
 
 /// Normalised residuals (prediction − measurement)/σ of every reading of `rows`, in
@@ -295,11 +325,7 @@ struct Problem<'a> {
 
 impl Problem<'_> {
     fn motor_at(&self, u: &DVector<f64>) -> Motor {
-        let mut m = self.base.clone();
-        for (fp, &ui) in self.params.iter().zip(u.iter()) {
-            fp.param.set(&mut m, fp.from_u(ui));
-        }
-        m
+        motor_at(&self.base, self.params, u)
     }
     fn weighted(&self, u: &DVector<f64>) -> DVector<f64> {
         self.evals.set(self.evals.get() + 1);
@@ -454,7 +480,15 @@ pub fn calibrate(
         out.push(FittedParam { name: fp.param.name(), value, std_error: se, at_bound, identifiable });
     }
     let evaluations = problem.evals.get();
-    Ok(Calibration { motor: fitted, params: out, chi2, n_readings: n_read, evaluations, warnings })
+    let lin = Linearisation {
+        residuals: DVector::from_iterator(r.len(), r.iter().zip(&problem.weights).map(|(x, w)| x * w)),
+        base: problem.base,
+        params: params.to_vec(),
+        u: problem.u,
+        weights: problem.weights,
+        jacobian: j,
+    };
+    Ok(Calibration { motor: fitted, params: out, chi2, n_readings: n_read, evaluations, warnings, lin })
 }
 
 #[cfg(test)]

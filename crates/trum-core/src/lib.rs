@@ -21,6 +21,7 @@ pub mod fluctuation;
 pub mod interface;
 pub mod losses;
 pub mod measurements;
+pub mod noise;
 pub mod papers;
 pub mod params;
 pub mod presets;

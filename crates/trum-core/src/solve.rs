@@ -356,8 +356,9 @@ fn coulomb_interface(
 }
 
 /// Generalised interface (radial slip, saturating traction): the rotor speed ratio
-/// u = v_r/v0 solves R0·μ·A·torque(u) = T_load + d_r·v0·u/R0 by safeguarded regula falsi
-/// (torque(u) decreases with u, so the root is unique).
+/// u = v_r/v0 solves R0·μ·A·torque(u) = T_load + d_r·v0·u/R0 by Newton steps with the
+/// analytic ∂torque/∂u, safeguarded by a bracket (torque(u) decreases with u, so the root
+/// is unique); a step that leaves the bracket falls back to regula falsi.
 fn general_interface(
     p: &Prepared,
     d: &Drive,
@@ -377,53 +378,52 @@ fn general_interface(
     if f0 < 0.0 {
         return (contact::stall_stick_half_angle_rad(ct), 0.0, true, fac0, fac0.torque);
     }
-    // Bracket [lo, hi] with f(lo) ≥ 0 > f(hi); a warm start narrows it first.
-    let (mut lo, mut flo, mut hi, mut fhi, mut best);
-    (lo, flo) = (0.0, f0);
-    let (f1, fac1) = f(1.0);
-    if f1 >= 0.0 {
-        return (0.0, v0, false, fac1, fac0.torque);
-    }
-    (hi, fhi, best) = (1.0, f1, fac1);
-    if let Some(g) = ts_guess.map(f64::cos).filter(|g| *g > 0.0 && *g < 1.0) {
-        for w in [g - 0.01, g + 0.01] {
-            let w = w.clamp(1e-6, 1.0 - 1e-6);
-            if w > lo && w < hi {
-                let (fw, fac) = f(w);
-                if fw >= 0.0 {
-                    (lo, flo) = (w, fw);
-                } else {
-                    (hi, fhi, best) = (w, fw, fac);
-                }
+    // Bracket [lo, hi] with f(lo) ≥ 0 > f(hi). f(1) (the rotor at crest speed) is only
+    // evaluated when the iteration needs it: with a warm guess it rarely does.
+    let (mut lo, mut flo, mut hi, mut fhi) = (0.0, f0, 1.0, f64::NAN);
+    let mut u = match ts_guess.map(f64::cos).filter(|g| *g > 0.0 && *g < 1.0) {
+        Some(g) => g,
+        None => {
+            let (f1, fac1) = f(1.0);
+            if f1 >= 0.0 {
+                return (0.0, v0, false, fac1, fac0.torque);
             }
+            fhi = f1;
+            lo - flo * (hi - lo) / (fhi - flo)
         }
-    }
-    // Illinois regula falsi: superlinear, and never leaves the bracket.
-    let mut u = hi;
-    let mut side = 0i8;
+    };
+    let mut best = fac0;
     for _ in 0..60 {
-        u = lo - flo * (hi - lo) / (fhi - flo);
-        if !(u > lo && u < hi) {
-            u = 0.5 * (lo + hi);
-        }
         let (fu, fac) = f(u);
         best = fac;
         if fu >= 0.0 {
             (lo, flo) = (u, fu);
-            if side == 1 {
-                fhi *= 0.5;
-            }
-            side = 1;
         } else {
             (hi, fhi) = (u, fu);
-            if side == -1 {
-                flo *= 0.5;
-            }
-            side = -1;
         }
         if hi - lo < 1e-14 || fu.abs() <= 1e-14 * tscale {
             break;
         }
+        let slope = tscale * fac.torque_du - visc;
+        let newton = u - fu / slope;
+        let next = if slope < 0.0 && newton > lo && newton < hi {
+            newton
+        } else if fhi.is_nan() {
+            // the root may sit at u = 1 (no load, no viscous drag): test that end now
+            let (f1, fac1) = f(1.0);
+            if f1 >= 0.0 {
+                return (0.0, v0, false, fac1, fac0.torque);
+            }
+            fhi = f1;
+            lo - flo * (hi - lo) / (fhi - flo)
+        } else {
+            let rf = lo - flo * (hi - lo) / (fhi - flo);
+            if rf > lo && rf < hi { rf } else { 0.5 * (lo + hi) }
+        };
+        if (next - u).abs() < 1e-15 {
+            break;
+        }
+        u = next;
     }
     let ts = u.clamp(-1.0, 1.0).acos().min(ct.half_angle_rad);
     (ts, u * v0, false, best, fac0.torque)

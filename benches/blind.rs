@@ -1,0 +1,96 @@
+//! The blind benchmark of `trum diagnose` (issue 5): every effect × two strengths × two
+//! noise levels × two campaign kinds, null cases and two-effect cases, each synthesised
+//! with `trum synth` (truth forms) and diagnosed without being told the effect.
+//!
+//! `cargo bench --bench blind` runs all cases (about half an hour on 2 cores) and
+//! rewrites the confusion matrix in docs/DIAGNOSIS.md (between the `blind:begin` and
+//! `blind:end` markers) and the per-case table docs/data/blind_cases.csv.
+//! `cargo bench --bench blind -- --slice` runs only the test suite's slice; `--no-write`
+//! prints without touching the docs.
+
+#[path = "../tests/support/blind.rs"]
+mod blind;
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let slice = args.iter().any(|a| a == "--slice");
+    let write = !args.iter().any(|a| a == "--no-write") && !slice;
+    let workers: usize = args
+        .iter()
+        .position(|a| a == "--workers")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2);
+    let cases = if slice { blind::slice_cases() } else { blind::full_cases() };
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<(usize, blind::Outcome)>> = Mutex::new(Vec::new());
+    let t0 = std::time::Instant::now();
+    std::thread::scope(|s| {
+        for _ in 0..workers {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::SeqCst);
+                let Some(case) = cases.get(i) else { break };
+                let o = blind::run_case(case, dir.path());
+                eprintln!(
+                    "[{:>3}/{}] {:>6.0} s  {:<44} {:>4} {:<14} noise {:<3} -> {:<40} confounded {:?} shrink {:?} ({:.1} s)",
+                    i + 1,
+                    cases.len(),
+                    t0.elapsed().as_secs_f64(),
+                    o.case.truth(),
+                    o.case.factor,
+                    o.case.campaign,
+                    o.case.noise,
+                    o.verdict,
+                    o.confounded,
+                    o.true_shrink.map(|x| (x * 100.0).round() / 100.0),
+                    o.seconds
+                );
+                results.lock().expect("results").push((i, o));
+            });
+        }
+    });
+    let mut results = results.into_inner().expect("results");
+    results.sort_by_key(|r| r.0);
+    let outcomes: Vec<blind::Outcome> = results.into_iter().map(|r| r.1).collect();
+    let sum = blind::summarise(&outcomes);
+    let times: Vec<f64> = outcomes.iter().map(|o| o.seconds).collect();
+    let table = blind::confusion_markdown(&outcomes);
+    let summary = format!(
+        "{} cases in {:.0} s wall ({} workers; diagnosis median {:.1} s, max {:.1} s per case).\n\n\
+         * observable non-null cases whose verdict is the injected effect or whose confounded set contains it: \
+         {:.0} % of {}\n* null cases with an effect claimed: {} of {}\n* median held-out shrink of the injected \
+         effect(s) over the observable non-null cases: {:.2}\n",
+        outcomes.len(),
+        t0.elapsed().as_secs_f64(),
+        workers,
+        blind::median(times.clone()),
+        times.iter().cloned().fold(0.0, f64::max),
+        100.0 * sum.hit_rate,
+        sum.non_null,
+        sum.false_claims,
+        sum.nulls,
+        sum.median_true_shrink
+    );
+    println!("{table}\n{summary}");
+    if write {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        std::fs::write(root.join("docs/data/blind_cases.csv"), blind::cases_csv(&outcomes)).expect("write CSV");
+        let doc_path = root.join("docs/DIAGNOSIS.md");
+        let doc = std::fs::read_to_string(&doc_path).expect("docs/DIAGNOSIS.md");
+        let (begin, end) = ("<!-- blind:begin -->", "<!-- blind:end -->");
+        let (Some(a), Some(b)) = (doc.find(begin), doc.find(end)) else {
+            panic!("docs/DIAGNOSIS.md lacks the {begin} / {end} markers");
+        };
+        let new = format!(
+            "{}{begin}\n\n{table}\n{summary}\nPer case: [docs/data/blind_cases.csv](data/blind_cases.csv).\n\n{}",
+            &doc[..a],
+            &doc[b..]
+        );
+        std::fs::write(&doc_path, new).expect("write docs/DIAGNOSIS.md");
+        eprintln!("wrote docs/DIAGNOSIS.md and docs/data/blind_cases.csv");
+    }
+}

@@ -1,0 +1,351 @@
+//! The blind benchmark of the diagnosis (issue 5, docs/DIAGNOSIS.md), shared by the
+//! full run (`cargo bench --bench blind`) and its fast slice in the test suite
+//! (`tests/blind_slice.rs`).
+//!
+//! Each case goes through the file interface exactly as outside data would: `trum synth`
+//! writes a measurement CSV with the injected effects in their truth forms (which differ
+//! in form from the candidates the diagnosis fits), and `trum diagnose --json` reads only
+//! that CSV and the nominal preset. Nothing else passes between the two.
+
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// Nominal motor of every case.
+pub const MOTOR: &str = "trum60a";
+
+/// One blind case: injected effects with their strength factor (× the typical strength,
+/// applied to every parameter of the effect), campaign, noise level and seed.
+#[derive(Clone, Debug)]
+pub struct Case {
+    pub effects: Vec<&'static str>,
+    pub factor: f64,
+    pub campaign: &'static str,
+    pub noise: f64,
+    pub seed: u64,
+}
+
+impl Case {
+    /// Injected effects as the verdict would name them (`none` when empty).
+    pub fn truth(&self) -> String {
+        if self.effects.is_empty() {
+            "none".into()
+        } else {
+            self.effects.join("+")
+        }
+    }
+
+    /// `--effect` arguments of `trum synth`: every parameter at `factor` × typical.
+    pub fn effect_args(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for name in &self.effects {
+            let e = trum_core::effects::Effect::from_name(name).expect("effect name");
+            let kv: Vec<String> =
+                e.info().params.iter().map(|p| format!("{}={:e}", p.name, self.factor * p.typical)).collect();
+            out.push("--effect".into());
+            out.push(format!("{name}:{}", kv.join(",")));
+        }
+        out
+    }
+
+    /// Whether the campaign can show the effect at all. thermal_drift needs a time series,
+    /// which a preload-torque campaign does not have; such cases expect `none`.
+    pub fn observable(&self) -> bool {
+        !(self.campaign == "preload-torque" && self.effects.contains(&"thermal_drift") && self.effects.len() == 1)
+    }
+}
+
+/// What the diagnosis said about a case.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    pub case: Case,
+    pub verdict: String,
+    pub confounded: Vec<String>,
+    /// Held-out shrink of the injected effect(s) (their ranking entry), if ranked.
+    pub true_shrink: Option<f64>,
+    /// Held-out shrink of the verdict's entry.
+    pub verdict_shrink: Option<f64>,
+    pub baseline_nrmse: f64,
+    pub noise_nrmse: f64,
+    pub rows: usize,
+    pub seconds: f64,
+}
+
+fn same_set(a: &str, b: &str) -> bool {
+    let mut x: Vec<&str> = a.split('+').collect();
+    let mut y: Vec<&str> = b.split('+').collect();
+    x.sort_unstable();
+    y.sort_unstable();
+    x == y
+}
+
+impl Outcome {
+    /// The verdict names the injected effect(s) exactly (`none` for a null case; also for an
+    /// effect the campaign cannot show).
+    pub fn correct(&self) -> bool {
+        let want = if self.case.observable() { self.case.truth() } else { "none".into() };
+        same_set(&self.verdict, &want)
+    }
+
+    /// The truth is the verdict or inside the reported confounded set.
+    pub fn correct_or_confounded(&self) -> bool {
+        self.correct()
+            || (!self.case.effects.is_empty()
+                && self.case.effects.len() == 1
+                && self.confounded.iter().any(|c| c == self.case.effects[0]))
+    }
+
+    /// An effect was claimed where none was injected.
+    pub fn false_claim(&self) -> bool {
+        self.case.effects.is_empty() && self.verdict != "none"
+    }
+}
+
+/// Runs the CLI in-process; panics with its stderr when it fails (a benchmark bug).
+fn trum(args: &[String]) -> String {
+    let (mut out, mut err) = (Vec::new(), Vec::new());
+    let argv = std::iter::once("trum".to_string()).chain(args.iter().cloned());
+    let code = trum_cli::run_with_io(argv, &mut out, &mut err);
+    assert_eq!(code, 0, "trum {}: {}", args.join(" "), String::from_utf8_lossy(&err));
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Synthesises the case's data and diagnoses it blind.
+pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
+    let tag = format!(
+        "{}-{}-{}-{}-{}",
+        case.truth().replace('+', "_"),
+        case.factor,
+        case.campaign,
+        case.noise,
+        case.seed
+    );
+    let data = dir.join(format!("{tag}.csv"));
+    let json = dir.join(format!("{tag}.json"));
+    let mut args: Vec<String> = vec!["synth".into(), "--motor".into(), MOTOR.into()];
+    args.extend(case.effect_args());
+    for (k, v) in [
+        ("--campaign", case.campaign.to_string()),
+        ("--noise", case.noise.to_string()),
+        ("--seed", case.seed.to_string()),
+        ("-o", data.display().to_string()),
+    ] {
+        args.push(k.into());
+        args.push(v);
+    }
+    trum(&args);
+    let t0 = std::time::Instant::now();
+    trum(&[
+        "diagnose".into(),
+        "--motor".into(),
+        MOTOR.into(),
+        "--data".into(),
+        data.display().to_string(),
+        "--json".into(),
+        json.display().to_string(),
+    ]);
+    let seconds = t0.elapsed().as_secs_f64();
+    let text = std::fs::read_to_string(&json).expect("diagnosis JSON");
+    let v: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
+    let verdict = v["verdict"].as_str().expect("verdict").to_string();
+    let confounded =
+        v["confounded_with"].as_array().expect("confounded_with").iter().filter_map(|x| x.as_str()).map(String::from).collect();
+    let ranking = v["ranking"].as_array().expect("ranking");
+    let shrink_of = |name: &str| {
+        ranking.iter().find(|r| r["effect"].as_str().is_some_and(|e| same_set(e, name))).and_then(|r| r["shrink"].as_f64())
+    };
+    let truth = case.truth();
+    Outcome {
+        true_shrink: if case.effects.is_empty() { None } else { shrink_of(&truth) },
+        verdict_shrink: shrink_of(&verdict),
+        verdict,
+        confounded,
+        baseline_nrmse: v["gap"]["baseline_heldout_nrmse"].as_f64().unwrap_or(f64::NAN),
+        noise_nrmse: v["gap"]["noise_nrmse"].as_f64().unwrap_or(f64::NAN),
+        rows: v["n_rows"].as_u64().unwrap_or(0) as usize,
+        seconds,
+        case: case.clone(),
+    }
+}
+
+/// Every effect named in shared/spec/diagnose.md.
+pub const EFFECTS: [&str; 7] = [
+    "radial_friction",
+    "preload_stiffening",
+    "hertz_softening",
+    "thermal_drift",
+    "voltage_sag",
+    "eccentricity",
+    "tangential_compliance",
+];
+
+/// The full benchmark: every effect × two strengths × two noise levels × two campaigns,
+/// eight null cases, four two-effect cases.
+pub fn full_cases() -> Vec<Case> {
+    let mut out = Vec::new();
+    let mut seed = 100;
+    let mut next = || {
+        seed += 1;
+        seed
+    };
+    for campaign in ["preload-torque", "combined"] {
+        for noise in [0.5, 1.0] {
+            for e in EFFECTS {
+                for factor in [1.0, 2.0] {
+                    out.push(Case { effects: vec![e], factor, campaign, noise, seed: next() });
+                }
+            }
+            for _ in 0..2 {
+                out.push(Case { effects: vec![], factor: 0.0, campaign, noise, seed: next() });
+            }
+        }
+    }
+    for pair in [
+        ["radial_friction", "thermal_drift"],
+        ["voltage_sag", "eccentricity"],
+        ["preload_stiffening", "tangential_compliance"],
+        ["hertz_softening", "radial_friction"],
+    ] {
+        out.push(Case { effects: pair.to_vec(), factor: 1.0, campaign: "combined", noise: 1.0, seed: next() });
+    }
+    out
+}
+
+/// The fast slice in the test suite: every effect once (at twice the typical strength,
+/// nominal noise, the preload-torque campaign, where thermal_drift is unobservable and
+/// must give `none`), two null cases and one pair. Seeds differ from the full run's.
+pub fn slice_cases() -> Vec<Case> {
+    let mut out: Vec<Case> = EFFECTS
+        .iter()
+        .enumerate()
+        .map(|(i, &e)| Case { effects: vec![e], factor: 2.0, campaign: "preload-torque", noise: 1.0, seed: 900 + i as u64 })
+        .collect();
+    for s in 0..2 {
+        out.push(Case { effects: vec![], factor: 0.0, campaign: "preload-torque", noise: 1.0, seed: 950 + s });
+    }
+    out.push(Case {
+        effects: vec!["voltage_sag", "radial_friction"],
+        factor: 1.0,
+        campaign: "preload-torque",
+        noise: 1.0,
+        seed: 990,
+    });
+    out
+}
+
+/// Median of the finite values (NaN when none).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.retain(|x| x.is_finite());
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Summary statistics over the outcomes.
+pub struct Summary {
+    /// Non-null, observable cases whose verdict is the truth or contains it in the confounded set.
+    pub hit_rate: f64,
+    pub non_null: usize,
+    pub false_claims: usize,
+    pub nulls: usize,
+    pub median_true_shrink: f64,
+}
+
+pub fn summarise(outcomes: &[Outcome]) -> Summary {
+    let non_null: Vec<&Outcome> = outcomes.iter().filter(|o| !o.case.effects.is_empty() && o.case.observable()).collect();
+    let hits = non_null.iter().filter(|o| o.correct_or_confounded()).count();
+    let nulls = outcomes.iter().filter(|o| o.case.effects.is_empty()).count();
+    Summary {
+        hit_rate: hits as f64 / non_null.len().max(1) as f64,
+        non_null: non_null.len(),
+        false_claims: outcomes.iter().filter(|o| o.false_claim()).count(),
+        nulls,
+        median_true_shrink: median(non_null.iter().filter_map(|o| o.true_shrink).collect()),
+    }
+}
+
+/// The confusion matrix as Markdown: one row per injected truth, one column per verdict
+/// seen, plus "truth in confounded set" and shrink statistics.
+pub fn confusion_markdown(outcomes: &[Outcome]) -> String {
+    let mut verdicts: Vec<String> = outcomes.iter().map(|o| o.verdict.clone()).collect();
+    verdicts.sort();
+    verdicts.dedup();
+    // rows: none first, then the single effects, then the pairs
+    let mut truths: Vec<String> = outcomes.iter().map(|o| o.case.truth()).collect();
+    truths.sort_by_key(|t| (t != "none", t.contains('+'), t.clone()));
+    truths.dedup();
+    let mut s = String::new();
+    let _ = write!(s, "| injected \\ verdict |");
+    for v in &verdicts {
+        let _ = write!(s, " {} |", v.replace('_', "\\_"));
+    }
+    let _ = writeln!(s, " cases | correct | truth in confounded set | median shrink of truth |");
+    let _ = write!(s, "|---|");
+    for _ in &verdicts {
+        let _ = write!(s, "---|");
+    }
+    let _ = writeln!(s, "---|---|---|---|");
+    for t in &truths {
+        let rows: Vec<&Outcome> = outcomes.iter().filter(|o| &o.case.truth() == t).collect();
+        let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
+        for o in &rows {
+            *counts.entry(o.verdict.as_str()).or_default() += 1;
+        }
+        let _ = write!(s, "| {} |", t.replace('_', "\\_"));
+        for v in &verdicts {
+            match counts.get(v.as_str()) {
+                Some(n) => {
+                    let _ = write!(s, " {n} |");
+                }
+                None => {
+                    let _ = write!(s, " · |");
+                }
+            }
+        }
+        let correct = rows.iter().filter(|o| o.correct()).count();
+        let conf = rows.iter().filter(|o| !o.correct() && o.correct_or_confounded()).count();
+        let shrink = median(rows.iter().filter_map(|o| o.true_shrink).collect());
+        let shrink = if t == "none" || !shrink.is_finite() { "–".to_string() } else { format!("{shrink:.2}") };
+        let _ = writeln!(s, " {} | {correct} | {conf} | {shrink} |", rows.len());
+    }
+    s
+}
+
+/// One line per case, CSV.
+pub fn cases_csv(outcomes: &[Outcome]) -> String {
+    let mut s = String::from(
+        "truth,factor,campaign,noise,seed,observable,verdict,confounded_with,correct,correct_or_confounded,true_shrink,verdict_shrink,baseline_heldout_nrmse,noise_nrmse,rows,diagnose_s\n",
+    );
+    let f = |x: Option<f64>| x.map(|v| format!("{v:.4}")).unwrap_or_default();
+    for o in outcomes {
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{},{:.2}",
+            o.case.truth(),
+            o.case.factor,
+            o.case.campaign,
+            o.case.noise,
+            o.case.seed,
+            o.case.observable(),
+            o.verdict,
+            o.confounded.join("|"),
+            o.correct(),
+            o.correct_or_confounded(),
+            f(o.true_shrink),
+            f(o.verdict_shrink),
+            o.baseline_nrmse,
+            o.noise_nrmse,
+            o.rows,
+            o.seconds
+        );
+    }
+    s
+}
