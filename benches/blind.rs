@@ -6,7 +6,7 @@
 //! rewrites the confusion matrix in docs/DIAGNOSIS.md (between the `blind:begin` and
 //! `blind:end` markers) and the per-case table docs/data/blind_cases.csv.
 //! `cargo bench --bench blind -- --slice` runs only the test suite's slice; `--no-write`
-//! prints without touching the docs.
+//! prints without touching the docs; `--signals` prints only each case's signal χ². Each case's CSV and JSON stay in target/blind/.
 
 #[path = "../tests/support/blind.rs"]
 mod blind;
@@ -25,7 +25,17 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(2);
     let cases = if slice { blind::slice_cases() } else { blind::full_cases() };
-    let dir = tempfile::tempdir().expect("temporary directory");
+    if args.iter().any(|a| a == "--signals") {
+        // only what each case's injected effects leave after a baseline calibration
+        for c in &cases {
+            let sig: Vec<String> = c.effects.iter().map(|e| format!("{e} {:.0}", c.signal_chi2(e))).collect();
+            println!("{:<16} x{} noise {:<4} seed {}: {}", c.campaign, c.factor, c.noise, c.seed, sig.join(", "));
+        }
+        return;
+    }
+    // the synthesised CSVs and diagnosis JSONs stay for inspection
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/blind");
+    std::fs::create_dir_all(&dir).expect("target/blind");
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<(usize, blind::Outcome)>> = Mutex::new(Vec::new());
     let t0 = std::time::Instant::now();
@@ -34,7 +44,7 @@ fn main() {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(case) = cases.get(i) else { break };
-                let o = blind::run_case(case, dir.path());
+                let o = blind::run_case(case, &dir);
                 eprintln!(
                     "[{:>3}/{}] {:>6.0} s  {:<44} {:>4} {:<14} noise {:<3} -> {:<40} confounded {:?} shrink {:?} ({:.1} s)",
                     i + 1,

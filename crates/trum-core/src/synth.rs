@@ -152,8 +152,9 @@ impl Noise {
     }
 }
 
-/// Bench noise per column (standard deviations at noise level 1; docs/SYNTH.md).
-fn reading_noise(o: Observable, v: f64) -> f64 {
+/// Bench noise per column: standard deviation of a reading of value `v` at noise level 1
+/// (docs/SYNTH.md).
+pub fn reading_noise(o: Observable, v: f64) -> f64 {
     match o {
         Observable::SpeedRpm => 0.3 + 0.005 * v.abs(),
         Observable::InputPowerW => 0.02 + 0.01 * v.abs(),
