@@ -73,7 +73,7 @@ fn main() {
         "{} cases in {:.0} s wall ({} workers; diagnosis median {:.1} s, max {:.1} s per case).\n\n\
          * observable non-null cases whose verdict is the injected effect or whose confounded set contains it: \
          {:.0} % of {}\n* null cases with an effect claimed: {} of {}\n* median held-out shrink of the injected \
-         effect(s) over the observable non-null cases: {:.2}\n",
+         effect(s) over the observable non-null cases: {:.2} (beyond noise: {:.2})\n",
         outcomes.len(),
         t0.elapsed().as_secs_f64(),
         workers,
@@ -83,7 +83,8 @@ fn main() {
         sum.non_null,
         sum.false_claims,
         sum.nulls,
-        sum.median_true_shrink
+        sum.median_true_shrink,
+        sum.median_true_excess_shrink
     );
     println!("{table}\n{summary}");
     if write {

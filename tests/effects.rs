@@ -169,6 +169,47 @@ fn tangential_compliance_lowers_the_speed_torque_curve() {
     assert!(bal.abs() < 1e-6 * s.input_power_w);
 }
 
+/// Load torque at which the speed at preload `f` falls to `frac` of its no-load value.
+fn torque_at_speed_fraction(m: &Motor, f: f64, frac: f64) -> f64 {
+    let v0 = at(m, f, 0.0).speed_rpm;
+    let (mut lo, mut hi) = (0.0, 3.0);
+    for _ in 0..60 {
+        let t = 0.5 * (lo + hi);
+        if at(m, f, t).speed_rpm > frac * v0 {
+            lo = t;
+        } else {
+            hi = t;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The corner at stall: with Coulomb friction the whole contact drives once the stick
+/// point leaves it, the torque stops rising as the rotor slows, and the last part of the
+/// speed falls over a sliver of torque (only the rotor's viscous drag sets it). Shear
+/// compliance keeps the traction rising as slip grows, so the curve runs into stall
+/// more gradually. Measure: torque span of the last 10 % of speed over that of a 10 %
+/// step in mid-curve (1 for a straight line, near 0 for a sharp corner). At 100 N the
+/// contact is narrow and the baseline corner sharp (0.15); at high preload the contact
+/// is wide and there is no corner to round, with or without compliance.
+#[test]
+fn tangential_compliance_rounds_the_stall_corner() {
+    let corner = |m: &Motor| {
+        let t = |frac| torque_at_speed_fraction(m, 100.0, frac);
+        (t(1e-3) - t(0.1)) / (t(0.5) - t(0.6))
+    };
+    let compliant = |k: f64| {
+        let mut m = preset("trum60a").unwrap();
+        m.effects.set_strength(Effect::TangentialCompliance, k);
+        corner(&m)
+    };
+    let base = corner(&preset("trum60a").unwrap());
+    let (c1, c2) = (compliant(1.0), compliant(2.0));
+    assert!(base < 0.25, "baseline corner ratio {base}");
+    assert!(c1 > 2.0 * base, "typical compliance {c1} vs baseline {base}");
+    assert!(c2 > c1, "more compliance, rounder corner: {c2} vs {c1}");
+}
+
 #[test]
 fn truth_forms_differ_from_candidate_forms() {
     for e in ALL {

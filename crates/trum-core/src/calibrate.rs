@@ -297,21 +297,25 @@ fn motor_at(base: &Motor, params: &[FitParam], u: &DVector<f64>) -> Motor {
 /// Normalised residuals (prediction − measurement)/σ of every reading of `rows`, in
 /// order; a point the model cannot solve contributes a large residual (50 σ).
 pub fn residuals(motor: &Motor, rows: &[ObservedRow]) -> Vec<f64> {
+    use rayon::prelude::*;
     let p = Prepared::new(motor);
-    let mut out = Vec::new();
-    for r in rows {
+    let one = |r: &ObservedRow| -> Vec<f64> {
         // Cold starts: a warm start from a neighbouring row could settle on another
         // fixed point where the amplitude map has several, and the fit must see one model.
         let s = solve_prepared(&p, motor, &r.op, None);
-        for &(o, v, sigma) in &r.readings {
-            if s.status.is_valid() {
-                out.push((o.predict(&s, r.ambient_c) - v) / sigma);
-            } else {
-                out.push(50.0);
-            }
-        }
+        r.readings
+            .iter()
+            .map(|&(o, v, sigma)| if s.status.is_valid() { (o.predict(&s, r.ambient_c) - v) / sigma } else { 50.0 })
+            .collect()
+    };
+    // Large data sets in parallel chunks (the order of the result is kept): a diagnosis
+    // fits its candidates in parallel too, and nested chunks let the idle core help the
+    // slowest candidate.
+    if rows.len() >= 128 {
+        rows.par_chunks(32).flat_map_iter(|c| c.iter().flat_map(one).collect::<Vec<f64>>()).collect()
+    } else {
+        rows.iter().flat_map(one).collect()
     }
-    out
 }
 
 struct Problem<'a> {
