@@ -36,6 +36,10 @@ pub struct DiagnoseArgs {
     /// Write a self-contained HTML report (plots, tables, method) here.
     #[arg(long, value_name = "OUT.html")]
     report: Option<PathBuf>,
+    /// Refit every model on every cross-validation fold instead of the approximate
+    /// leave-block-out refit (slower; docs/DIAGNOSIS.md).
+    #[arg(long)]
+    exact_cv: bool,
 }
 
 pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
@@ -46,7 +50,8 @@ pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
         drop(crate::args::OutputTarget::create(p, ".tmp")?);
     }
     let spinner = spinner();
-    let d = diagnose(&motor, &bench.rows, &bench.groups, &DiagnoseOptions::default());
+    let opts = DiagnoseOptions { exact_cv: a.exact_cv, ..DiagnoseOptions::default() };
+    let d = diagnose(&motor, &bench.rows, &bench.groups, &opts);
     spinner.finish_and_clear();
     let d = d.map_err(|e| anyhow!("cannot diagnose '{}': {e}", a.data))?;
     let json_stdout = a.json.as_ref().is_some_and(|p| p.as_os_str() == "-");
