@@ -1,6 +1,6 @@
 //! Criterion benchmarks of the steady-state solver: one operating point cold, a sweep
-//! with warm starts (points per second), and an effect-laden point. Reference problems
-//! come from the presets so tests and benches share them.
+//! with warm starts (points per second), an effect-laden point, and `trum map` to CSV. Reference problems come from the presets so tests and
+//! benches share them. `bash benches/quick.sh` is the short CI-sized run.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use std::hint::black_box;
@@ -12,15 +12,17 @@ use trum_core::{solve, OperatingPoint};
 fn one_point(c: &mut Criterion) {
     let m = preset("trum60a").expect("preset");
     let op = OperatingPoint::new(250.0, 0.3, 200.0, 43e3);
-    c.bench_function("solve/cold/trum60a", |b| b.iter(|| solve(black_box(&m), black_box(&op))));
+    let mut g = c.benchmark_group("solve");
+    g.throughput(Throughput::Elements(1));
+    g.bench_function("cold/trum60a", |b| b.iter(|| solve(black_box(&m), black_box(&op))));
     let p = Prepared::new(&m);
+    g.bench_function("cold_prepared/trum60a", |b| b.iter(|| solve_prepared(black_box(&p), &m, black_box(&op), None)));
     let guess = solve(&m, &OperatingPoint::new(249.0, 0.29, 200.0, 43e3));
-    c.bench_function("solve/warm/trum60a", |b| {
-        b.iter(|| solve_prepared(black_box(&p), &m, black_box(&op), Some(&guess)))
-    });
+    g.bench_function("warm/trum60a", |b| b.iter(|| solve_prepared(black_box(&p), &m, black_box(&op), Some(&guess))));
     let mut r = m.clone();
     r.effects.parse_assignment("radial_friction=1").expect("effect");
-    c.bench_function("solve/cold/trum60a+radial_friction", |b| b.iter(|| solve(black_box(&r), black_box(&op))));
+    g.bench_function("cold/trum60a+radial_friction", |b| b.iter(|| solve(black_box(&r), black_box(&op))));
+    g.finish();
 }
 
 fn sweep(c: &mut Criterion) {
@@ -47,5 +49,24 @@ fn sweep(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, one_point, sweep);
+fn map_csv(c: &mut Criterion) {
+    // `trum map` in-process to memory: solving, CSV formatting and the parallel pipeline
+    // (all columns; `-o -` writes to the given buffer).
+    let mut g = c.benchmark_group("map");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(100 * 100));
+    let mut out = Vec::with_capacity(8 << 20);
+    g.bench_function("csv_all_columns/10000", |b| {
+        b.iter(|| {
+            out.clear();
+            let args = ["trum", "map", "--motor", "trum60a", "--preload-n", "100:500:100", "--torque-nm", "0:1.2:100", "-q", "-o", "-"];
+            let code = trum_cli::run_with_io(args, &mut out, &mut std::io::sink());
+            assert_eq!(code, 0);
+            black_box(out.len())
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, one_point, sweep, map_csv);
 criterion_main!(benches);

@@ -7,7 +7,7 @@
 //! byte-identical whatever the parallelism. At most three waves exist at once (one being
 //! solved, one queued, one being written): memory is constant for any grid size.
 
-use crate::args::{check_grid, csv_number, default_grid, GridArgs, MotorArgs, OutputTarget, Progress};
+use crate::args::{check_grid, default_grid, GridArgs, MotorArgs, OutputTarget, Progress};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use rayon::prelude::*;
@@ -107,22 +107,147 @@ pub fn header(cols: &[&Quantity]) -> String {
 /// Solves and formats one chunk.
 fn chunk_csv(motor: &Motor, prep: &Prepared, grid: &Grid, cols: &[&Quantity], range: std::ops::Range<u64>) -> Vec<u8> {
     let mut buf = Vec::with_capacity((range.end - range.start) as usize * (24 * cols.len() + 64));
+    let mut fmt = NumberFormatter::new();
     solve_range(motor, prep, grid, range, |_, op, s| {
-        use std::fmt::Write as _;
-        let mut line = String::with_capacity(24 * cols.len() + 64);
-        let _ = write!(line, "{},{},{},{},{}", op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz, s.status);
+        for v in [op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz] {
+            fmt.push(&mut buf, v);
+            buf.push(b',');
+        }
+        buf.extend_from_slice(s.status.as_str().as_bytes());
         let valid = s.status.is_valid();
         for q in cols {
-            line.push(',');
+            buf.push(b',');
             // Invalid points: empty cells (never "NaN"); the status column says why.
             if valid {
-                line.push_str(&csv_number((q.get)(s)));
+                fmt.push(&mut buf, (q.get)(s));
             }
         }
-        line.push('\n');
-        buf.extend_from_slice(line.as_bytes());
+        buf.push(b'\n');
     });
     buf
+}
+
+/// Writes numbers as `format!("{v}")` (and so [`crate::args::csv_number`]) does —
+/// shortest round-trip digits, plain decimal notation, never an exponent — but through
+/// `ryu`, without allocating: number formatting cost more than solving in large maps.
+pub struct NumberFormatter {
+    ryu: ryu::Buffer,
+}
+
+impl Default for NumberFormatter {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl NumberFormatter {
+    /// A formatter with its own scratch buffer.
+    pub fn new() -> Self {
+        NumberFormatter { ryu: ryu::Buffer::new() }
+    }
+
+    /// Appends `v` to `out`; nothing for a non-finite value (an empty CSV cell).
+    pub fn push(&mut self, out: &mut Vec<u8>, v: f64) {
+        if !v.is_finite() {
+            return;
+        }
+        let s = self.ryu.format_finite(v).as_bytes();
+        let Some(e) = s.iter().position(|&b| b == b'e') else {
+            // Decimal form: the same digits as Display, which omits a trailing ".0".
+            out.extend_from_slice(s.strip_suffix(b".0").unwrap_or(s));
+            return;
+        };
+        // Exponent form `[-]d[.ddd]eEXP` (one nonzero digit before the point): place the
+        // digits around the decimal point without an exponent.
+        let (neg, mant) = if s[0] == b'-' { (true, &s[1..e]) } else { (false, &s[..e]) };
+        let frac = mant.get(2..).unwrap_or(&[]);
+        let point = 1 + parse_exponent(&s[e + 1..]); // value = 0.DIGITS × 10^point
+        let n = 1 + frac.len() as i64;
+        if neg {
+            out.push(b'-');
+        }
+        if point <= 0 {
+            out.extend_from_slice(b"0.");
+            push_zeros(out, -point);
+            out.push(mant[0]);
+            out.extend_from_slice(frac);
+        } else if point >= n {
+            out.push(mant[0]);
+            out.extend_from_slice(frac);
+            push_zeros(out, point - n);
+        } else {
+            let k = point as usize - 1;
+            out.push(mant[0]);
+            out.extend_from_slice(&frac[..k]);
+            out.push(b'.');
+            out.extend_from_slice(&frac[k..]);
+        }
+    }
+}
+
+fn push_zeros(out: &mut Vec<u8>, n: i64) {
+    const ZEROS: [u8; 64] = [b'0'; 64];
+    let mut n = n.max(0) as usize;
+    while n > 0 {
+        let k = n.min(ZEROS.len());
+        out.extend_from_slice(&ZEROS[..k]);
+        n -= k;
+    }
+}
+
+fn parse_exponent(s: &[u8]) -> i64 {
+    let (neg, s) = if s.first() == Some(&b'-') { (true, &s[1..]) } else { (false, s) };
+    let e = s.iter().fold(0i64, |acc, &b| acc * 10 + i64::from(b - b'0'));
+    if neg {
+        -e
+    } else {
+        e
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn number_formatter_writes_what_display_writes() {
+        let mut f = NumberFormatter::new();
+        let (mut exact, mut total) = (0usize, 0usize);
+        let mut check = |v: f64| {
+            let mut out = Vec::new();
+            f.push(&mut out, v);
+            let got = String::from_utf8(out).expect("ascii");
+            let want = format!("{v}");
+            // Same shortest round trip in the same notation. (Where two 17-digit strings
+            // are equally short, ryu and std may pick different last digits: 1658206780088562.2
+            // vs .3 for 1.6582067800885623e15; both parse back to v.)
+            assert_eq!(got.parse::<f64>().map(f64::to_bits), Ok(v.to_bits()), "{v:e}: {got}");
+            assert_eq!(got.len(), want.len(), "{v:e}: {got} vs {want}");
+            assert!(!got.contains('e'));
+            exact += usize::from(got == want);
+            total += 1;
+        };
+        for v in [0.0, -0.0, 1.0, -1.0, 0.1, 1e-7, 1.5e20, 1e21, 123.456, 5e-324, f64::MAX, f64::MIN_POSITIVE, 43000.0] {
+            check(v);
+        }
+        // Random bit patterns over the whole finite range, and values of map magnitudes.
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = f64::from_bits(x);
+            if v.is_finite() {
+                check(v);
+                check(v.abs().log2().fract() * 1e3);
+            }
+        }
+        assert!(exact as f64 >= 0.999 * total as f64, "{exact} of {total} identical to Display");
+        let mut out = Vec::new();
+        f.push(&mut out, f64::NAN);
+        f.push(&mut out, f64::INFINITY);
+        assert!(out.is_empty());
+    }
 }
 
 fn write_map(
@@ -137,7 +262,9 @@ fn write_map(
     w.write_all(header(cols).as_bytes())?;
     let total = grid.len();
     let nchunks = total.div_ceil(chunk);
-    let wave = (4 * pool.current_num_threads() as u64).max(2);
+    // Two chunks per thread keep both busy; at most three waves (solving, queued, being
+    // written) of ~2 MB chunks bound the memory (4 per thread reached 51 MB at 10^7 points).
+    let wave = (2 * pool.current_num_threads() as u64).max(2);
     let prep = Prepared::new(motor);
     // A bounded channel of one wave is the reorder buffer: the solver thread runs at most
     // one wave ahead of the writer.

@@ -74,36 +74,83 @@ fn g(phi: f64) -> f64 {
 /// Inverts g(φ0) = y by safeguarded Newton iteration to 1e-14 in φ0, starting from the
 /// small-angle (g ≈ φ³/3) or near-full (g ≈ π − π·ε²/2, ε = π − φ) asymptotes.
 pub fn contact_from_ratio(y: f64) -> Contact {
+    contact_from_ratio_near(y, None).0
+}
+
+/// [`contact_from_ratio`] started from `guess_rad` (a nearby φ0, e.g. of the previous
+/// amplitude iterate; the root is unique, so the start only changes the cost). Also
+/// returns (sin φ0, cos φ0), which the solver would otherwise recompute.
+pub fn contact_from_ratio_near(y: f64, guess_rad: Option<f64>) -> (Contact, f64, f64) {
     if y >= PI {
         // Full contact: p = k_f W (cos θ − c) over the whole wave, ∫ = −2π c / k  ⇒  c = −y/π.
-        return Contact { half_angle_rad: PI, offset: -y / PI, full: true };
+        return (Contact { half_angle_rad: PI, offset: -y / PI, full: true }, PI.sin(), -1.0);
     }
     if y <= 0.0 {
-        return Contact { half_angle_rad: 0.0, offset: 1.0, full: false };
+        return (Contact { half_angle_rad: 0.0, offset: 1.0, full: false }, 0.0, 1.0);
     }
-    let mut lo = 0.0;
-    let mut hi = PI;
-    let mut phi = if y < 1.5 { (3.0 * y).cbrt().min(PI * 0.999) } else { PI - (2.0 * (PI - y) / PI).sqrt() };
-    for _ in 0..60 {
-        let (s, c) = phi.sin_cos();
-        let r = s - phi * c - y;
-        if r > 0.0 {
-            hi = phi;
+    let start = guess_rad.filter(|g| *g > 0.0 && *g < PI).unwrap_or(if y < 1.5 {
+        (3.0 * y).cbrt().min(PI * 0.999)
+    } else {
+        PI - (2.0 * (PI - y) / PI).sqrt()
+    });
+    // g' = φ·sin φ, g'' = sin φ + φ·cos φ.
+    let (phi, s, c) = newton_sin_cos(|p, s, c| (s - p * c - y, p * s, s + p * c), (0.0, -y), (PI, PI - y), start);
+    (Contact { half_angle_rad: phi, offset: c, full: false }, s, c)
+}
+
+/// Root of an increasing f on the bracket [lo, hi] (f(lo) ≤ 0 ≤ f(hi), values given) by
+/// safeguarded Newton. `f(x, sin x, cos x)` returns (f, f', f''): every function solved
+/// here is made of sin and cos of the unknown, so one `sin_cos` per iteration serves the
+/// value, the derivatives and the caller, who gets (x, sin x, cos x) back.
+///
+/// A step that would leave the bracket is replaced by regula falsi on the bracket
+/// (bisection if that stalls): near a root at the bracket's edge, Newton from the far side
+/// overshoots, and plain bisection then needed ~30 iterations. Newton's error after a
+/// step δ is about |f''/(2f')|·δ²; once that is below 1e-16 relative the step is taken
+/// without another evaluation, and sin/cos are carried over it by their Taylor series
+/// (error δ³/6 < 1e-24).
+fn newton_sin_cos(
+    f: impl Fn(f64, f64, f64) -> (f64, f64, f64),
+    (mut lo, mut flo): (f64, f64),
+    (mut hi, mut fhi): (f64, f64),
+    start: f64,
+) -> (f64, f64, f64) {
+    let mut x = if start > lo && start < hi { start } else { 0.5 * (lo + hi) };
+    let (mut s, mut c) = x.sin_cos();
+    let mut stalled = 0;
+    for _ in 0..100 {
+        let (v, d, dd) = f(x, s, c);
+        if v > 0.0 {
+            (hi, fhi) = (x, v);
         } else {
-            lo = phi;
+            (lo, flo) = (x, v);
         }
-        let d = phi * s;
-        let mut next = if d > 0.0 { phi - r / d } else { 0.5 * (lo + hi) };
-        if !(next > lo && next < hi) {
-            next = 0.5 * (lo + hi);
+        let step = v / d;
+        let next = x - step;
+        if d > 0.0 && next > lo && next < hi {
+            // (The step bound keeps the cubic term negligible where f'' happens to vanish.)
+            if step.abs() <= 1e-7 * x.abs() && step * step * dd.abs() <= 2e-16 * d * x.abs() {
+                // Converged: carry sin and cos over the last (tiny) step.
+                let (s1, c1) = (s - step * c - 0.5 * step * step * s, c + step * s - 0.5 * step * step * c);
+                return (next, s1, c1);
+            }
+            x = next;
+            stalled = 0;
+        } else {
+            // Regula falsi, with the Illinois halving when the same end keeps moving.
+            let rf = lo - flo * (hi - lo) / (fhi - flo);
+            stalled += 1;
+            x = if stalled < 3 && rf > lo && rf < hi { rf } else { 0.5 * (lo + hi) };
+            if stalled >= 3 {
+                stalled = 0;
+            }
         }
-        let done = (next - phi).abs() <= 1e-14 * (1.0 + phi);
-        phi = next;
-        if done || hi - lo < 1e-15 {
+        if hi - lo <= 1e-15 * hi.abs().max(1e-300) {
             break;
         }
+        (s, c) = x.sin_cos();
     }
-    Contact { half_angle_rad: phi, offset: phi.cos(), full: false }
+    (x, s, c)
 }
 
 /// Contact angle Xc [mechanical degrees, full arc] from the half-angle φ0 in wave phase
@@ -157,40 +204,40 @@ pub fn stick_half_angle_rad(
     viscous_nm_per_cos: f64,
     guess_rad: Option<f64>,
 ) -> Option<f64> {
+    let (s0, c0) = contact.half_angle_rad.sin_cos();
+    stick_half_angle_sin_cos(contact, (s0, c0), torque_scale_nm, load_torque_nm, viscous_nm_per_cos, guess_rad)
+        .map(|r| r.0)
+}
+
+/// [`stick_half_angle_rad`] given (sin φ0, cos φ0) of the contact half-angle (cos φ0 = −1
+/// in full contact); returns (θs, sin θs, cos θs).
+pub fn stick_half_angle_sin_cos(
+    contact: &Contact,
+    (sin_phi0, cos_phi0): (f64, f64),
+    torque_scale_nm: f64,
+    load_torque_nm: f64,
+    viscous_nm_per_cos: f64,
+    guess_rad: Option<f64>,
+) -> Option<(f64, f64, f64)> {
     let c = contact.offset;
-    let chi0 = contact.chi0();
+    let chi0 = sin_phi0 - contact.half_angle_rad * c;
     let tmax = stall_stick_half_angle_rad(contact);
-    let f = |t: f64| {
-        let (s, co) = t.sin_cos();
+    // sin/cos of θmax: of φ0, or of π/2.
+    let (smax, cmax) = if tmax < contact.half_angle_rad { (1.0, 0.0) } else { (sin_phi0, cos_phi0) };
+    let f = |t: f64, s: f64, co: f64| {
         let val = torque_scale_nm * (2.0 * (s - t * c) - chi0) - load_torque_nm - viscous_nm_per_cos * co;
         let der = torque_scale_nm * 2.0 * (co - c) + viscous_nm_per_cos * s;
-        (val, der)
+        let der2 = -torque_scale_nm * 2.0 * s + viscous_nm_per_cos * co;
+        (val, der, der2)
     };
-    let (fmax, _) = f(tmax);
+    let (fmax, _, _) = f(tmax, smax, cmax);
     if fmax < 0.0 {
         return None;
     }
-    let (mut lo, mut hi) = (0.0, tmax);
-    // Starting point: warm start, else the small-θs/Newton-from-midpoint guess.
-    let mut t = guess_rad.filter(|g| *g > 0.0 && *g < tmax).unwrap_or(0.5 * tmax);
-    for _ in 0..60 {
-        let (v, d) = f(t);
-        if v > 0.0 {
-            hi = t;
-        } else {
-            lo = t;
-        }
-        let mut next = if d > 0.0 { t - v / d } else { 0.5 * (lo + hi) };
-        if !(next > lo && next < hi) {
-            next = 0.5 * (lo + hi);
-        }
-        let done = (next - t).abs() <= 1e-14 * (1.0 + t);
-        t = next;
-        if done || hi - lo < 1e-15 {
-            break;
-        }
-    }
-    Some(t)
+    let (f0, _, _) = f(0.0, 0.0, 1.0);
+    // Starting point: warm start, else the middle of the range.
+    let start = guess_rad.filter(|g| *g > 0.0 && *g < tmax).unwrap_or(0.5 * tmax);
+    Some(newton_sin_cos(f, (0.0, f0), (tmax, fmax), start))
 }
 
 #[cfg(test)]
@@ -248,6 +295,37 @@ mod tests {
         let stall = scale * ct.chi0();
         assert!(stick_half_angle_rad(&ct, scale, stall * 1.001, 0.0, None).is_none());
         assert!(stick_half_angle_rad(&ct, scale, stall * 0.999, 0.0, None).is_some());
+    }
+
+    #[test]
+    fn inner_solves_give_the_same_root_and_its_sine_and_cosine_from_any_start() {
+        // Starts just beside the root (where plain Newton from the far side overshoots out
+        // of the bracket), at the ends and far away: the root to 1e-14, sin/cos to 1e-15.
+        for &y in &[1e-6, 0.3, 1.5, 2.9, 3.14] {
+            let (cold, s, c) = contact_from_ratio_near(y, None);
+            let phi = cold.half_angle_rad;
+            assert!((s - phi.sin()).abs() < 1e-15 && (c - phi.cos()).abs() < 1e-15 && c == cold.offset);
+            for g in [1e-12, phi * (1.0 - 1e-9), phi * (1.0 + 1e-9), PI - 1e-12, 1.0] {
+                let (w, s, c) = contact_from_ratio_near(y, Some(g));
+                assert!((w.half_angle_rad - phi).abs() < 1e-14 * (1.0 + phi), "y={y} start {g}");
+                assert!((s - w.half_angle_rad.sin()).abs() < 1e-15 && (c - w.half_angle_rad.cos()).abs() < 1e-15);
+            }
+        }
+        for &(y, load) in &[(0.5, 0.1), (2.5, 0.3), (2.5, 0.0), (4.0, 1.5)] {
+            let ct = contact_from_ratio(y);
+            let sc0 = if ct.full { (PI.sin(), -1.0) } else { ct.half_angle_rad.sin_cos() };
+            let Some((t, _, _)) = stick_half_angle_sin_cos(&ct, sc0, 2.0, load, 0.05, None) else {
+                panic!("y={y}: no stick angle")
+            };
+            let resid = 2.0 * torque_factor(t, &ct) - load - 0.05 * t.cos();
+            assert!(resid.abs() < 1e-13, "y={y}: {resid}");
+            let tmax = stall_stick_half_angle_rad(&ct);
+            for g in [1e-12, t * (1.0 - 1e-9), t * (1.0 + 1e-9), tmax * (1.0 - 1e-12), 1.0] {
+                let (w, s, c) = stick_half_angle_sin_cos(&ct, sc0, 2.0, load, 0.05, Some(g)).expect("root");
+                assert!((w - t).abs() < 1e-14, "y={y} start {g}: {w} vs {t}");
+                assert!((s - w.sin()).abs() < 1e-15 && (c - w.cos()).abs() < 1e-15);
+            }
+        }
     }
 
     #[test]

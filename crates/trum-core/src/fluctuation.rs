@@ -121,7 +121,9 @@ mod tests {
         let m = preset("trum60a").unwrap();
         let op = OperatingPoint::new(250.0, 0.2, 200.0, 43e3);
         let f0 = speed_fluctuation(&m, &op, 0.0, 16).unwrap();
-        assert_eq!(f0.speed_std_rpm, 0.0);
+        // Zero up to rounding: the samples are warm-started from each other, and warm and
+        // cold solves agree to the solver's tolerance, not to the last bit.
+        assert!(f0.speed_std_rpm <= 1e-12 * f0.mean_speed_rpm, "{}", f0.speed_std_rpm);
         let s = crate::solve(&m, &op);
         assert!((f0.mean_speed_rpm - s.speed_rpm).abs() < 1e-9 * s.speed_rpm);
         // std ≈ |dΩ/dF|·ΔF/√2 for a small ripple (first-order perturbation)

@@ -330,29 +330,44 @@ struct Drive {
 }
 
 /// Baseline 2-D Coulomb interface: closed forms (seed 001 eq. 10-11; crate::contact).
+/// `sc0` = (sin φ0, cos φ0). Returns (θs, v_r, stalled, torque factor 2χ(θs) − χ(φ0),
+/// power factor 2E(θs) − E(φ0), stall torque factor). χ and E are written out here with
+/// the sines and cosines the root finds already have: one `sin_cos` per Newton step is
+/// the whole transcendental cost of a trial.
 fn coulomb_interface(
     p: &Prepared,
     d: &Drive,
     ct: &Contact,
+    (s0, c0): (f64, f64),
     tscale: f64,
     v0: f64,
     ts_guess: Option<f64>,
-) -> (f64, f64, bool) {
+) -> (f64, f64, bool, f64, f64, f64) {
+    let (phi, c) = (ct.half_angle_rad, ct.offset);
+    let chi0 = s0 - phi * c;
+    let e0 = 0.5 * phi + 0.5 * s0 * c0 - c * s0;
+    let tmax = contact::stall_stick_half_angle_rad(ct);
+    let (smax, cmax) = if tmax < phi { (1.0, 0.0) } else { (s0, c0) };
+    let tf0 = 2.0 * (smax - tmax * c) - chi0;
     let visc = p.dr * v0 / p.r0;
-    match contact::stick_half_angle_rad(ct, tscale, d.t_load, visc, ts_guess) {
-        Some(t) => (t, v0 * t.cos(), false),
-        None => {
-            let tmax = contact::stall_stick_half_angle_rad(ct);
-            // Narrow contact (φ0 < π/2): below v_r = v0·cos φ0 the whole contact drives with
-            // the constant torque R0·μ·F, and the rotor's viscous torque sets the speed.
-            let drive = tscale * contact::torque_factor(tmax, ct);
-            if tmax < 0.5 * PI && p.dr > 0.0 && d.t_load < drive {
-                (tmax, ((drive - d.t_load) / p.dr * p.r0).min(v0 * tmax.cos()), false)
-            } else {
-                (tmax, 0.0, true)
+    let (ts, st, cs, vr, stalled) =
+        match contact::stick_half_angle_sin_cos(ct, (s0, c0), tscale, d.t_load, visc, ts_guess) {
+            Some((t, st, cs)) => (t, st, cs, v0 * cs, false),
+            None => {
+                // Narrow contact (φ0 < π/2): below v_r = v0·cos φ0 the whole contact drives with
+                // the constant torque R0·μ·F, and the rotor's viscous torque sets the speed.
+                let drive = tscale * tf0;
+                if tmax < 0.5 * PI && p.dr > 0.0 && d.t_load < drive {
+                    (tmax, smax, cmax, ((drive - d.t_load) / p.dr * p.r0).min(v0 * cmax), false)
+                } else {
+                    (tmax, smax, cmax, 0.0, true)
+                }
             }
-        }
-    }
+        };
+    let tf = 2.0 * (st - ts * c) - chi0;
+    // c_t·ω = 2Nμk_f·h0·[2E(θs) − E(φ0)]: friction power taken from the wave over (ωW)².
+    let pf = 2.0 * (0.5 * ts + 0.5 * st * cs - c * st) - e0;
+    (ts, vr, stalled, tf, pf, tf0)
 }
 
 /// Generalised interface (radial slip, saturating traction): the rotor speed ratio
@@ -429,19 +444,15 @@ fn general_interface(
     (ts, u * v0, false, best, fac0.torque)
 }
 
-fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>) -> Trial {
+fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>, phi_guess: Option<f64>) -> Trial {
     let a = contact::force_scale_n(p.n, p.kf, w, p.k);
-    let ct = contact::contact_from_ratio(d.f_n / a);
+    let (ct, s0, c0) = contact::contact_from_ratio_near(d.f_n / a, phi_guess);
     let v0 = stator::crest_surface_speed_m_s(p.k, p.h0, d.omega, w);
     let tscale = p.r0 * d.mu * a;
     let (ts, vr, stalled, tf, pf, rf, tf0);
     if p.law.radial_ratio == 0.0 && p.compliance == 0.0 {
-        (ts, vr, stalled) = coulomb_interface(p, d, &ct, tscale, v0, ts_guess);
-        tf = contact::torque_factor(ts, &ct);
-        // c_t·ω = 2Nμk_f·h0·[2E(θs) − E(φ0)]: friction power taken from the wave over (ωW)².
-        pf = 2.0 * contact::e_int(ts, ct.offset) - contact::e_int(ct.half_angle_rad, ct.offset);
+        (ts, vr, stalled, tf, pf, tf0) = coulomb_interface(p, d, &ct, (s0, c0), tscale, v0, ts_guess);
         rf = 0.0;
-        tf0 = contact::torque_factor(contact::stall_stick_half_angle_rad(&ct), &ct);
     } else {
         let mut law = p.law;
         if p.compliance > 0.0 {
@@ -673,10 +684,14 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
     let w_hi0 = p.theta * d.v / (d.omega * p.c);
     let mut evals = 0u32;
     let mut ts_guess = guess.map(|g| g.stick_half_angle_rad).filter(|t| t.is_finite());
+    // The inner root finds (contact and stick angles) have unique roots: starting them
+    // from the previous trial only makes them cheaper.
+    let mut phi_guess: Option<f64> = None;
     let mut eval = |w: f64, ts_guess: &mut Option<f64>| {
         evals += 1;
-        let t = trial(p, d, w, *ts_guess);
+        let t = trial(p, d, w, *ts_guess, phi_guess);
         *ts_guess = Some(t.ts);
+        phi_guess = Some(t.contact.half_angle_rad).filter(|_| !t.contact.full);
         t
     };
     // Upper bracket: r(W) = W − W' ≥ 0.
@@ -687,11 +702,11 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
         grow += 1;
     }
     let mut lo: Option<Trial> = None;
-    // Start: warm guess if it lies inside the bracket, else one fixed-point step from the top.
-    // The amplitude always descends from the bound onto the largest fixed point: a warm
-    // amplitude from a neighbouring point can sit below the middle one of several fixed
-    // points and fall onto another branch (found by tests/reliability_known_bugs.rs). The
-    // guess still warm-starts the inner stick-angle solves.
+    // Start: one fixed-point step from the top. The amplitude always descends from the
+    // bound onto the largest fixed point: a warm amplitude from a neighbouring point can
+    // sit below the middle one of several fixed points and fall onto another branch
+    // (found by tests/reliability_known_bugs.rs). The guess still warm-starts the inner
+    // stick-angle solves.
     let start = hi.w_next;
     let mut cur = eval(start, &mut ts_guess);
     let mut prev: Option<Trial> = None;

@@ -136,6 +136,40 @@ where
 mod tests {
     use super::*;
     #[test]
+    fn sweeps_give_the_cold_answer_everywhere() {
+        // Dense grids through running, stall and clamped regions: the warm-started sweep
+        // (inner solves started from the neighbour) must give every point's cold status and
+        // numbers to 1e-9 relative.
+        use crate::quantities::QUANTITIES;
+        use crate::solve::{solve, Status};
+        let mut seen = std::collections::HashSet::new();
+        for name in ["trum60a", "trum60-qut", "generic60"] {
+            let m = crate::presets::preset(name).expect("preset");
+            let p = Prepared::new(&m);
+            for (hz, v) in [(41_300.0, 88.0), (43_000.0, 200.0), (44_000.0, 300.0)] {
+                let g = Grid {
+                    preload_n: Axis::linspace(5.0, 700.0, 24),
+                    voltage_v: Axis::fixed(v),
+                    frequency_hz: Axis::fixed(hz),
+                    torque_nm: Axis::linspace(0.0, 2.5, 23),
+                };
+                solve_range(&m, &p, &g, 0..g.len(), |_, op, s| {
+                    let c = solve(&m, op);
+                    seen.insert(c.status);
+                    assert_eq!(s.status, c.status, "{name} {op:?}");
+                    if c.status.is_valid() {
+                        for q in QUANTITIES {
+                            let (a, b) = ((q.get)(s), (q.get)(&c));
+                            assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-300), "{name} {op:?} {}: {a} vs {b}", q.name);
+                        }
+                    }
+                });
+            }
+        }
+        assert!([Status::Ok, Status::Stall, Status::Clamped].iter().all(|s| seen.contains(s)), "{seen:?}");
+    }
+
+    #[test]
     fn index_order_is_torque_fastest() {
         let g = Grid {
             preload_n: Axis::linspace(100.0, 300.0, 3),
