@@ -14,7 +14,7 @@ use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use trum_core::dynamics::hertz::{
-    identify_beta, BetaIdentificationInput, Branch, HertzError, HertzOscillator, OperatingPoint, ResponseCurve,
+    identify_beta, BetaIdentificationInput, Branch, FamilyCurve, HertzError, HertzOscillator, OperatingPoint,
     ResponseMethod,
 };
 use trum_core::sweep::Axis;
@@ -45,14 +45,6 @@ pub struct OscillatorArgs {
     force_factor_n_per_v: Option<f64>,
 }
 
-/// The oscillator's keys, as written in an `--oscillator` file.
-fn oscillator_keys() -> Vec<String> {
-    match toml::Value::try_from(HertzOscillator::default()) {
-        Ok(toml::Value::Table(t)) => t.keys().cloned().collect(),
-        _ => Vec::new(),
-    }
-}
-
 /// 1-based line of the first `key = ...` assignment in `text` (0 if not found).
 fn line_of(text: &str, key: &str) -> usize {
     text.lines()
@@ -72,43 +64,28 @@ impl OscillatorArgs {
                 let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].lines().count().max(1));
                 anyhow!("{shown}, line {line}: {}", e.message())
             })?;
-            let keys = oscillator_keys();
-            let mut merged = match toml::Value::try_from(&o) {
-                Ok(toml::Value::Table(t)) => t,
-                _ => bail!("internal error: the default oscillator does not serialise"),
-            };
             for (k, v) in table {
                 let line = line_of(&text, &k);
-                if !keys.contains(&k) {
-                    bail!("{shown}, line {line}, key '{k}': unknown key; valid keys are: {}", keys.join(", "));
-                }
                 let x = match v {
                     toml::Value::Float(x) => x,
                     toml::Value::Integer(i) => i as f64,
                     other => bail!("{shown}, line {line}, key '{k}': expected a number, got {}", other.type_str()),
                 };
-                if let Err(e) = check_param(&k, x) {
-                    bail!("{shown}, line {line}, key '{k}': {e}");
-                }
-                merged.insert(k, toml::Value::Float(x));
+                set_param(&mut o, &k, x).map_err(|e| anyhow!("{shown}, line {line}, key '{k}': {e}"))?;
             }
-            o = toml::Value::Table(merged).try_into().map_err(|e| anyhow!("{shown}: {e}"))?;
         }
-        set_flag(&mut o.modal_mass_kg, "--modal-mass-kg", "modal_mass_kg", self.modal_mass_kg)?;
-        set_flag(&mut o.damping_ns_per_m, "--damping-ns-per-m", "damping_ns_per_m", self.damping_ns_per_m)?;
-        set_flag(
-            &mut o.linear_stiffness_n_per_m,
-            "--linear-stiffness-n-per-m",
-            "linear_stiffness_n_per_m",
-            self.linear_stiffness_n_per_m,
-        )?;
-        set_flag(&mut o.beta_n_per_m3, "--beta-n-per-m3", "beta_n_per_m3", self.beta_n_per_m3)?;
-        set_flag(
-            &mut o.force_factor_n_per_v,
-            "--force-factor-n-per-v",
-            "force_factor_n_per_v",
-            self.force_factor_n_per_v,
-        )?;
+        let flags = [
+            ("--modal-mass-kg", "modal_mass_kg", self.modal_mass_kg),
+            ("--damping-ns-per-m", "damping_ns_per_m", self.damping_ns_per_m),
+            ("--linear-stiffness-n-per-m", "linear_stiffness_n_per_m", self.linear_stiffness_n_per_m),
+            ("--beta-n-per-m3", "beta_n_per_m3", self.beta_n_per_m3),
+            ("--force-factor-n-per-v", "force_factor_n_per_v", self.force_factor_n_per_v),
+        ];
+        for (flag, key, value) in flags {
+            if let Some(v) = value {
+                set_param(&mut o, key, v).map_err(|e| anyhow!("{flag} {v}: {e}"))?;
+            }
+        }
         if let Some(f) = self.linear_resonance_hz {
             o.linear_stiffness_n_per_m =
                 trum_core::dynamics::hertz::linear_stiffness_from_resonance_n_per_m(o.modal_mass_kg, f)
@@ -119,35 +96,13 @@ impl OscillatorArgs {
     }
 }
 
-fn set_flag(slot: &mut f64, flag: &str, key: &str, value: Option<f64>) -> Result<()> {
-    if let Some(v) = value {
-        check_param(key, v).map_err(|e| anyhow!("{flag} {v}: {e}"))?;
-        *slot = v;
-    }
-    Ok(())
-}
-
-/// The core's own range check for one parameter (the default with `key` set to `value`).
-fn check_param(key: &str, value: f64) -> Result<(), String> {
-    let mut o = HertzOscillator::default();
-    let slot = match key {
-        "modal_mass_kg" => &mut o.modal_mass_kg,
-        "damping_ns_per_m" => &mut o.damping_ns_per_m,
-        "linear_stiffness_n_per_m" => &mut o.linear_stiffness_n_per_m,
-        "beta_n_per_m3" => &mut o.beta_n_per_m3,
-        "force_factor_n_per_v" => &mut o.force_factor_n_per_v,
-        "dynamic_contact_coefficient" => &mut o.dynamic_contact_coefficient,
-        "reference_preload_n" => &mut o.reference_preload_n,
-        "reference_voltage_v" => &mut o.reference_voltage_v,
-        "beta_preload_exponent" => &mut o.beta_preload_exponent,
-        "beta_voltage_exponent" => &mut o.beta_voltage_exponent,
-        _ => return Err("unknown key".into()),
-    };
-    *slot = value;
-    match o.validate() {
+/// Sets one parameter by name: unknown keys and out-of-range values are errors.
+fn set_param(o: &mut HertzOscillator, key: &str, value: f64) -> Result<(), String> {
+    match o.set_param(key, value) {
+        Ok(true) => Ok(()),
+        Ok(false) => Err(format!("unknown key; valid keys are: {}", HertzOscillator::PARAM_KEYS.join(", "))),
         Err(HertzError::InvalidParameter { reason, .. }) => Err(format!("{value} {reason}")),
         Err(e) => Err(e.to_string()),
-        Ok(()) => Ok(()),
     }
 }
 
@@ -193,26 +148,10 @@ pub struct ResonanceArgs {
     plot: Option<PathBuf>,
 }
 
-/// One curve of the family: its operating point and the core's answer.
-struct Curve {
-    op: OperatingPoint,
-    result: Result<ResponseCurve, HertzError>,
-    backbone: Vec<(f64, f64)>,
-}
-
 fn status_of(e: &HertzError) -> &'static str {
     match e {
         HertzError::NoStaticEquilibrium { .. } => "no_static_equilibrium",
         _ => "invalid_input",
-    }
-}
-
-fn branch_name(b: Branch) -> &'static str {
-    match b {
-        Branch::Single => "single",
-        Branch::Lower => "lower",
-        Branch::Middle => "middle",
-        Branch::Upper => "upper",
     }
 }
 
@@ -222,29 +161,6 @@ fn axis_values(ax: &Axis, name: &str) -> Result<Vec<f64>> {
     }
     let v: Vec<f64> = (0..ax.n).map(|i| ax.at(i)).collect();
     Ok(v)
-}
-
-/// Default band: from below the lowest to above the highest of every curve's linear
-/// resonance and backbone peak, with 10 damping bandwidths of margin.
-fn default_band(o: &HertzOscillator, ops: &[OperatingPoint], method: ResponseMethod) -> Option<Axis> {
-    let (mut lo, mut hi, mut bw) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
-    for op in ops {
-        let Ok(eff) = o.effective(op) else { continue };
-        let f0 = eff.linear_resonance_hz();
-        let w0 = 2.0 * std::f64::consts::PI * f0;
-        let peak_amp = eff.forcing_amplitude_n / (eff.damping_ns_per_m * w0);
-        let f_peak = o.backbone(op, &[peak_amp], method).ok().and_then(|b| b.first().map(|p| p.frequency_hz));
-        for f in [Some(f0), f_peak].into_iter().flatten() {
-            lo = lo.min(f);
-            hi = hi.max(f);
-        }
-        bw = bw.max(eff.damping_ns_per_m / (2.0 * std::f64::consts::PI * eff.modal_mass_kg));
-    }
-    if !lo.is_finite() {
-        return None;
-    }
-    let margin = 0.3 * (hi - lo) + 10.0 * bw;
-    Some(Axis::linspace((lo - margin).max(0.5 * lo), hi + margin, 401))
 }
 
 pub fn run(a: &ResonanceArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
@@ -264,32 +180,22 @@ pub fn run(a: &ResonanceArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         .collect();
     let band = match a.frequency_hz {
         Some(ax) => ax,
-        None => default_band(&osc, &ops, method)
-            .ok_or_else(|| anyhow!("no operating point has a static equilibrium; give --frequency-hz"))?,
+        None => {
+            let (lo, hi) = osc
+                .response_band_hz(&ops, method)
+                .ok_or_else(|| anyhow!("no operating point has a static equilibrium; give --frequency-hz"))?;
+            Axis::linspace(lo, hi, 401)
+        }
     };
     let freqs = axis_values(&band, "frequency-hz")?;
     if let Some(f) = freqs.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
         bail!("--frequency-hz: {f} must be a finite frequency > 0");
     }
-    let curves: Vec<Curve> = ops
-        .iter()
-        .map(|op| {
-            let result = osc.response_curve(op, &freqs, method);
-            let backbone = match &result {
-                Ok(c) => {
-                    let top = 1.2 * c.points.iter().map(|p| p.amplitude_m).fold(0.0, f64::max);
-                    let amps: Vec<f64> = (0..=100).map(|i| top * i as f64 / 100.0).collect();
-                    let pts = osc.backbone(op, &amps, method).unwrap_or_default();
-                    pts.iter().map(|p| (p.frequency_hz, p.amplitude_m)).collect()
-                }
-                Err(_) => Vec::new(),
-            };
-            Curve { op: *op, result, backbone }
-        })
-        .collect();
+    let curves = osc.response_family(&ops, &freqs, method).map_err(|e| anyhow!("--frequency-hz: {e}"))?;
     for c in &curves {
-        if let Err(e) = &c.result {
-            writeln!(err, "note: {} V, {} N: {} ({e})", c.op.voltage_v, c.op.preload_n, status_of(e))?;
+        if let Err(e) = &c.response {
+            let op = c.operating_point;
+            writeln!(err, "note: {} V, {} N: {} ({e})", op.voltage_v, op.preload_n, status_of(e))?;
         }
     }
     if let Some(path) = &a.output {
@@ -308,12 +214,12 @@ const RESPONSE_HEADER: &str = "voltage_v,preload_n,frequency_hz,branch,status,am
 
 /// One row per solution: every branch at every frequency, then the backbone and the two
 /// saddle nodes of each curve; a curve without a static equilibrium is one status row.
-fn response_csv(curves: &[Curve]) -> String {
+fn response_csv(curves: &[FamilyCurve]) -> String {
     let mut s = String::from(RESPONSE_HEADER);
     s.push('\n');
     for c in curves {
-        let (v, n) = (csv_number(c.op.voltage_v), csv_number(c.op.preload_n));
-        let r = match &c.result {
+        let (v, n) = (csv_number(c.operating_point.voltage_v), csv_number(c.operating_point.preload_n));
+        let r = match &c.response {
             Ok(r) => r,
             Err(e) => {
                 s.push_str(&format!("{v},{n},,,{},,,\n", status_of(e)));
@@ -324,14 +230,18 @@ fn response_csv(curves: &[Curve]) -> String {
             s.push_str(&format!(
                 "{v},{n},{},{},ok,{},{},{}\n",
                 csv_number(p.frequency_hz),
-                branch_name(p.branch),
+                p.branch.as_str(),
                 csv_number(p.amplitude_m),
                 csv_number(p.phase_lag_rad),
                 p.stable
             ));
         }
-        for (f, amp) in &c.backbone {
-            s.push_str(&format!("{v},{n},{},backbone,ok,{},,\n", csv_number(*f), csv_number(*amp)));
+        for b in &c.backbone {
+            s.push_str(&format!(
+                "{v},{n},{},backbone,ok,{},,\n",
+                csv_number(b.frequency_hz),
+                csv_number(b.amplitude_m)
+            ));
         }
         if let Some(j) = &r.jumps {
             for (name, f, amp) in [
@@ -345,18 +255,19 @@ fn response_csv(curves: &[Curve]) -> String {
     s
 }
 
-fn response_plot(curves: &[Curve], by_voltage: bool, by_preload: bool) -> LinePlot {
+fn response_plot(curves: &[FamilyCurve], by_voltage: bool, by_preload: bool) -> LinePlot {
     let n = curves.len();
     let mut lines = Vec::new();
     for (i, c) in curves.iter().enumerate() {
-        let Ok(r) = &c.result else { continue };
+        let Ok(r) = &c.response else { continue };
+        let op = c.operating_point;
         let color = series_color(i, n);
         let mut label = Vec::new();
         if by_voltage || !by_preload {
-            label.push(format!("{} V", fmt_sig(c.op.voltage_v, 6)));
+            label.push(format!("{} V", fmt_sig(op.voltage_v, 6)));
         }
         if by_preload {
-            label.push(format!("{} N", fmt_sig(c.op.preload_n, 6)));
+            label.push(format!("{} N", fmt_sig(op.preload_n, 6)));
         }
         let pts = |b: Branch| r.points.iter().filter(move |p| p.branch == b).map(|p| (p.frequency_hz, p.amplitude_m));
         let (mut lower, mut middle, mut upper): (Vec<_>, Vec<_>, Vec<_>) =
@@ -387,7 +298,8 @@ fn response_plot(curves: &[Curve], by_voltage: bool, by_preload: bool) -> LinePl
         lines.push(solid(sorted(lower), lower_label));
         lines.push(solid(sorted(upper), None));
         lines.push(Line { label: None, color, points: sorted(middle), dashed: true });
-        lines.push(Line { label: None, color, points: c.backbone.clone(), dashed: true });
+        let backbone = c.backbone.iter().map(|b| (b.frequency_hz, b.amplitude_m)).collect();
+        lines.push(Line { label: None, color, points: backbone, dashed: true });
     }
     LinePlot {
         title: "amplitude-frequency response (dashed: unstable branch, backbone)".into(),
@@ -397,7 +309,7 @@ fn response_plot(curves: &[Curve], by_voltage: bool, by_preload: bool) -> LinePl
     }
 }
 
-fn write_summary(curves: &[Curve], out: &mut dyn Write) -> Result<()> {
+fn write_summary(curves: &[FamilyCurve], out: &mut dyn Write) -> Result<()> {
     let header = [
         "voltage_v [V]",
         "preload_n [N]",
@@ -411,8 +323,8 @@ fn write_summary(curves: &[Curve], out: &mut dyn Write) -> Result<()> {
     ];
     let mut rows = Vec::new();
     for c in curves {
-        let mut row = vec![fmt_sig(c.op.voltage_v, 6), fmt_sig(c.op.preload_n, 6)];
-        match &c.result {
+        let mut row = vec![fmt_sig(c.operating_point.voltage_v, 6), fmt_sig(c.operating_point.preload_n, 6)];
+        match &c.response {
             Err(e) => {
                 row.push(status_of(e).into());
                 row.extend(std::iter::repeat_n("-".to_string(), 6));
@@ -420,7 +332,7 @@ fn write_summary(curves: &[Curve], out: &mut dyn Write) -> Result<()> {
             Ok(r) => {
                 row.push("ok".into());
                 // the backbone starts at zero amplitude, i.e. at the linear resonance
-                let lin = c.backbone.first().map_or(f64::NAN, |p| p.0);
+                let lin = c.backbone.first().map_or(f64::NAN, |p| p.frequency_hz);
                 let peak = r.points.iter().map(|p| p.amplitude_m).fold(f64::NAN, f64::max);
                 let (up, down) = r.jumps.as_ref().map_or((f64::NAN, f64::NAN), |j| (j.jump_up_hz, j.jump_down_hz));
                 row.extend([lin, r.equivalent_beta_n_per_m3, peak, up, down, (up - down).abs()].map(|x| fmt_sig(x, 7)));

@@ -11,9 +11,11 @@ use clap::Args;
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::PathBuf;
-use trum_core::dynamics::transient::{step_response, NodeState, StepResponse, TransientConfig, TransientError};
+use trum_core::dynamics::transient::{
+    steady_comparison, step_response, SteadyComparison, StepResponse, TransientConfig, TransientError,
+};
 use trum_core::sweep::Axis;
-use trum_core::{solve, Motor, OperatingPoint, Solution};
+use trum_core::Motor;
 
 #[derive(Args, Debug)]
 pub struct StepArgs {
@@ -75,7 +77,7 @@ struct Run {
     frequency_hz: f64,
     phase_deg: f64,
     result: Result<StepResponse, TransientError>,
-    steady: Solution,
+    steady: SteadyComparison,
 }
 
 fn values(ax: &Axis, flag: &str) -> Result<Vec<f64>> {
@@ -85,38 +87,24 @@ fn values(ax: &Axis, flag: &str) -> Result<Vec<f64>> {
     Ok((0..ax.n).map(|i| ax.at(i)).collect())
 }
 
-fn state_name(s: NodeState) -> &'static str {
-    match s {
-        NodeState::NoContact => "no_contact",
-        NodeState::Stick => "stick",
-        NodeState::Slip => "slip",
-    }
-}
-
 /// Status of a run: `ok`, `not_moving` (no positive final speed, no metrics),
 /// `not_settled` (outside the ±2 % band at the end), or the failure.
 fn status(r: &Result<StepResponse, TransientError>) -> &'static str {
     match r {
-        Ok(s) if s.metrics.delay_s.is_none() => "not_moving",
-        Ok(s) if s.metrics.settling_time_s.is_none() => "not_settled",
-        Ok(_) => "ok",
+        Ok(s) => s.metrics.status(),
         Err(TransientError::Diverged { .. }) => "diverged",
         Err(_) => "invalid_input",
     }
 }
 
 /// The reported quantities of a run: name (unit-suffixed), value, unit, meaning.
-fn quantities(r: &Run, motor: &Motor, torque_nm: f64) -> Vec<(&'static str, f64, &'static str, &'static str)> {
+fn quantities(r: &Run) -> Vec<(&'static str, f64, &'static str, &'static str)> {
     let nan = f64::NAN;
     let (m, a) = match &r.result {
         Ok(s) => (Some(s.metrics), Some(s.averages)),
         Err(_) => (None, None),
     };
     let opt = |v: Option<f64>| v.unwrap_or(nan);
-    let valid = r.steady.status.is_valid();
-    let steady = |v: f64| if valid { v } else { nan };
-    // at steady state the contact torque carries the load and the rotor's viscous loss
-    let steady_torque = steady(torque_nm + motor.rotor.viscous_damping_nms * r.steady.speed_rad_s);
     let rel = |x: f64, y: f64| (x - y) / y;
     let speed = a.map_or(nan, |a| a.speed_rpm);
     let torque = a.map_or(nan, |a| a.contact_torque_nm);
@@ -128,13 +116,13 @@ fn quantities(r: &Run, motor: &Motor, torque_nm: f64) -> Vec<(&'static str, f64,
         ("settling_time_s", opt(m.and_then(|m| m.settling_time_s)), "s", "last entry into the ±2 % band"),
         ("peak_speed_rpm", m.map_or(nan, |m| m.peak_speed_rpm), "rpm", "largest period-averaged speed"),
         ("final_speed_rpm", speed, "rpm", "mean speed over the last 20 % of the run"),
-        ("steady_speed_rpm", steady(r.steady.speed_rpm), "rpm", "steady-state solver at this point"),
-        ("speed_difference", rel(speed, steady(r.steady.speed_rpm)), "-", "(final - steady) / steady"),
+        ("steady_speed_rpm", r.steady.speed_rpm, "rpm", "steady-state solver at this point"),
+        ("speed_difference", rel(speed, r.steady.speed_rpm), "-", "(final - steady) / steady"),
         ("contact_torque_nm", torque, "N m", "mean contact torque over the last 20 %"),
-        ("steady_contact_torque_nm", steady_torque, "N m", "load + rotor viscous torque at the steady speed"),
-        ("torque_difference", rel(torque, steady_torque), "-", "(transient - steady) / steady"),
+        ("steady_contact_torque_nm", r.steady.contact_torque_nm, "N m", "load + rotor viscous torque at steady speed"),
+        ("torque_difference", rel(torque, r.steady.contact_torque_nm), "-", "(transient - steady) / steady"),
         ("amplitude_m", amp, "m", "mean wave amplitude over the last 20 %"),
-        ("steady_amplitude_m", steady(r.steady.amplitude_m), "m", "steady-state wave amplitude"),
+        ("steady_amplitude_m", r.steady.amplitude_m, "m", "steady-state wave amplitude"),
         ("contact_fraction", a.map_or(nan, |a| a.contact_fraction), "-", "mean fraction of the wavelength in contact"),
         ("stick_fraction", a.map_or(nan, |a| a.stick_fraction), "-", "mean fraction of the wavelength sticking"),
     ]
@@ -188,7 +176,7 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
             frequency_hz: f,
             phase_deg: p,
             result: step_response(&motor, &config(v, f, p)),
-            steady: solve(&motor, &OperatingPoint::new(a.preload_n, a.torque_nm, v, f)),
+            steady: steady_comparison(&motor, &config(v, f, p)),
         })
         .collect();
     if single {
@@ -203,7 +191,7 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
         }
     }
     if let Some(path) = &a.table {
-        write_atomic(path, ".csv", &table_csv(&runs, &motor, a.torque_nm), out)?;
+        write_atomic(path, ".csv", &table_csv(&runs), out)?;
     }
     let to_stderr =
         [&a.output, &a.table, &a.snapshots].iter().any(|p| p.as_deref().is_some_and(|p| p.as_os_str() == "-"));
@@ -225,7 +213,7 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
     if single {
         print_single(&runs[0], &motor, a, summary)?;
     } else {
-        print_sweep(&runs, &motor, a.torque_nm, summary)?;
+        print_sweep(&runs, summary)?;
     }
     Ok(0)
 }
@@ -272,10 +260,8 @@ fn print_single(r: &Run, motor: &Motor, a: &StepArgs, out: &mut dyn Write) -> Re
     )?;
     writeln!(out, "status   {} (steady solver: {})", status(&r.result), r.steady.status)?;
     writeln!(out)?;
-    let rows: Vec<Vec<String>> = quantities(r, motor, a.torque_nm)
-        .into_iter()
-        .map(|(n, v, u, m)| vec![n.into(), fmt_sig(v, 6), u.into(), m.into()])
-        .collect();
+    let rows: Vec<Vec<String>> =
+        quantities(r).into_iter().map(|(n, v, u, m)| vec![n.into(), fmt_sig(v, 6), u.into(), m.into()]).collect();
     write_table(out, &["quantity", "value", "unit", "meaning"], &[Align::Left, Align::Right, Align::Left], &rows)?;
     for s in &resp.snapshots {
         let (nc, st, sl) = s.counts();
@@ -289,7 +275,7 @@ fn print_single(r: &Run, motor: &Motor, a: &StepArgs, out: &mut dyn Write) -> Re
     Ok(())
 }
 
-fn print_sweep(runs: &[Run], motor: &Motor, torque_nm: f64, out: &mut dyn Write) -> Result<()> {
+fn print_sweep(runs: &[Run], out: &mut dyn Write) -> Result<()> {
     let picked = ["final_speed_rpm", "delay_s", "rise_time_s", "overshoot", "settling_time_s", "steady_speed_rpm"];
     let mut header =
         vec!["voltage_v".to_string(), "frequency_hz".into(), "phase_difference_deg".into(), "status".into()];
@@ -297,7 +283,7 @@ fn print_sweep(runs: &[Run], motor: &Motor, torque_nm: f64, out: &mut dyn Write)
     let rows: Vec<Vec<String>> = runs
         .iter()
         .map(|r| {
-            let q = quantities(r, motor, torque_nm);
+            let q = quantities(r);
             let mut row = vec![fmt_sig(r.voltage_v, 6), fmt_sig(r.frequency_hz, 6), fmt_sig(r.phase_deg, 6)];
             row.push(status(&r.result).into());
             row.extend(picked.iter().map(|p| q.iter().find(|x| x.0 == *p).map_or("-".into(), |x| fmt_sig(x.1, 5))));
@@ -311,10 +297,10 @@ fn print_sweep(runs: &[Run], motor: &Motor, torque_nm: f64, out: &mut dyn Write)
     Ok(())
 }
 
-fn table_csv(runs: &[Run], motor: &Motor, torque_nm: f64) -> String {
+fn table_csv(runs: &[Run]) -> String {
     let mut s = String::from("voltage_v,frequency_hz,phase_difference_deg,status");
     if let Some(r) = runs.first() {
-        for q in quantities(r, motor, torque_nm) {
+        for q in quantities(r) {
             s.push(',');
             s.push_str(q.0);
         }
@@ -328,7 +314,7 @@ fn table_csv(runs: &[Run], motor: &Motor, torque_nm: f64) -> String {
             csv_number(r.phase_deg),
             status(&r.result)
         ));
-        for q in quantities(r, motor, torque_nm) {
+        for q in quantities(r) {
             s.push(',');
             s.push_str(&csv_number(q.1));
         }
@@ -375,7 +361,7 @@ fn snapshots_csv(r: &StepResponse, mu: f64) -> String {
             ];
             s.push_str(&nums.map(csv_number).join(","));
             s.push(',');
-            s.push_str(state_name(n.state));
+            s.push_str(n.state.as_str());
             s.push('\n');
         }
     }
@@ -394,7 +380,7 @@ fn speed_plot(resp: &StepResponse, r: &Run) -> LinePlot {
         line(&t.speed_rpm, series_color(0, 3), "speed_rpm", false),
         line(&t.speed_period_mean_rpm, series_color(1, 3), "period mean", false),
     ];
-    if r.steady.status.is_valid() {
+    if r.steady.speed_rpm.is_finite() {
         let (t0, t1) = (t.time_s.first().copied().unwrap_or(0.0), t.time_s.last().copied().unwrap_or(0.0));
         let v = r.steady.speed_rpm;
         lines.push(Line {
