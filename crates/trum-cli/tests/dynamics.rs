@@ -5,6 +5,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use trum_core::dynamics::hertz::{HertzOscillator, OperatingPoint, RecordOptions, ResponseMethod, SimulationSettings};
 
+mod common;
+use common::snapshot;
+
 fn trum(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_trum")).args(args).output().expect("run trum")
 }
@@ -22,17 +25,6 @@ fn fails(args: &[&str]) -> String {
     assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
     assert!(!err.contains("panicked"), "{err}");
     err
-}
-
-fn snapshot(name: &str, actual: &str) {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots").join(name);
-    if std::env::var_os("UPDATE_SNAPSHOTS").is_some() {
-        std::fs::write(&path, actual).expect("write snapshot");
-        return;
-    }
-    let expected = std::fs::read_to_string(&path)
-        .unwrap_or_else(|_| panic!("missing snapshot {}; run with UPDATE_SNAPSHOTS=1", path.display()));
-    assert_eq!(actual, expected, "snapshot {name} differs; if intended, rerun with UPDATE_SNAPSHOTS=1");
 }
 
 fn p(path: &Path) -> &str {
