@@ -61,7 +61,8 @@ impl OscillatorArgs {
             let text =
                 std::fs::read_to_string(path).with_context(|| format!("cannot read oscillator file '{shown}'"))?;
             let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
-                let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].lines().count().max(1));
+                let before = e.span().and_then(|s| text.get(..s.start)).unwrap_or("");
+                let line = before.matches('\n').count() + 1;
                 anyhow!("{shown}, line {line}: {}", e.message())
             })?;
             for (k, v) in table {

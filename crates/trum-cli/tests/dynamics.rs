@@ -245,6 +245,9 @@ fn identify_hertz_bad_input_names_file_line_and_column() {
     let osc = file("neg.toml", "# comment\nmodal_mass_kg = -1\n");
     let e = fails(&["resonance", "--oscillator", &osc, "-o", "-"]);
     assert!(e.contains(&format!("{osc}, line 2, key 'modal_mass_kg': -1 must be finite and > 0")), "{e}");
+    let osc = file("syntax.toml", "modal_mass_kg = 0.05\nfoo bar\n");
+    let e = fails(&["resonance", "--oscillator", &osc, "-o", "-"]);
+    assert!(e.contains(&format!("{osc}, line 2: ")), "{e}");
     let osc = file("str.toml", "beta_n_per_m3 = \"big\"\n");
     let e = fails(&["resonance", "--oscillator", &osc, "-o", "-"]);
     assert!(e.contains("line 1, key 'beta_n_per_m3': expected a number, got string"), "{e}");
