@@ -169,16 +169,28 @@ pub fn hertz_identify<'py>(
         harmonics,
     };
     let id = detached(py, || identify_beta(&input))?.map_err(|e| input_err(py, e.to_string()))?;
+    float_dict(
+        py,
+        &[
+            ("beta_n_per_m3", id.beta_n_per_m3),
+            ("one_term_beta_n_per_m3", id.one_term_beta_n_per_m3),
+            ("harmonic_fit_r_squared", id.harmonic_fit_r_squared),
+            ("waveform_residual_rms", id.waveform_residual_rms_v),
+            ("balance_residual_rms_m", id.balance_residual_rms_m),
+            ("balance_relative_residual", id.balance_relative_residual),
+            ("displacement_amplitude_m", id.displacement_amplitude_m),
+            ("periods_spanned", id.periods_spanned),
+            ("drive_force_n", force),
+        ],
+    )
+}
+
+/// `{name: value}` of named numbers (`None` becomes Python's `None`).
+fn float_dict<'py, T: IntoPyObject<'py> + Copy>(py: Python<'py>, items: &[(&str, T)]) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("beta_n_per_m3", id.beta_n_per_m3)?;
-    d.set_item("one_term_beta_n_per_m3", id.one_term_beta_n_per_m3)?;
-    d.set_item("harmonic_fit_r_squared", id.harmonic_fit_r_squared)?;
-    d.set_item("waveform_residual_rms", id.waveform_residual_rms_v)?;
-    d.set_item("balance_residual_rms_m", id.balance_residual_rms_m)?;
-    d.set_item("balance_relative_residual", id.balance_relative_residual)?;
-    d.set_item("displacement_amplitude_m", id.displacement_amplitude_m)?;
-    d.set_item("periods_spanned", id.periods_spanned)?;
-    d.set_item("drive_force_n", force)?;
+    for (k, v) in items {
+        d.set_item(*k, *v)?;
+    }
     Ok(d)
 }
 
@@ -258,27 +270,39 @@ pub fn step<'py>(
         series.set_item(k, PyArray::from_vec(py, v))?;
     }
     let mt = r.metrics;
-    let metrics = PyDict::new(py);
-    metrics.set_item("final_speed_rpm", mt.final_speed_rpm)?;
-    metrics.set_item("peak_speed_rpm", mt.peak_speed_rpm)?;
-    metrics.set_item("delay_s", mt.delay_s)?;
-    metrics.set_item("rise_time_s", mt.rise_time_s)?;
-    metrics.set_item("overshoot", mt.overshoot)?;
-    metrics.set_item("settling_time_s", mt.settling_time_s)?;
+    let metrics = float_dict(
+        py,
+        &[
+            ("final_speed_rpm", Some(mt.final_speed_rpm)),
+            ("peak_speed_rpm", Some(mt.peak_speed_rpm)),
+            ("delay_s", mt.delay_s),
+            ("rise_time_s", mt.rise_time_s),
+            ("overshoot", mt.overshoot),
+            ("settling_time_s", mt.settling_time_s),
+        ],
+    )?;
     let a = r.averages;
-    let averages = PyDict::new(py);
-    averages.set_item("window_s", a.window_s)?;
-    averages.set_item("speed_rpm", a.speed_rpm)?;
-    averages.set_item("contact_torque_nm", a.contact_torque_nm)?;
-    averages.set_item("amplitude_m", a.amplitude_m)?;
-    averages.set_item("axial_force_n", a.axial_force_n)?;
-    averages.set_item("contact_fraction", a.contact_fraction)?;
-    averages.set_item("stick_fraction", a.stick_fraction)?;
-    let st = PyDict::new(py);
+    let averages = float_dict(
+        py,
+        &[
+            ("window_s", a.window_s),
+            ("speed_rpm", a.speed_rpm),
+            ("contact_torque_nm", a.contact_torque_nm),
+            ("amplitude_m", a.amplitude_m),
+            ("axial_force_n", a.axial_force_n),
+            ("contact_fraction", a.contact_fraction),
+            ("stick_fraction", a.stick_fraction),
+        ],
+    )?;
+    let st = float_dict(
+        py,
+        &[
+            ("speed_rpm", steady.speed_rpm),
+            ("contact_torque_nm", steady.contact_torque_nm),
+            ("amplitude_m", steady.amplitude_m),
+        ],
+    )?;
     st.set_item("status", steady.status.as_str())?;
-    st.set_item("speed_rpm", steady.speed_rpm)?;
-    st.set_item("contact_torque_nm", steady.contact_torque_nm)?;
-    st.set_item("amplitude_m", steady.amplitude_m)?;
     let mu = m.friction_layer.friction_coefficient;
     let mut snaps = Vec::with_capacity(r.snapshots.len());
     for s in &r.snapshots {
