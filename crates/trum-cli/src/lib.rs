@@ -18,6 +18,8 @@ mod optimize;
 mod plot;
 mod point;
 mod report;
+mod resonance;
+mod step;
 mod svg;
 mod synth;
 mod table;
@@ -57,6 +59,15 @@ enum Command {
     Calibrate(calib::CalibrateArgs),
     /// Diagnose the sim-to-real gap: where the model misses, which effect causes it, how far it shrinks.
     Diagnose(diagnose::DiagnoseArgs),
+    /// Nonlinear (Hertzian) resonance curves: every branch, backbone and jump frequencies vs voltage and preload (seed 003).
+    #[command(allow_negative_numbers = true)]
+    Resonance(resonance::ResonanceArgs),
+    /// Identify the cubic coefficient beta from a sampled waveform by harmonic balance (seed 003 eq. 5-9).
+    #[command(name = "identify-hertz", allow_negative_numbers = true)]
+    IdentifyHertz(resonance::IdentifyArgs),
+    /// Step response of the rotor speed with stick-slip contact (seed 004); metrics vs the steady solver.
+    #[command(allow_negative_numbers = true)]
+    Step(step::StepArgs),
 }
 
 /// Runs the CLI with the given arguments (the first is the program name) and returns
@@ -127,5 +138,8 @@ fn run(cli: Cli, out: &mut dyn Write, err: &mut dyn Write) -> anyhow::Result<i32
         Command::Synth(a) => synth::run(&a, out, err),
         Command::Calibrate(a) => calib::run(&a, out, err),
         Command::Diagnose(a) => diagnose::run(&a, out, err),
+        Command::Resonance(a) => resonance::run(&a, out, err),
+        Command::IdentifyHertz(a) => resonance::identify(&a, out),
+        Command::Step(a) => step::run(&a, out, err),
     }
 }

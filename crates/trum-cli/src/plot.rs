@@ -134,10 +134,7 @@ struct Spec {
 }
 
 pub fn run(a: &PlotArgs, err: &mut dyn Write) -> Result<i32> {
-    let ext = a.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
-    if ext != "png" && ext != "svg" {
-        bail!("-o '{}': the plot file name must end in .png or .svg", a.output.display());
-    }
+    check_plot_path(&a.output)?;
     let (dx, dy, dg, dz) = match a.kind {
         Some(k) => k.columns(),
         None => ("", "", None, None),
@@ -175,23 +172,87 @@ pub fn run(a: &PlotArgs, err: &mut dyn Write) -> Result<i32> {
     };
     let spec = Spec { title: a.title.clone().unwrap_or_else(|| format!("{source}: {what}")), x, y, group, z };
 
+    write_figure(&a.output, &SpecFigure { spec: &spec, data: &data }, err)?;
+    Ok(0)
+}
+
+/// Something `write_figure` can draw on either backend.
+pub trait Figure {
+    /// Draws on `root`; `labels` is false when no font is available.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, labels: bool, err: &mut dyn Write) -> Result<()>;
+}
+
+/// Checks that `output` is a plot file name (.png or .svg, the format follows it).
+pub fn check_plot_path(output: &Path) -> Result<String> {
+    let ext = output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    if ext != "png" && ext != "svg" {
+        bail!("-o '{}': the plot file name must end in .png or .svg", output.display());
+    }
+    Ok(ext)
+}
+
+/// Draws `fig` into `output` (.png or .svg) through an atomically renamed temporary file.
+pub fn write_figure(output: &Path, fig: &impl Figure, err: &mut dyn Write) -> Result<()> {
+    let ext = check_plot_path(output)?;
     let labels = fonts_available();
     if !labels {
         writeln!(err, "warning: no usable system font found (plotters' ttf); the plot is drawn without text")?;
     }
-    let target = OutputTarget::create(&a.output, &format!(".{ext}"))?;
+    let target = OutputTarget::create(output, &format!(".{ext}"))?;
     let OutputTarget::File(tmp, _) = &target else { bail!("a plot cannot be written to stdout; give a file name") };
     if ext == "svg" {
         let root = SVGBackend::new(tmp.path(), SIZE_PX).into_drawing_area();
-        draw(&root, &spec, &data, labels, err)?;
+        root.fill(&WHITE).map_err(de)?;
+        fig.draw(&root, labels, err)?;
         root.present().map_err(de)?;
     } else {
         let root = BitMapBackend::new(tmp.path(), SIZE_PX).into_drawing_area();
-        draw(&root, &spec, &data, labels, err)?;
+        root.fill(&WHITE).map_err(de)?;
+        fig.draw(&root, labels, err)?;
         root.present().map_err(de)?;
     }
-    target.finish()?;
-    Ok(0)
+    target.finish()
+}
+
+struct SpecFigure<'a> {
+    spec: &'a Spec,
+    data: &'a Data,
+}
+
+impl Figure for SpecFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, labels: bool, err: &mut dyn Write) -> Result<()> {
+        draw(root, self.spec, self.data, labels, err)
+    }
+}
+
+/// One polyline of a [`LinePlot`]; non-finite points break it.
+pub struct Line {
+    /// Legend text (`None`: not in the legend).
+    pub label: Option<String>,
+    /// Colour.
+    pub color: RGBColor,
+    /// Points in drawing order.
+    pub points: Vec<(f64, f64)>,
+    /// Dashed instead of solid (unstable branches, backbones, limits).
+    pub dashed: bool,
+}
+
+/// Explicit lines against named (unit-suffixed) axes.
+pub struct LinePlot {
+    /// Title.
+    pub title: String,
+    /// Horizontal axis column name (its unit is looked up for the label).
+    pub x: String,
+    /// Vertical axis column name.
+    pub y: String,
+    /// The lines.
+    pub lines: Vec<Line>,
+}
+
+impl Figure for LinePlot {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, labels: bool, _: &mut dyn Write) -> Result<()> {
+        draw_lines(root, self, labels)
+    }
 }
 
 fn de<E: std::fmt::Display>(e: E) -> anyhow::Error {
@@ -348,7 +409,6 @@ fn draw<DB: DrawingBackend>(
     labels: bool,
     err: &mut dyn Write,
 ) -> Result<()> {
-    root.fill(&WHITE).map_err(de)?;
     let xs = data.col(&spec.x, "--x")?;
     let ys = data.col(&spec.y, "--y")?;
     match &spec.z {
@@ -385,22 +445,41 @@ fn curves<DB: DrawingBackend>(
     }
     let mut groups: Vec<(f64, Vec<(f64, f64)>)> = groups.into_values().collect();
     groups.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let xr = finite_range(xs.iter().copied()).ok_or_else(|| anyhow!("no finite values in column '{}'", spec.x))?;
-    let yr = finite_range(groups.iter().flat_map(|g| g.1.iter().map(|p| p.1)))
-        .ok_or_else(|| anyhow!("no valid values of '{}' to plot (every point is invalid)", spec.y))?;
+    let n = groups.len();
+    let lines = groups
+        .into_iter()
+        .enumerate()
+        .map(|(gi, (g, mut points))| {
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let label = spec.group.as_deref().map(|gname| {
+                let unit = unit_of(gname).map(|u| format!(" {}", u.replace(' ', "·"))).unwrap_or_default();
+                format!("{gname} = {}{unit}", crate::args::fmt_sig(g, 6))
+            });
+            Line { label, color: series_color(gi, n), points, dashed: false }
+        })
+        .collect();
+    let plot = LinePlot { title: spec.title.clone(), x: spec.x.clone(), y: spec.y.clone(), lines };
+    draw_lines(root, &plot, labels)
+}
+
+fn draw_lines<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, plot: &LinePlot, labels: bool) -> Result<()> {
+    let pts = || plot.lines.iter().flat_map(|l| l.points.iter());
+    let xr = finite_range(pts().map(|p| p.0)).ok_or_else(|| anyhow!("no finite values in column '{}'", plot.x))?;
+    let yr = finite_range(pts().map(|p| p.1))
+        .ok_or_else(|| anyhow!("no valid values of '{}' to plot (every point is invalid)", plot.y))?;
     let (x0, x1) = padded(xr.0, xr.1, false);
     let (y0, y1) = padded(yr.0, yr.1, true);
 
     let mut cb = ChartBuilder::on(root);
     cb.margin(20);
     if labels {
-        cb.caption(&spec.title, ("sans-serif", 22)).x_label_area_size(55).y_label_area_size(80);
+        cb.caption(&plot.title, ("sans-serif", 22)).x_label_area_size(55).y_label_area_size(80);
     }
     let mut chart = cb.build_cartesian_2d(x0..x1, y0..y1).map_err(de)?;
     let mut mesh = chart.configure_mesh();
     if labels {
-        mesh.x_desc(axis_label(&spec.x))
-            .y_desc(axis_label(&spec.y))
+        mesh.x_desc(axis_label(&plot.x))
+            .y_desc(axis_label(&plot.y))
             .x_label_formatter(&tick)
             .y_label_formatter(&tick)
             .label_style(("sans-serif", 15))
@@ -409,26 +488,29 @@ fn curves<DB: DrawingBackend>(
         mesh.x_labels(0).y_labels(0);
     }
     mesh.draw().map_err(de)?;
-    let n = groups.len();
-    for (gi, (g, mut pts)) in groups.into_iter().enumerate() {
-        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let color = series_color(gi, n);
+    let mut legend = false;
+    for line in &plot.lines {
+        let color = line.color;
         let style = color.stroke_width(2);
         // invalid points (NaN) break the line instead of being joined across
         let mut labelled = false;
-        for seg in pts.split(|p| !p.1.is_finite()).filter(|s| !s.is_empty()) {
-            let series = chart.draw_series(LineSeries::new(seg.iter().copied(), style)).map_err(de)?;
-            if !labelled && spec.group.is_some() && labels {
-                let gname = spec.group.as_deref().unwrap_or("");
-                let unit = unit_of(gname).map(|u| format!(" {}", u.replace(' ', "·"))).unwrap_or_default();
+        for seg in line.points.split(|p| !p.0.is_finite() || !p.1.is_finite()).filter(|s| !s.is_empty()) {
+            let pts = seg.iter().copied();
+            let series = if line.dashed {
+                chart.draw_series(DashedLineSeries::new(pts, 8, 5, style)).map_err(de)?
+            } else {
+                chart.draw_series(LineSeries::new(pts, style)).map_err(de)?
+            };
+            if let (false, true, Some(label)) = (labelled, labels, &line.label) {
                 series
-                    .label(format!("{gname} = {}{unit}", crate::args::fmt_sig(g, 6)))
+                    .label(label.clone())
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3)));
                 labelled = true;
+                legend = true;
             }
         }
     }
-    if labels && spec.group.is_some() {
+    if legend {
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)
@@ -442,7 +524,7 @@ fn curves<DB: DrawingBackend>(
 }
 
 /// Distinct colours: a viridis-like ramp for ordered groups (preloads, voltages).
-fn series_color(i: usize, n: usize) -> RGBColor {
+pub fn series_color(i: usize, n: usize) -> RGBColor {
     let t = if n <= 1 { 0.0 } else { i as f64 / (n - 1) as f64 };
     // stop short of viridis' pale yellow end, which is hard to see on white
     colormap(0.9 * t)

@@ -1,6 +1,6 @@
 //! End-to-end tests of `trum synth`, `trum calibrate` and `trum diagnose`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 fn trum(args: &[&str]) -> Output {
@@ -36,17 +36,6 @@ fn synth(dir: &Path, name: &str, extra: &[&str]) -> String {
     args.extend_from_slice(extra);
     ok(&args);
     p
-}
-
-fn snapshot(name: &str, actual: &str) {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots").join(name);
-    if std::env::var_os("UPDATE_SNAPSHOTS").is_some() {
-        std::fs::write(&path, actual).expect("write snapshot");
-        return;
-    }
-    let expected = std::fs::read_to_string(&path)
-        .unwrap_or_else(|_| panic!("missing snapshot {}; run with UPDATE_SNAPSHOTS=1", path.display()));
-    assert_eq!(actual, expected, "snapshot {name} differs; if intended, rerun with UPDATE_SNAPSHOTS=1");
 }
 
 #[test]

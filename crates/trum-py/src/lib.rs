@@ -3,6 +3,7 @@
 //! trum-core: motors, vectorised solves with the GIL released, maps and the criterion.
 //! Errors are raised as `trum.ParameterError` / `trum.InputError` with the core's message.
 
+pub mod dynamics;
 pub mod vector;
 
 use numpy::ndarray::{Array, IxDyn};
@@ -530,6 +531,10 @@ fn _trum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(effects_list, m)?)?;
     m.add_function(wrap_pyfunction!(quantities_list, m)?)?;
     m.add_function(wrap_pyfunction!(parameter_keys, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::hertz_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::hertz_response, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::hertz_identify, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::step, m)?)?;
     m.add("STATUS_NAMES", vector::STATUS_NAMES.to_vec())?;
     m.add("INPUTS", vector::INPUTS.to_vec())?;
     m.add("AXES", AXES.to_vec())?;

@@ -264,6 +264,49 @@ impl HertzOscillator {
         Ok(())
     }
 
+    /// Parameter names, as the fields are called in a TOML file or a dict.
+    pub const PARAM_KEYS: [&'static str; 10] = [
+        "modal_mass_kg",
+        "damping_ns_per_m",
+        "linear_stiffness_n_per_m",
+        "beta_n_per_m3",
+        "force_factor_n_per_v",
+        "dynamic_contact_coefficient",
+        "reference_preload_n",
+        "reference_voltage_v",
+        "beta_preload_exponent",
+        "beta_voltage_exponent",
+    ];
+
+    /// The parameter called `key` (one of [`Self::PARAM_KEYS`]), for setting it by name.
+    pub fn param_mut(&mut self, key: &str) -> Option<&mut f64> {
+        Some(match key {
+            "modal_mass_kg" => &mut self.modal_mass_kg,
+            "damping_ns_per_m" => &mut self.damping_ns_per_m,
+            "linear_stiffness_n_per_m" => &mut self.linear_stiffness_n_per_m,
+            "beta_n_per_m3" => &mut self.beta_n_per_m3,
+            "force_factor_n_per_v" => &mut self.force_factor_n_per_v,
+            "dynamic_contact_coefficient" => &mut self.dynamic_contact_coefficient,
+            "reference_preload_n" => &mut self.reference_preload_n,
+            "reference_voltage_v" => &mut self.reference_voltage_v,
+            "beta_preload_exponent" => &mut self.beta_preload_exponent,
+            "beta_voltage_exponent" => &mut self.beta_voltage_exponent,
+            _ => return None,
+        })
+    }
+
+    /// Sets the parameter `key` to `value` if the oscillator stays valid (an error names
+    /// the parameter and the range otherwise, and nothing changes). `Ok(false)`: `key` is
+    /// not a parameter.
+    pub fn set_param(&mut self, key: &str, value: f64) -> HertzResult<bool> {
+        let mut next = self.clone();
+        let Some(slot) = next.param_mut(key) else { return Ok(false) };
+        *slot = value;
+        next.validate()?;
+        *self = next;
+        Ok(true)
+    }
+
     /// Builds an oscillator with the default TRUM values but a given linear resonance
     /// `frequency_hz` (> 0), i.e. k = m(2πf)². Seed 003 eq. 2.
     pub fn with_linear_resonance_hz(frequency_hz: f64) -> HertzResult<Self> {
@@ -421,6 +464,18 @@ pub enum Branch {
     Middle,
     /// Largest of three amplitudes (stable).
     Upper,
+}
+
+impl Branch {
+    /// The word written in `branch` columns: `single`, `lower`, `middle`, `upper`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Branch::Single => "single",
+            Branch::Lower => "lower",
+            Branch::Middle => "middle",
+            Branch::Upper => "upper",
+        }
+    }
 }
 
 /// One steady-state solution of the amplitude equation (seed 003 eq. 12).
@@ -794,6 +849,73 @@ impl HertzOscillator {
             points: self.frequency_response(op, frequencies_hz, method)?,
             jumps: self.jump_frequencies(op, method)?,
         })
+    }
+}
+
+/// One curve of [`HertzOscillator::response_family`]: the response (or why there is none,
+/// e.g. [`HertzError::NoStaticEquilibrium`]) and its backbone up to 1.2 × the largest
+/// amplitude of the curve (101 points, starting at the linear resonance).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FamilyCurve {
+    /// Operating point.
+    pub operating_point: OperatingPoint,
+    /// Branches and jumps, or the reason the operating point has no response.
+    pub response: HertzResult<ResponseCurve>,
+    /// Backbone (empty when `response` is an error).
+    pub backbone: Vec<BackbonePoint>,
+}
+
+impl HertzOscillator {
+    /// A frequency band holding every linear resonance and backbone peak (at the linear peak
+    /// amplitude F/(c·ω0)) of `ops`, with 30 % of its width plus ten damping bandwidths
+    /// c/(2πm) of margin on each side, in Hz; `None` if no point has a static equilibrium.
+    pub fn response_band_hz(&self, ops: &[OperatingPoint], method: ResponseMethod) -> Option<(f64, f64)> {
+        let (mut lo, mut hi, mut bw) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+        for op in ops {
+            let Ok(eff) = self.effective(op) else { continue };
+            let f0 = eff.linear_resonance_hz();
+            let peak_amp = eff.forcing_amplitude_n / (eff.damping_ns_per_m * 2.0 * PI * f0);
+            let f_peak = self.backbone(op, &[peak_amp], method).ok().and_then(|b| b.first().map(|p| p.frequency_hz));
+            for f in [Some(f0), f_peak].into_iter().flatten() {
+                lo = lo.min(f);
+                hi = hi.max(f);
+            }
+            bw = bw.max(eff.damping_ns_per_m / (2.0 * PI * eff.modal_mass_kg));
+        }
+        if !lo.is_finite() {
+            return None;
+        }
+        let margin = 0.3 * (hi - lo) + 10.0 * bw;
+        Some(((lo - margin).max(0.5 * lo), hi + margin))
+    }
+
+    /// Response curves with backbones for every operating point of `ops` (seed 003
+    /// Fig. 11, eq. 10-12). A point without a response is kept with its error; invalid
+    /// frequencies are an error of the whole family.
+    pub fn response_family(
+        &self,
+        ops: &[OperatingPoint],
+        frequencies_hz: &[f64],
+        method: ResponseMethod,
+    ) -> HertzResult<Vec<FamilyCurve>> {
+        for &f in frequencies_hz {
+            validate_frequency(f)?;
+        }
+        Ok(ops
+            .iter()
+            .map(|op| {
+                let response = self.response_curve(op, frequencies_hz, method);
+                let backbone = match &response {
+                    Ok(c) => {
+                        let top = 1.2 * c.points.iter().map(|p| p.amplitude_m).fold(0.0, f64::max);
+                        let amps: Vec<f64> = (0..=100).map(|i| top * i as f64 / 100.0).collect();
+                        self.backbone(op, &amps, method).unwrap_or_default()
+                    }
+                    Err(_) => Vec::new(),
+                };
+                FamilyCurve { operating_point: *op, response, backbone }
+            })
+            .collect())
     }
 }
 

@@ -42,6 +42,7 @@
 //! exact kinematic slip increments). Effects in `Motor::effects` are not modelled here.
 
 use crate::params::Motor;
+use crate::solve::{solve, OperatingPoint, Status};
 use thiserror::Error;
 
 mod metrics;
@@ -187,6 +188,17 @@ pub enum NodeState {
     Slip,
 }
 
+impl NodeState {
+    /// The word written in `state` columns: `no_contact`, `stick`, `slip`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            NodeState::NoContact => "no_contact",
+            NodeState::Stick => "stick",
+            NodeState::Slip => "slip",
+        }
+    }
+}
+
 /// One contact node at a snapshot.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NodeSample {
@@ -239,6 +251,20 @@ pub struct StepMetrics {
     /// Time after which the speed stays within ±2 % of the final speed [s]
     /// (`None` if it is still outside the band at the end of the record).
     pub settling_time_s: Option<f64>,
+}
+
+impl StepMetrics {
+    /// `ok`; `not_moving` (no positive final speed, so no metrics, e.g. a standing wave);
+    /// `not_settled` (still outside the ±2 % band at the end of the run).
+    pub fn status(&self) -> &'static str {
+        if self.delay_s.is_none() {
+            "not_moving"
+        } else if self.settling_time_s.is_none() {
+            "not_settled"
+        } else {
+            "ok"
+        }
+    }
 }
 
 /// Means over the last whole drive periods of the run (at least 20 % of it), taken at
@@ -334,4 +360,32 @@ pub fn step_response(motor: &Motor, cfg: &TransientConfig) -> Result<StepRespons
         time_step_s: out.time_step_s,
         steps: out.steps,
     })
+}
+
+/// The steady-state solver's answer at the operating point of a run, in the terms of
+/// [`SteadyAverages`], to compare a settled transient with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SteadyComparison {
+    /// Status of the steady solution; the numbers are NaN unless it is valid.
+    pub status: Status,
+    /// Steady rotor speed [rev/min].
+    pub speed_rpm: f64,
+    /// Contact torque at steady state: the load plus the rotor's viscous torque d_r·Ω [N·m].
+    pub contact_torque_nm: f64,
+    /// Steady wave amplitude [m].
+    pub amplitude_m: f64,
+}
+
+/// Solves the steady model ([`crate::solve`]) at the preload, load, voltage and frequency
+/// of `cfg` (the steady model has no phase difference: it assumes the travelling wave).
+pub fn steady_comparison(motor: &Motor, cfg: &TransientConfig) -> SteadyComparison {
+    let s = solve(motor, &OperatingPoint::new(cfg.preload_n, cfg.load_torque_nm, cfg.voltage_v, cfg.frequency_hz));
+    let valid = s.status.is_valid();
+    let v = |x: f64| if valid { x } else { f64::NAN };
+    SteadyComparison {
+        status: s.status,
+        speed_rpm: v(s.speed_rpm),
+        contact_torque_nm: v(cfg.load_torque_nm + motor.rotor.viscous_damping_nms * s.speed_rad_s),
+        amplitude_m: v(s.amplitude_m),
+    }
 }

@@ -26,6 +26,17 @@ from ._registry import (
 from ._result import Result
 from ._motor import Motor
 from ._api import Optimum, map, optimize
+from ._dynamics import (
+    HertzIdentification,
+    Resonance,
+    ResonanceCurve,
+    Snapshot,
+    StepResult,
+    hertz_defaults,
+    identify_hertz,
+    resonance,
+    step,
+)
 from ._trum import __version__
 
 __all__ = [
@@ -34,6 +45,15 @@ __all__ = [
     "Optimum",
     # `map` is left out of __all__ so `from trum import *` does not shadow the builtin.
     "optimize",
+    "resonance",
+    "identify_hertz",
+    "step",
+    "hertz_defaults",
+    "Resonance",
+    "ResonanceCurve",
+    "HertzIdentification",
+    "StepResult",
+    "Snapshot",
     "presets",
     "preset_toml",
     "effects",

@@ -78,3 +78,36 @@ def preset_toml(name: str) -> str: ...
 def effects_list() -> List[Tuple[str, str, str, List[Tuple[str, str, float, float, float]]]]: ...
 def quantities_list() -> List[Tuple[str, str, str]]: ...
 def parameter_keys() -> List[Tuple[str, str]]: ...
+def hertz_defaults() -> List[Tuple[str, float]]: ...
+def hertz_response(
+    params: Sequence[Tuple[str, float]],
+    voltage_v: Sequence[float],
+    preload_n: Sequence[float],
+    frequency_hz: Optional[npt.NDArray[np.float64]] = None,
+    method_name: str = "multiple_scales",
+) -> Dict[str, Any]: ...
+def hertz_identify(
+    time_s: npt.NDArray[np.float64],
+    signal: npt.NDArray[np.float64],
+    frequency_hz: float,
+    params: Sequence[Tuple[str, float]],
+    voltage_v: Optional[float] = None,
+    preload_n: Optional[float] = None,
+    drive_force_n: Optional[float] = None,
+    feedback_gain_v_per_m: Optional[float] = None,
+    harmonics: int = 3,
+) -> Dict[str, float]: ...
+def step(
+    motor: Motor,
+    voltage_v: float,
+    frequency_hz: float,
+    phase_difference_deg: float,
+    preload_n: float,
+    torque_nm: float,
+    duration_s: float,
+    steps_per_period: int,
+    nodes_per_wavelength: int,
+    tangential_stiffness_ratio: float,
+    record_every: int,
+    snapshot_at_s: Sequence[float],
+) -> Dict[str, Any]: ...

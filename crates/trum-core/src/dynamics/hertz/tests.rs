@@ -364,3 +364,39 @@ fn bad_inputs_give_errors() {
     assert!(identify_beta(&BetaIdentificationInput { samples_v: &zeros, ..base }).is_err());
     assert!(linear_stiffness_from_resonance_n_per_m(0.05, -1.0).is_err());
 }
+
+/// Parameters by name (the CLI's `--oscillator` file and Python's dict): an invalid value
+/// is refused and changes nothing; the family keeps points without a static equilibrium
+/// as errors; the default band holds every jump of the family.
+#[test]
+fn parameters_by_name_family_and_band() {
+    let mut o = HertzOscillator::default();
+    assert_eq!(o.set_param("damping_ns_per_m", 2.0), Ok(true));
+    assert_eq!(o.damping_ns_per_m, 2.0);
+    assert!(matches!(
+        o.set_param("modal_mass_kg", -1.0),
+        Err(HertzError::InvalidParameter { name: "modal_mass_kg", .. })
+    ));
+    assert_eq!(o.modal_mass_kg, HertzOscillator::default().modal_mass_kg);
+    assert_eq!(o.set_param("modal_mass", 1.0), Ok(false));
+    for k in HertzOscillator::PARAM_KEYS {
+        assert!(HertzOscillator::default().param_mut(k).is_some(), "{k}");
+    }
+    let o = HertzOscillator::default();
+    let ops: Vec<OperatingPoint> =
+        [100.0, 200.0, 300.0].iter().map(|&v| OperatingPoint { voltage_v: v, preload_n: 400.0 }).collect();
+    let (lo, hi) = o.response_band_hz(&ops, ResponseMethod::MultipleScales).unwrap();
+    for op in &ops {
+        let j = o.jump_frequencies(op, ResponseMethod::MultipleScales).unwrap().unwrap();
+        assert!(lo < j.jump_down_hz && j.jump_up_hz < hi, "{j:?} outside {lo}..{hi}");
+    }
+    let mut with_bad = ops.clone();
+    with_bad.push(OperatingPoint { voltage_v: 200.0, preload_n: 1e6 });
+    let fam = o.response_family(&with_bad, &[40_900.0, 41_000.0], ResponseMethod::MultipleScales).unwrap();
+    assert_eq!(fam.len(), 4);
+    assert!(matches!(fam[3].response, Err(HertzError::NoStaticEquilibrium { .. })) && fam[3].backbone.is_empty());
+    let bb = &fam[1].backbone;
+    assert_eq!(bb.len(), 101);
+    assert_eq!(bb[0].amplitude_m, 0.0);
+    assert!(o.response_family(&ops, &[0.0], ResponseMethod::MultipleScales).is_err());
+}

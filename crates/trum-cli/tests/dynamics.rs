@@ -1,0 +1,369 @@
+//! End-to-end tests of `trum resonance`, `trum identify-hertz` and `trum step`: the files
+//! they write, agreement with trum-core, snapshots of the printed tables, bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use trum_core::dynamics::hertz::{HertzOscillator, OperatingPoint, RecordOptions, ResponseMethod, SimulationSettings};
+
+mod common;
+use common::snapshot;
+
+fn trum(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_trum")).args(args).output().expect("run trum")
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = trum(args);
+    assert_eq!(o.status.code(), Some(0), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Runs, expects exit status 1 and returns stderr.
+fn fails(args: &[&str]) -> String {
+    let o = trum(args);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+fn p(path: &Path) -> &str {
+    path.to_str().unwrap_or_default()
+}
+
+/// Header and rows of a CSV as strings.
+fn csv_rows(text: &str) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut r = csv::Reader::from_reader(text.as_bytes());
+    let h = r.headers().expect("header").iter().map(String::from).collect();
+    let rows = r.records().map(|x| x.expect("row").iter().map(String::from).collect()).collect();
+    (h, rows)
+}
+
+fn num(s: &str) -> f64 {
+    s.parse().unwrap_or_else(|_| panic!("'{s}' is not a number"))
+}
+
+#[test]
+fn resonance_csv_has_every_branch_the_jumps_and_status_rows() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("r.csv");
+    let summary = ok(&[
+        "resonance",
+        "--voltage-v",
+        "100:300:3",
+        "--preload-n",
+        "400",
+        "--frequency-hz",
+        "40800:41050:251",
+        "-o",
+        p(&out),
+    ]);
+    snapshot("resonance_summary.txt", &summary);
+    let text = std::fs::read_to_string(&out).expect("csv written");
+    assert!(!text.to_lowercase().contains("nan"));
+    let (h, rows) = csv_rows(&text);
+    assert_eq!(
+        h,
+        ["voltage_v", "preload_n", "frequency_hz", "branch", "status", "amplitude_m", "phase_lag_rad", "stable"]
+    );
+    let o = HertzOscillator::default();
+    let op = OperatingPoint { voltage_v: 200.0, preload_n: 400.0 };
+    let jumps = o.jump_frequencies(&op, ResponseMethod::MultipleScales).expect("valid").expect("bistable at 200 V");
+    let at200 = |branch: &str| -> Vec<(f64, f64)> {
+        rows.iter().filter(|r| r[0] == "200" && r[3] == branch).map(|r| (num(&r[2]), num(&r[5]))).collect()
+    };
+    // the saddle nodes are the core's, bit for bit
+    assert_eq!(at200("jump_up"), [(jumps.jump_up_hz, jumps.jump_up_amplitude_m)]);
+    assert_eq!(at200("jump_down"), [(jumps.jump_down_hz, jumps.jump_down_amplitude_m)]);
+    // inside the hysteresis band three roots, ordered, the middle one unstable
+    let (lower, middle, upper) = (at200("lower"), at200("middle"), at200("upper"));
+    assert!(lower.len() > 50 && lower.len() == middle.len() && middle.len() == upper.len());
+    for i in 0..lower.len() {
+        let f = lower[i].0;
+        assert!(f > jumps.jump_down_hz && f < jumps.jump_up_hz, "{f} outside the band {jumps:?}");
+        assert!(lower[i].1 < middle[i].1 && middle[i].1 < upper[i].1);
+    }
+    for r in rows.iter().filter(|r| r[3] == "middle") {
+        assert_eq!(r[7], "false");
+    }
+    for r in rows.iter().filter(|r| ["lower", "upper"].contains(&r[3].as_str())) {
+        assert_eq!(r[7], "true");
+    }
+    // softening backbone: starts at the linear resonance, frequency falls with amplitude
+    let bb = at200("backbone");
+    let eff = o.effective(&op).expect("valid");
+    assert!((bb[0].0 - eff.linear_resonance_hz()).abs() < 1e-9 && bb[0].1 == 0.0);
+    assert!(bb.windows(2).all(|w| w[1].0 < w[0].0 && w[1].1 > w[0].1));
+    // hysteresis grows with voltage (seed 003 Fig. 11a)
+    let band = |v: &str| {
+        let f = |b: &str| rows.iter().find(|r| r[0] == v && r[3] == b).map(|r| num(&r[2])).expect("jump row");
+        f("jump_up") - f("jump_down")
+    };
+    assert!(band("100") < band("200") && band("200") < band("300"));
+
+    // a preload the softening spring cannot carry: a status row, no numbers, no NaN
+    let csv = ok(&["resonance", "--voltage-v", "200", "--preload-n", "1e6", "--frequency-hz", "41000", "-o", "-"]);
+    let (_, rows) = csv_rows(&csv);
+    assert_eq!(rows, [["200", "1000000", "", "", "no_static_equilibrium", "", "", ""]]);
+}
+
+#[test]
+fn resonance_plots_and_preload_family() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let png = dir.path().join("r.png");
+    let svg = dir.path().join("r.svg");
+    ok(&["resonance", "--voltage-v", "200", "--preload-n", "200:400:3", "--plot", p(&png)]);
+    assert_eq!(&std::fs::read(&png).expect("png")[..8], b"\x89PNG\r\n\x1a\n");
+    let csv = ok(&[
+        "resonance",
+        "--voltage-v",
+        "200",
+        "--preload-n",
+        "200:400:3",
+        "--method",
+        "harmonic-balance",
+        "--plot",
+        p(&svg),
+        "-o",
+        "-",
+    ]);
+    assert!(std::fs::read_to_string(&svg).expect("svg").starts_with("<svg"));
+    // the peak amplitude grows with preload (seed 003 Fig. 12)
+    let (_, rows) = csv_rows(&csv);
+    let peak =
+        |n: &str| rows.iter().filter(|r| r[1] == n && r[3] != "backbone").map(|r| num(&r[5])).fold(0.0, f64::max);
+    assert!(peak("200") < peak("300") && peak("300") < peak("400"));
+    // bad plot name fails before anything is computed or written
+    let e = fails(&["resonance", "--plot", p(&dir.path().join("r.jpg"))]);
+    assert!(e.contains(".png or .svg"), "{e}");
+    let e = fails(&["resonance"]);
+    assert!(e.contains("-o CSV and/or --plot"), "{e}");
+}
+
+/// A feedback-voltage record of the oscillator at 200 V, 400 N on its upper branch at
+/// 40.93 kHz (the core's identification test case), started on the branch and settled.
+fn waveform_csv(dir: &Path, displacement: bool) -> (PathBuf, f64) {
+    let o = HertzOscillator::default();
+    let op = OperatingPoint { voltage_v: 200.0, preload_n: 400.0 };
+    let f = 40_930.0;
+    let pts = o.frequency_response(&op, &[f], ResponseMethod::MultipleScales).expect("valid");
+    let upper = pts.last().expect("a branch");
+    let init = o.branch_state(&op, upper).expect("valid");
+    let rec = RecordOptions { from_s: 0.6, stride: 2 };
+    let ts = o
+        .simulate_constant_frequency(&op, f, 0.6 + 40.0 / f, &init, &rec, &SimulationSettings::default())
+        .expect("simulates");
+    let (name, scale) = if displacement { ("displacement_m", 1.0) } else { ("feedback_voltage_v", 2.0e6) };
+    let mut s = format!("# simulated at 200 V, 400 N, {f} Hz\ntime_s,{name}\n");
+    for (t, w) in ts.time_s.iter().zip(&ts.displacement_m) {
+        s.push_str(&format!("{t},{}\n", scale * w));
+    }
+    let path = dir.join(format!("{name}.csv"));
+    std::fs::write(&path, s).expect("write waveform");
+    (path, o.beta_at_n_per_m3(&op).expect("valid"))
+}
+
+#[test]
+fn identify_hertz_recovers_beta_from_a_simulated_waveform() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (volts, beta) = waveform_csv(dir.path(), false);
+    let args =
+        ["identify-hertz", "--data", p(&volts), "--frequency-hz", "40930", "--voltage-v", "200", "--preload-n", "400"];
+    let json = ok(&[&args[..], &["--feedback-gain-v-per-m", "2e6", "--json"]].concat());
+    let v: serde_json::Value = serde_json::from_str(&json).expect("JSON");
+    let got = v["beta_n_per_m3"].as_f64().expect("number");
+    assert!((got / beta - 1.0).abs() < 0.01, "{got} vs {beta}");
+    assert!(v["harmonic_fit_r_squared"].as_f64().expect("number") > 0.999_999);
+    assert!(v["waveform_residual_rms_v"].is_number() && v["balance_relative_residual"].is_number());
+    // the displacement form of the same record gives the same beta
+    let (disp, _) = waveform_csv(dir.path(), true);
+    let json = ok(&[
+        "identify-hertz",
+        "--data",
+        p(&disp),
+        "--frequency-hz",
+        "40930",
+        "--voltage-v",
+        "200",
+        "--preload-n",
+        "400",
+        "--json",
+    ]);
+    let v2: serde_json::Value = serde_json::from_str(&json).expect("JSON");
+    let got2 = v2["beta_n_per_m3"].as_f64().expect("number");
+    assert!((got2 / got - 1.0).abs() < 1e-6, "{got2} vs {got}");
+    // the table names every figure with its unit
+    let table = ok(&[&args[..], &["--feedback-gain-v-per-m", "2e6"]].concat());
+    for want in ["beta_n_per_m3", "N/m³", "harmonic_fit_r_squared", "waveform_residual_rms_v", "balance_residual_rms_m"]
+    {
+        assert!(table.contains(want), "{table}");
+    }
+    // beta is sensitive to the assumed k (docs/DYNAMICS.md: ~300x the relative error of k);
+    // a 10 Hz error in the linear resonance moves it by several per cent and worsens the fit
+    let off =
+        ok(&[&args[..], &["--feedback-gain-v-per-m", "2e6", "--linear-resonance-hz", "40990", "--json"]].concat());
+    let v3: serde_json::Value = serde_json::from_str(&off).expect("JSON");
+    let rel = |v: &serde_json::Value| v["balance_relative_residual"].as_f64().expect("number");
+    assert!(rel(&v3) > 1.5 * rel(&v), "{} vs {}", rel(&v3), rel(&v));
+    assert!((v3["beta_n_per_m3"].as_f64().expect("number") / got - 1.0).abs() > 0.05);
+}
+
+#[test]
+fn identify_hertz_bad_input_names_file_line_and_column() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let file = |name: &str, text: &str| {
+        let path = d.join(name);
+        std::fs::write(&path, text).expect("write");
+        path.to_string_lossy().into_owned()
+    };
+    let run = |f: &str, extra: &[&str]| {
+        let base = ["identify-hertz", "--data", f, "--frequency-hz", "41000", "--voltage-v", "200"];
+        fails(&[&base[..], extra].concat())
+    };
+    let f = file("cell.csv", "time_s,displacement_m\n0,1e-6\n1e-6,abc\n");
+    let e = run(&f, &[]);
+    assert!(e.contains(&format!("{f}, line 3, column 'displacement_m': 'abc' is not a finite number")), "{e}");
+    let f = file("time.csv", "time_s,displacement_m\n0,1e-6\n2e-6,1e-6\n1e-6,1e-6\n");
+    let e = run(&f, &[]);
+    assert!(e.contains("line 4, column 'time_s'") && e.contains("times must increase"), "{e}");
+    let f = file("cols.csv", "t,w\n0,1\n");
+    let e = run(&f, &[]);
+    assert!(e.contains(&f) && e.contains("line 1: no 'time_s' column; the columns are: t, w"), "{e}");
+    let f = file("volts.csv", "time_s,feedback_voltage_v\n0,1\n1e-6,2\n");
+    let e = run(&f, &[]);
+    assert!(e.contains("--feedback-gain-v-per-m is needed"), "{e}");
+    let f = file("short.csv", "time_s,displacement_m\n0,1e-6\n1e-6,2e-6\n2e-6,1e-6\n");
+    let e = run(&f, &[]);
+    assert!(e.contains(&f) && e.contains("input too short"), "{e}");
+    let e = run(&d.join("missing.csv").to_string_lossy(), &[]);
+    assert!(e.contains("cannot read waveform") && e.contains("missing.csv"), "{e}");
+    // oscillator parameters: file, line and key; flags by name
+    let osc = file("osc.toml", "modal_mass_kg = 0.05\ndamping_ns_per_mm = 1.0\n");
+    let e = fails(&["resonance", "--oscillator", &osc, "-o", "-"]);
+    assert!(e.contains(&format!("{osc}, line 2, key 'damping_ns_per_mm': unknown key; valid keys are:")), "{e}");
+    let osc = file("neg.toml", "# comment\nmodal_mass_kg = -1\n");
+    let e = fails(&["resonance", "--oscillator", &osc, "-o", "-"]);
+    assert!(e.contains(&format!("{osc}, line 2, key 'modal_mass_kg': -1 must be finite and > 0")), "{e}");
+    let osc = file("syntax.toml", "modal_mass_kg = 0.05\nfoo bar\n");
+    let e = fails(&["resonance", "--oscillator", &osc, "-o", "-"]);
+    assert!(e.contains(&format!("{osc}, line 2: ")), "{e}");
+    let osc = file("str.toml", "beta_n_per_m3 = \"big\"\n");
+    let e = fails(&["resonance", "--oscillator", &osc, "-o", "-"]);
+    assert!(e.contains("line 1, key 'beta_n_per_m3': expected a number, got string"), "{e}");
+    let e = fails(&["resonance", "--damping-ns-per-m", "0", "-o", "-"]);
+    assert!(e.contains("--damping-ns-per-m 0: 0 must be finite and > 0"), "{e}");
+    let e = fails(&["resonance", "--frequency-hz", "-5", "-o", "-"]);
+    assert!(e.contains("--frequency-hz: -5 must be a finite frequency > 0"), "{e}");
+    // a partial oscillator file keeps the other defaults and changes the answer
+    let osc = file("part.toml", "damping_ns_per_m = 5\n");
+    let soft = ok(&["resonance", "--voltage-v", "200", "--frequency-hz", "40900", "-o", "-"]);
+    let damped = ok(&["resonance", "--oscillator", &osc, "--voltage-v", "200", "--frequency-hz", "40900", "-o", "-"]);
+    let branches = |s: &str| csv_rows(s).1.iter().filter(|r| r[3] != "backbone" && !r[3].starts_with("jump")).count();
+    assert_eq!(branches(&soft), 3, "bistable at 40.9 kHz");
+    assert_eq!(branches(&damped), 1, "5x damping removes the hysteresis there");
+}
+
+const FAST: [&str; 6] = ["--duration-s", "0.004", "--nodes-per-wavelength", "64", "--steps-per-period", "64"];
+
+#[test]
+fn step_prints_metrics_against_the_steady_solver_and_writes_files() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let (series, snaps, plot, splot) = (d.join("s.csv"), d.join("n.csv"), d.join("s.svg"), d.join("n.png"));
+    let args = [
+        "step",
+        "--motor",
+        "trum60a",
+        "-o",
+        p(&series),
+        "--snapshot-at-s",
+        "2e-5,0.0035",
+        "--snapshots",
+        p(&snaps),
+        "--plot",
+        p(&plot),
+        "--snapshot-plot",
+        p(&splot),
+    ];
+    let out = ok(&[&args[..], &FAST[..]].concat());
+    snapshot("step_trum60a_fast.txt", &out);
+    // settled speed: 0-15 % above the rigid-Coulomb steady solver with the default
+    // layer stiffness (docs/DYNAMICS.md); the contact torque balances the rotor loss
+    let value = |name: &str| {
+        let line = out.lines().find(|l| l.starts_with(&format!("{name} "))).expect("quantity printed");
+        num(line.split_whitespace().nth(1).expect("value"))
+    };
+    assert!(value("speed_difference") > 0.0 && value("speed_difference") < 0.15, "{out}");
+    assert!(value("torque_difference").abs() < 0.15, "{out}");
+    assert!(value("overshoot") > 0.05 && value("delay_s") < 1e-3, "{out}");
+    let (h, rows) = csv_rows(&std::fs::read_to_string(&series).expect("series"));
+    assert_eq!(h[0], "time_s");
+    assert!(h.contains(&"speed_rpm".to_string()) && h.contains(&"contact_torque_nm".to_string()));
+    assert_eq!(num(&rows[0][1]), 0.0, "starts at rest");
+    let (h, rows) = csv_rows(&std::fs::read_to_string(&snaps).expect("snapshots"));
+    assert_eq!(h.last().map(String::as_str), Some("state"));
+    assert_eq!(rows.len(), 2 * 64);
+    // Coulomb: |f| <= mu p everywhere, slip nodes at the limit, no-contact nodes unloaded
+    let (fi, li) = (4, 5);
+    for r in &rows {
+        let (f, lim) = (num(&r[fi]), num(&r[li]));
+        assert!(f.abs() <= lim * (1.0 + 1e-12), "{r:?}");
+        match r[7].as_str() {
+            "slip" => assert!((f.abs() - lim).abs() <= 1e-9 * lim, "{r:?}"),
+            "no_contact" => assert!(f == 0.0 && lim == 0.0, "{r:?}"),
+            s => assert_eq!(s, "stick"),
+        }
+    }
+    // full contact at 20 us, all three zones once running (seed 004 Fig. 10)
+    assert!(rows[..64].iter().all(|r| r[7] != "no_contact"));
+    for s in ["stick", "slip", "no_contact"] {
+        assert!(rows[64..].iter().any(|r| r[7] == s), "no {s} node at 3.5 ms");
+    }
+    assert!(std::fs::read_to_string(&plot).expect("svg").starts_with("<svg"));
+    assert_eq!(&std::fs::read(&splot).expect("png")[..8], b"\x89PNG\r\n\x1a\n");
+}
+
+#[test]
+fn step_sweep_over_phase_table() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let table = dir.path().join("t.csv");
+    let out = ok(&[
+        &["step", "--motor", "trum60a", "--phase-difference-deg", "-90:90:3", "--table", p(&table)][..],
+        &FAST[..],
+    ]
+    .concat());
+    assert!(out.contains("not_moving"), "{out}");
+    let (h, rows) = csv_rows(&std::fs::read_to_string(&table).expect("table"));
+    assert_eq!(&h[..4], ["voltage_v", "frequency_hz", "phase_difference_deg", "status"]);
+    let col = |name: &str| h.iter().position(|c| c == name).expect("column");
+    let speed: Vec<f64> = rows.iter().map(|r| num(&r[col("final_speed_rpm")])).collect();
+    // -90 deg reverses the rotor, 0 deg (standing wave) does not turn it
+    assert!(speed[2] > 50.0 && (speed[0] + speed[2]).abs() < 1e-6 * speed[2], "{speed:?}");
+    assert!(speed[1].abs() < 1e-3 * speed[2], "{speed:?}");
+    assert_eq!(rows[1][3], "not_moving");
+    assert_eq!(rows[1][col("delay_s")], "", "no metrics for a standing wave: empty, not NaN");
+}
+
+#[test]
+fn step_bad_input_and_failed_runs_leave_no_file() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("s.csv");
+    let base = ["step", "--motor", "trum60a", "-o", p(&out)];
+    let e = fails(&[&base[..], &["--steps-per-period", "8"]].concat());
+    assert!(e.contains("--steps-per-period = 8: must be >= 16"), "{e}");
+    let e = fails(&[&base[..], &["--snapshot-at-s", "0.5"]].concat());
+    assert!(e.contains("--snapshot-at-s = 0.5: must lie in [0, duration_s]"), "{e}");
+    let e = fails(&[&base[..], &["--voltage-v", "-200"]].concat());
+    assert!(e.contains("--voltage-v = -200: must be finite and > 0"), "{e}");
+    // a run refused by the stability check after the settings were accepted
+    let e = fails(&[&base[..], &["--tangential-stiffness-ratio", "1e6"]].concat());
+    assert!(e.contains("time step too large") && e.contains("--steps-per-period"), "{e}");
+    let e = fails(&[&base[..], &["--effect", "radial_friction=0.5"]].concat());
+    assert!(e.contains("does not include unmodelled effects"), "{e}");
+    let e = fails(&["step", "--motor", "trum60a", "--voltage-v", "100:200:2", "-o", p(&out)]);
+    assert!(e.contains("single operating point"), "{e}");
+    let e = fails(&["step", "--motor", "trum61"]);
+    assert!(e.contains("unknown preset 'trum61'"), "{e}");
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0, "no partial output");
+}

@@ -1,0 +1,264 @@
+"""Nonlinear resonance of the Hertzian oscillator and β identification (seed 003), and the
+stick-slip step response (seed 004): ``trum.resonance``, ``trum.identify_hertz``,
+``trum.step`` (the CLI's ``trum resonance``, ``trum identify-hertz``, ``trum step``)."""
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _trum
+from ._api import _axis, _motor
+from ._errors import InputError
+from ._motor import Motor, _number
+
+Values = Union[float, Sequence[float], np.ndarray]
+
+
+def hertz_defaults() -> Dict[str, float]:
+    """The Hertzian oscillator's default parameters (60 mm TRUM, docs/DYNAMICS.md)."""
+    return dict(_trum.hertz_defaults())
+
+
+def _params(oscillator: Optional[Mapping[str, Any]]) -> List[tuple]:
+    if oscillator is None:
+        return []
+    if not isinstance(oscillator, Mapping):
+        raise InputError(f"oscillator: expected a dict of parameters, got {type(oscillator).__name__}")
+    return [(str(k), _number("oscillator", str(k), v)) for k, v in oscillator.items()]
+
+
+def _values(name: str, v: Values) -> List[float]:
+    """A number, a 1-D array or list of numbers, or a ``(start, stop, n)`` tuple."""
+    if isinstance(v, tuple) and len(v) == 3:
+        a, b, n = _axis(name, v)
+        if n < 1:
+            raise InputError(f"{name}: the point count {n} must be >= 1")
+        return np.linspace(a, b, n).tolist()
+    if isinstance(v, numbers.Real) and not isinstance(v, bool):
+        return [float(v)]
+    try:
+        arr = np.asarray(v, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected numbers, got {v!r}") from None
+    if arr.ndim != 1 or arr.size == 0:
+        raise InputError(f"{name}: expected a number or a non-empty 1-D array, got shape {arr.shape}")
+    return arr.tolist()
+
+
+@dataclass(frozen=True)
+class ResonanceCurve:
+    """The response at one (voltage, preload): every branch at every frequency (points of
+    the same frequency share ``frequency_hz``), the backbone and the saddle nodes."""
+
+    voltage_v: float
+    preload_n: float
+    status: str  # 'ok', 'no_static_equilibrium' or 'invalid_input'
+    reason: str
+    frequency_hz: np.ndarray
+    amplitude_m: np.ndarray
+    phase_lag_rad: np.ndarray
+    stable: np.ndarray
+    branch: np.ndarray  # 'single', 'lower', 'middle' (unstable) or 'upper'
+    backbone_frequency_hz: np.ndarray
+    backbone_amplitude_m: np.ndarray
+    jump_up_hz: Optional[float]
+    jump_up_amplitude_m: Optional[float]
+    jump_down_hz: Optional[float]
+    jump_down_amplitude_m: Optional[float]
+    linear_resonance_hz: Optional[float]
+    equivalent_beta_n_per_m3: Optional[float]
+
+    @property
+    def hysteresis_hz(self) -> Optional[float]:
+        """Width of the bistable band, or ``None`` when the response is single valued."""
+        if self.jump_up_hz is None or self.jump_down_hz is None:
+            return None
+        return abs(self.jump_up_hz - self.jump_down_hz)
+
+
+@dataclass(frozen=True)
+class Resonance:
+    """Result of :func:`resonance`: one curve per (voltage, preload), voltage slowest."""
+
+    frequency_hz: np.ndarray
+    curves: List[ResonanceCurve]
+
+    def to_dict(self) -> Dict[str, np.ndarray]:
+        """Flat columns laid out like the CLI's CSV: ``voltage_v, preload_n, frequency_hz,
+        branch, status, amplitude_m, phase_lag_rad, stable``; branch rows, then the
+        ``backbone`` rows, then ``jump_up``/``jump_down``; a curve without a response is
+        one row with its status and NaN numbers."""
+        cols: Dict[str, list] = {k: [] for k in
+                                 ("voltage_v", "preload_n", "frequency_hz", "branch", "status",
+                                  "amplitude_m", "phase_lag_rad", "stable")}
+
+        def add(c: ResonanceCurve, f, branch, status, a, ph, st) -> None:
+            for k, v in zip(cols, (c.voltage_v, c.preload_n, f, branch, status, a, ph, st)):
+                cols[k].append(v)
+
+        nan = float("nan")
+        for c in self.curves:
+            if c.status != "ok":
+                add(c, nan, "", c.status, nan, nan, None)
+                continue
+            for i in range(c.frequency_hz.size):
+                add(c, c.frequency_hz[i], c.branch[i], "ok", c.amplitude_m[i], c.phase_lag_rad[i], bool(c.stable[i]))
+            for f, a in zip(c.backbone_frequency_hz, c.backbone_amplitude_m):
+                add(c, f, "backbone", "ok", a, nan, None)
+            if c.jump_up_hz is not None:
+                add(c, c.jump_up_hz, "jump_up", "ok", c.jump_up_amplitude_m, nan, False)
+                add(c, c.jump_down_hz, "jump_down", "ok", c.jump_down_amplitude_m, nan, False)
+        out = {k: np.array(v, dtype=np.float64) for k, v in cols.items()
+               if k in ("voltage_v", "preload_n", "frequency_hz", "amplitude_m", "phase_lag_rad")}
+        out["branch"] = np.array(cols["branch"], dtype=object)
+        out["status"] = np.array(cols["status"], dtype=object)
+        out["stable"] = np.array(cols["stable"], dtype=object)
+        return out
+
+
+def resonance(
+    *,
+    voltage_v: Values = (100.0, 300.0, 3),
+    preload_n: Values = 400.0,
+    frequency_hz: Optional[Values] = None,
+    method: str = "multiple_scales",
+    oscillator: Optional[Mapping[str, float]] = None,
+) -> Resonance:
+    """Amplitude–frequency response of the Hertzian oscillator (seed 003 eq. 10-12) for
+    every voltage × preload: all branches incl. the unstable one, backbone, jump-up and
+    jump-down frequencies. Each of ``voltage_v``, ``preload_n``, ``frequency_hz`` is a
+    number, a 1-D array or ``(start, stop, n)``; ``frequency_hz=None`` picks 401 points
+    over a band holding every peak and jump. ``method``: ``'multiple_scales'`` or
+    ``'harmonic_balance'``. ``oscillator``: parameters overriding :func:`hertz_defaults`.
+    A point the softening spring cannot carry has status ``'no_static_equilibrium'``."""
+    freqs = None if frequency_hz is None else np.ascontiguousarray(_values("frequency_hz", frequency_hz))
+    d = _trum.hertz_response(
+        _params(oscillator), _values("voltage_v", voltage_v), _values("preload_n", preload_n), freqs, method
+    )
+    curves = []
+    for c in d["curves"]:
+        c = dict(c)
+        c["branch"] = np.array(c["branch"], dtype=object)
+        curves.append(ResonanceCurve(**c))
+    return Resonance(d["frequency_hz"], curves)
+
+
+@dataclass(frozen=True)
+class HertzIdentification:
+    """β identified by harmonic balance, with the fit quality (see docs/DYNAMICS.md)."""
+
+    beta_n_per_m3: float
+    one_term_beta_n_per_m3: float
+    harmonic_fit_r_squared: float
+    waveform_residual_rms: float  # in the unit of the signal (V or m)
+    balance_residual_rms_m: float
+    balance_relative_residual: float
+    displacement_amplitude_m: float
+    periods_spanned: float
+    drive_force_n: float
+
+
+def identify_hertz(
+    time_s: Any,
+    signal: Any,
+    *,
+    frequency_hz: float,
+    voltage_v: Optional[float] = None,
+    preload_n: Optional[float] = None,
+    drive_force_n: Optional[float] = None,
+    feedback_gain_v_per_m: Optional[float] = None,
+    oscillator: Optional[Mapping[str, float]] = None,
+    harmonics: int = 3,
+) -> HertzIdentification:
+    """The cubic coefficient β from a sampled waveform (seed 003 eq. 5-9), given m, c and
+    k (``oscillator``, e.g. ``{"modal_mass_kg": ..., "damping_ns_per_m": ...}``).
+
+    ``signal`` is the feedback-electrode voltage [V] when ``feedback_gain_v_per_m`` is
+    given, else the modal displacement [m]. The drive force is ``drive_force_n``, or
+    A·V + k_c·N from ``voltage_v`` (and ``preload_n``); ``preload_n`` also adds the DC
+    balance. Bad records raise :class:`trum.InputError` with the reason."""
+    t = np.ascontiguousarray(np.asarray(time_s, dtype=np.float64))
+    s = np.ascontiguousarray(np.asarray(signal, dtype=np.float64))
+    if t.ndim != 1 or s.ndim != 1:
+        raise InputError(f"time_s and signal must be 1-D arrays, got shapes {t.shape} and {s.shape}")
+    if isinstance(harmonics, bool) or not isinstance(harmonics, numbers.Integral) or harmonics < 0:
+        raise InputError(f"harmonics: expected a whole number >= 1, got {harmonics!r}")
+    d = _trum.hertz_identify(
+        t, s, float(frequency_hz), _params(oscillator), voltage_v=voltage_v, preload_n=preload_n,
+        drive_force_n=drive_force_n, feedback_gain_v_per_m=feedback_gain_v_per_m, harmonics=int(harmonics),
+    )
+    return HertzIdentification(**d)
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """Contact state over one wavelength at one instant (seed 004 Fig. 10)."""
+
+    requested_time_s: float
+    time_s: float
+    speed_rpm: float
+    position_m: np.ndarray
+    pressure_n_per_m: np.ndarray
+    tangential_force_n_per_m: np.ndarray
+    friction_limit_n_per_m: np.ndarray
+    slip_speed_m_s: np.ndarray
+    state: np.ndarray  # 'no_contact', 'stick' or 'slip' per node
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """Result of :func:`step`."""
+
+    series: Dict[str, np.ndarray]
+    metrics: Dict[str, Optional[float]]
+    status: str  # 'ok', 'not_moving' or 'not_settled'
+    averages: Dict[str, float]
+    steady: Dict[str, Any]
+    snapshots: List[Snapshot] = field(default_factory=list)
+    time_step_s: float = 0.0
+    steps: int = 0
+
+    def speed_difference(self) -> float:
+        """(settled transient speed − steady-solver speed) / steady-solver speed."""
+        return (self.averages["speed_rpm"] - self.steady["speed_rpm"]) / self.steady["speed_rpm"]
+
+
+def step(
+    motor: Union[Motor, str],
+    *,
+    voltage_v: float = 200.0,
+    frequency_hz: float = 43e3,
+    phase_difference_deg: float = 90.0,
+    preload_n: float = 260.0,
+    torque_nm: float = 0.0,
+    duration_s: float = 10e-3,
+    steps_per_period: int = 64,
+    nodes_per_wavelength: int = 256,
+    tangential_stiffness_ratio: float = 300.0,
+    record_every: int = 16,
+    snapshot_at_s: Sequence[float] = (),
+) -> StepResult:
+    """Step response of the rotor speed with the stick-slip contact (seed 004): the drive
+    switches on at t = 0. Returns the time series, the metrics (delay, rise time,
+    overshoot, settling time; ``None`` where undefined, e.g. a standing wave at 0°), the
+    settled averages, the steady-state solver at the same point and the contact
+    snapshots at ``snapshot_at_s``. The GIL is released while it runs."""
+    for name, v in (("steps_per_period", steps_per_period), ("nodes_per_wavelength", nodes_per_wavelength),
+                    ("record_every", record_every)):
+        if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 0:
+            raise InputError(f"{name}: expected a whole number, got {v!r}")
+    d = _trum.step(
+        _motor(motor), float(voltage_v), float(frequency_hz), float(phase_difference_deg), float(preload_n),
+        float(torque_nm), float(duration_s), int(steps_per_period), int(nodes_per_wavelength),
+        float(tangential_stiffness_ratio), int(record_every), [float(t) for t in snapshot_at_s],
+    )
+    snaps = []
+    for s in d["snapshots"]:
+        s = dict(s)
+        s["state"] = np.array(s["state"], dtype=object)
+        snaps.append(Snapshot(**s))
+    return StepResult(dict(d["series"]), dict(d["metrics"]), d["status"], dict(d["averages"]), dict(d["steady"]),
+                      snaps, d["time_step_s"], d["steps"])

@@ -1,0 +1,334 @@
+//! Nonlinear and transient dynamics for Python: the Hertzian oscillator's response curves
+//! and β identification (seed 003), and the stick-slip step response (seed 004). The
+//! numbers are trum-core's; the work runs with the GIL released.
+
+use crate::{detached, input_err, raise, PyMotor};
+use numpy::{PyArray, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use trum_core::dynamics::hertz::{
+    identify_beta, BetaIdentificationInput, HertzError, HertzOscillator, OperatingPoint, ResponseMethod,
+};
+use trum_core::dynamics::transient::{steady_comparison, step_response, TransientConfig, TransientError};
+
+/// The oscillator: defaults with `params` (name, value) applied; a bad name or value is a
+/// `ParameterError` naming the key.
+fn oscillator(py: Python<'_>, params: &[(String, f64)]) -> PyResult<HertzOscillator> {
+    let mut o = HertzOscillator::default();
+    for (k, v) in params {
+        let reason = match o.set_param(k, *v) {
+            Ok(true) => continue,
+            Ok(false) => format!("unknown key; valid keys are: {}", HertzOscillator::PARAM_KEYS.join(", ")),
+            Err(HertzError::InvalidParameter { reason, .. }) => format!("{v} {reason}"),
+            Err(e) => e.to_string(),
+        };
+        let kw = [
+            ("source", "oscillator".into_pyobject(py)?.into_any().unbind()),
+            ("key", k.clone().into_pyobject(py)?.into_any().unbind()),
+            ("reason", reason.clone().into_pyobject(py)?.into_any().unbind()),
+        ];
+        return Err(raise(py, "ParameterError", format!("oscillator, key '{k}': {reason}"), &kw));
+    }
+    Ok(o)
+}
+
+fn method(py: Python<'_>, name: &str) -> PyResult<ResponseMethod> {
+    match name {
+        "multiple_scales" => Ok(ResponseMethod::MultipleScales),
+        "harmonic_balance" => Ok(ResponseMethod::HarmonicBalance),
+        _ => Err(input_err(py, format!("method '{name}': expected 'multiple_scales' or 'harmonic_balance'"))),
+    }
+}
+
+/// The default oscillator's parameters `{name: value}`.
+#[pyfunction]
+pub fn hertz_defaults() -> Vec<(&'static str, f64)> {
+    let mut o = HertzOscillator::default();
+    HertzOscillator::PARAM_KEYS.iter().map(|k| (*k, o.param_mut(k).map_or(f64::NAN, |v| *v))).collect()
+}
+
+/// Response curves of every (voltage, preload) pair, voltage slowest. `frequency_hz`
+/// `None`: 401 points over the core's default band. Returns `{frequency_hz, curves}`;
+/// each curve is a dict with the operating point, `status`, `reason`, the branch points
+/// (`frequency_hz`, `amplitude_m`, `phase_lag_rad`, `stable`, `branch`), the backbone,
+/// the saddle nodes (`None` when single valued), `linear_resonance_hz` and the
+/// equivalent β.
+#[pyfunction]
+#[pyo3(signature = (params, voltage_v, preload_n, frequency_hz = None, method_name = "multiple_scales"))]
+pub fn hertz_response<'py>(
+    py: Python<'py>,
+    params: Vec<(String, f64)>,
+    voltage_v: Vec<f64>,
+    preload_n: Vec<f64>,
+    frequency_hz: Option<PyReadonlyArray1<'py, f64>>,
+    method_name: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let o = oscillator(py, &params)?;
+    let m = method(py, method_name)?;
+    let ops: Vec<OperatingPoint> = voltage_v
+        .iter()
+        .flat_map(|&v| preload_n.iter().map(move |&n| OperatingPoint { voltage_v: v, preload_n: n }))
+        .collect();
+    if ops.is_empty() || ops.len() > 100_000 {
+        return Err(input_err(py, format!("{} operating points: give between 1 and 100000", ops.len())));
+    }
+    let freqs: Vec<f64> = match &frequency_hz {
+        Some(a) => a.as_slice().map(<[f64]>::to_vec).unwrap_or_else(|_| a.as_array().to_vec()),
+        None => {
+            let (lo, hi) = o
+                .response_band_hz(&ops, m)
+                .ok_or_else(|| input_err(py, "no operating point has a static equilibrium; give frequency_hz"))?;
+            (0..401).map(|i| lo + (hi - lo) * i as f64 / 400.0).collect()
+        }
+    };
+    if freqs.is_empty() || freqs.len() > 1_000_000 {
+        return Err(input_err(py, format!("frequency_hz: {} points; give between 1 and 1000000", freqs.len())));
+    }
+    let family = detached(py, || o.response_family(&ops, &freqs, m))?
+        .map_err(|e| input_err(py, format!("frequency_hz: {e}")))?;
+    let mut curves = Vec::with_capacity(family.len());
+    for c in &family {
+        let d = PyDict::new(py);
+        d.set_item("voltage_v", c.operating_point.voltage_v)?;
+        d.set_item("preload_n", c.operating_point.preload_n)?;
+        let (status, reason) = match &c.response {
+            Ok(_) => ("ok", String::new()),
+            Err(e @ HertzError::NoStaticEquilibrium { .. }) => ("no_static_equilibrium", e.to_string()),
+            Err(e) => ("invalid_input", e.to_string()),
+        };
+        d.set_item("status", status)?;
+        d.set_item("reason", reason)?;
+        let empty = Vec::new();
+        let pts = c.response.as_ref().map_or(&empty, |r| &r.points);
+        let col = |f: fn(&trum_core::dynamics::hertz::ResponsePoint) -> f64| pts.iter().map(f).collect::<Vec<f64>>();
+        d.set_item("frequency_hz", PyArray::from_vec(py, col(|p| p.frequency_hz)))?;
+        d.set_item("amplitude_m", PyArray::from_vec(py, col(|p| p.amplitude_m)))?;
+        d.set_item("phase_lag_rad", PyArray::from_vec(py, col(|p| p.phase_lag_rad)))?;
+        d.set_item("stable", PyArray::from_vec(py, pts.iter().map(|p| p.stable).collect::<Vec<bool>>()))?;
+        d.set_item("branch", pts.iter().map(|p| p.branch.as_str()).collect::<Vec<&str>>())?;
+        let bb =
+            |f: fn(&trum_core::dynamics::hertz::BackbonePoint) -> f64| c.backbone.iter().map(f).collect::<Vec<f64>>();
+        d.set_item("backbone_frequency_hz", PyArray::from_vec(py, bb(|b| b.frequency_hz)))?;
+        d.set_item("backbone_amplitude_m", PyArray::from_vec(py, bb(|b| b.amplitude_m)))?;
+        let r = c.response.as_ref().ok();
+        let jumps = r.and_then(|r| r.jumps);
+        d.set_item("jump_up_hz", jumps.map(|j| j.jump_up_hz))?;
+        d.set_item("jump_up_amplitude_m", jumps.map(|j| j.jump_up_amplitude_m))?;
+        d.set_item("jump_down_hz", jumps.map(|j| j.jump_down_hz))?;
+        d.set_item("jump_down_amplitude_m", jumps.map(|j| j.jump_down_amplitude_m))?;
+        d.set_item("equivalent_beta_n_per_m3", r.map(|r| r.equivalent_beta_n_per_m3))?;
+        d.set_item("linear_resonance_hz", c.backbone.first().map(|b| b.frequency_hz))?;
+        curves.push(d);
+    }
+    let out = PyDict::new(py);
+    out.set_item("frequency_hz", PyArray::from_vec(py, freqs))?;
+    out.set_item("curves", curves)?;
+    Ok(out)
+}
+
+/// β by harmonic balance from a sampled waveform (seed 003 eq. 5-9). `signal` is the
+/// feedback voltage [V] with `feedback_gain_v_per_m`, else the displacement [m]. The drive
+/// force is `drive_force_n`, or A·V + k_c·N from `voltage_v` and `preload_n`.
+#[pyfunction]
+#[pyo3(signature = (time_s, signal, frequency_hz, params, voltage_v = None, preload_n = None,
+    drive_force_n = None, feedback_gain_v_per_m = None, harmonics = 3))]
+#[allow(clippy::too_many_arguments)]
+pub fn hertz_identify<'py>(
+    py: Python<'py>,
+    time_s: PyReadonlyArray1<'py, f64>,
+    signal: PyReadonlyArray1<'py, f64>,
+    frequency_hz: f64,
+    params: Vec<(String, f64)>,
+    voltage_v: Option<f64>,
+    preload_n: Option<f64>,
+    drive_force_n: Option<f64>,
+    feedback_gain_v_per_m: Option<f64>,
+    harmonics: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let o = oscillator(py, &params)?;
+    let force = match (drive_force_n, voltage_v) {
+        (Some(_), Some(_)) => return Err(input_err(py, "give voltage_v or drive_force_n, not both")),
+        (Some(f), None) => f,
+        (None, Some(v)) => o
+            .forcing_amplitude_n(&OperatingPoint { voltage_v: v, preload_n: preload_n.unwrap_or(0.0) })
+            .map_err(|e| input_err(py, format!("voltage_v/preload_n: {e}")))?,
+        (None, None) => return Err(input_err(py, "give voltage_v or drive_force_n")),
+    };
+    let t = time_s.as_array().to_vec();
+    let s = signal.as_array().to_vec();
+    let input = BetaIdentificationInput {
+        sample_times_s: &t,
+        samples_v: &s,
+        drive_frequency_hz: frequency_hz,
+        feedback_gain_v_per_m: feedback_gain_v_per_m.unwrap_or(1.0),
+        drive_force_amplitude_n: force,
+        static_force_n: preload_n,
+        modal_mass_kg: o.modal_mass_kg,
+        damping_ns_per_m: o.damping_ns_per_m,
+        linear_stiffness_n_per_m: o.linear_stiffness_n_per_m,
+        harmonics,
+    };
+    let id = detached(py, || identify_beta(&input))?.map_err(|e| input_err(py, e.to_string()))?;
+    float_dict(
+        py,
+        &[
+            ("beta_n_per_m3", id.beta_n_per_m3),
+            ("one_term_beta_n_per_m3", id.one_term_beta_n_per_m3),
+            ("harmonic_fit_r_squared", id.harmonic_fit_r_squared),
+            ("waveform_residual_rms", id.waveform_residual_rms_v),
+            ("balance_residual_rms_m", id.balance_residual_rms_m),
+            ("balance_relative_residual", id.balance_relative_residual),
+            ("displacement_amplitude_m", id.displacement_amplitude_m),
+            ("periods_spanned", id.periods_spanned),
+            ("drive_force_n", force),
+        ],
+    )
+}
+
+/// `{name: value}` of named numbers (`None` becomes Python's `None`).
+fn float_dict<'py, T: IntoPyObject<'py> + Copy>(py: Python<'py>, items: &[(&str, T)]) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (k, v) in items {
+        d.set_item(*k, *v)?;
+    }
+    Ok(d)
+}
+
+/// The Python argument a core config field comes from.
+fn argument(name: &str) -> &str {
+    match name {
+        "phase_difference_rad" => "phase_difference_deg",
+        "snapshot_times_s" => "snapshot_at_s",
+        "load_torque_nm" => "torque_nm",
+        n => n,
+    }
+}
+
+/// Step response of the rotor speed (seed 004). Returns a dict: `series` (arrays),
+/// `metrics` (`None` where undefined), `status`, `averages`, `steady` (the steady solver
+/// at the same point), `snapshots` (per-node arrays and states), `time_step_s`, `steps`.
+#[pyfunction]
+#[pyo3(signature = (motor, voltage_v, frequency_hz, phase_difference_deg, preload_n, torque_nm, duration_s,
+    steps_per_period, nodes_per_wavelength, tangential_stiffness_ratio, record_every, snapshot_at_s))]
+#[allow(clippy::too_many_arguments)]
+pub fn step<'py>(
+    py: Python<'py>,
+    motor: &Bound<'py, PyMotor>,
+    voltage_v: f64,
+    frequency_hz: f64,
+    phase_difference_deg: f64,
+    preload_n: f64,
+    torque_nm: f64,
+    duration_s: f64,
+    steps_per_period: usize,
+    nodes_per_wavelength: usize,
+    tangential_stiffness_ratio: f64,
+    record_every: usize,
+    snapshot_at_s: Vec<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &motor.get().inner;
+    if !m.effects.is_none() {
+        return Err(input_err(
+            py,
+            "the transient model does not include unmodelled effects; use a motor without effects",
+        ));
+    }
+    let cfg = TransientConfig {
+        duration_s,
+        steps_per_period,
+        nodes_per_wavelength,
+        phase_difference_rad: phase_difference_deg.to_radians(),
+        load_torque_nm: torque_nm,
+        voltage_v,
+        frequency_hz,
+        preload_n,
+        record_every,
+        snapshot_times_s: snapshot_at_s,
+        tangential_stiffness_ratio,
+        ..TransientConfig::default()
+    };
+    let (r, steady) = detached(py, || (step_response(m, &cfg), steady_comparison(m, &cfg)))?;
+    let r = r.map_err(|e| match e {
+        TransientError::InvalidConfig { name, value, reason } => {
+            let shown = if name == "phase_difference_rad" { phase_difference_deg } else { value };
+            input_err(py, format!("{} = {shown}: {reason}", argument(name)))
+        }
+        TransientError::Diverged { .. } => raise(py, "TrumError", e.to_string(), &[]),
+        e => input_err(py, e.to_string()),
+    })?;
+    let series = PyDict::new(py);
+    let t = r.series;
+    for (k, v) in [
+        ("time_s", t.time_s),
+        ("speed_rpm", t.speed_rpm),
+        ("speed_period_mean_rpm", t.speed_period_mean_rpm),
+        ("amplitude_m", t.amplitude_m),
+        ("axial_position_m", t.axial_position_m),
+        ("contact_torque_nm", t.torque_nm),
+        ("axial_force_n", t.axial_force_n),
+    ] {
+        series.set_item(k, PyArray::from_vec(py, v))?;
+    }
+    let mt = r.metrics;
+    let metrics = float_dict(
+        py,
+        &[
+            ("final_speed_rpm", Some(mt.final_speed_rpm)),
+            ("peak_speed_rpm", Some(mt.peak_speed_rpm)),
+            ("delay_s", mt.delay_s),
+            ("rise_time_s", mt.rise_time_s),
+            ("overshoot", mt.overshoot),
+            ("settling_time_s", mt.settling_time_s),
+        ],
+    )?;
+    let a = r.averages;
+    let averages = float_dict(
+        py,
+        &[
+            ("window_s", a.window_s),
+            ("speed_rpm", a.speed_rpm),
+            ("contact_torque_nm", a.contact_torque_nm),
+            ("amplitude_m", a.amplitude_m),
+            ("axial_force_n", a.axial_force_n),
+            ("contact_fraction", a.contact_fraction),
+            ("stick_fraction", a.stick_fraction),
+        ],
+    )?;
+    let st = float_dict(
+        py,
+        &[
+            ("speed_rpm", steady.speed_rpm),
+            ("contact_torque_nm", steady.contact_torque_nm),
+            ("amplitude_m", steady.amplitude_m),
+        ],
+    )?;
+    st.set_item("status", steady.status.as_str())?;
+    let mu = m.friction_layer.friction_coefficient;
+    let mut snaps = Vec::with_capacity(r.snapshots.len());
+    for s in &r.snapshots {
+        let d = PyDict::new(py);
+        d.set_item("requested_time_s", s.requested_time_s)?;
+        d.set_item("time_s", s.time_s)?;
+        d.set_item("speed_rpm", s.speed_rpm)?;
+        let col = |f: &dyn Fn(&trum_core::dynamics::transient::NodeSample) -> f64| {
+            s.nodes.iter().map(f).collect::<Vec<f64>>()
+        };
+        d.set_item("position_m", PyArray::from_vec(py, col(&|n| n.position_m)))?;
+        d.set_item("pressure_n_per_m", PyArray::from_vec(py, col(&|n| n.pressure_n_per_m)))?;
+        d.set_item("tangential_force_n_per_m", PyArray::from_vec(py, col(&|n| n.tangential_force_n_per_m)))?;
+        d.set_item("friction_limit_n_per_m", PyArray::from_vec(py, col(&|n| mu * n.pressure_n_per_m)))?;
+        d.set_item("slip_speed_m_s", PyArray::from_vec(py, col(&|n| n.slip_speed_m_s)))?;
+        d.set_item("state", s.nodes.iter().map(|n| n.state.as_str()).collect::<Vec<&str>>())?;
+        snaps.push(d);
+    }
+    let d = PyDict::new(py);
+    d.set_item("series", series)?;
+    d.set_item("metrics", metrics)?;
+    d.set_item("status", mt.status())?;
+    d.set_item("averages", averages)?;
+    d.set_item("steady", st)?;
+    d.set_item("snapshots", snaps)?;
+    d.set_item("time_step_s", r.time_step_s)?;
+    d.set_item("steps", r.steps)?;
+    Ok(d)
+}

@@ -1,0 +1,172 @@
+"""trum.resonance, trum.identify_hertz and trum.step: physics, errors, agreement with the CLI."""
+import csv
+import io
+import math
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+import trum
+
+FAST = dict(duration_s=0.004, nodes_per_wavelength=64)
+
+
+def test_resonance_branches_jumps_and_trends():
+    r = trum.resonance(voltage_v=(100, 300, 3), preload_n=400.0, frequency_hz=(40800, 41050, 251))
+    assert [c.voltage_v for c in r.curves] == [100.0, 200.0, 300.0]
+    assert r.frequency_hz.shape == (251,)
+    c = r.curves[1]
+    assert c.status == "ok" and c.reason == ""
+    inside = (c.frequency_hz > c.jump_down_hz) & (c.frequency_hz < c.jump_up_hz)
+    assert set(c.branch[inside]) == {"lower", "middle", "upper"}
+    assert set(c.branch[~inside]) == {"single"}
+    assert not c.stable[c.branch == "middle"].any() and c.stable[c.branch != "middle"].all()
+    # softening (seed 003 Fig. 11): jump-up above jump-down, backbone bends down
+    assert c.jump_up_hz > c.jump_down_hz + 100
+    assert np.all(np.diff(c.backbone_frequency_hz) < 0) and c.backbone_amplitude_m[0] == 0.0
+    assert c.backbone_frequency_hz[0] == c.linear_resonance_hz
+    widths = [x.hysteresis_hz for x in r.curves]
+    assert widths[0] < widths[1] < widths[2]
+    # preload family: the peak grows with preload (Fig. 12); harmonic balance works too
+    p = trum.resonance(voltage_v=200.0, preload_n=np.array([200.0, 300.0, 400.0]), method="harmonic_balance")
+    peaks = [x.amplitude_m.max() for x in p.curves]
+    assert peaks[0] < peaks[1] < peaks[2]
+    assert p.frequency_hz.size == 401
+
+
+def test_resonance_status_instead_of_nan_and_errors():
+    r = trum.resonance(voltage_v=200.0, preload_n=[400.0, 1e6], frequency_hz=41000.0)
+    assert [c.status for c in r.curves] == ["ok", "no_static_equilibrium"]
+    assert "exceeds the largest static force" in r.curves[1].reason
+    assert r.curves[1].amplitude_m.size == 0 and r.curves[1].jump_up_hz is None
+    d = r.to_dict()
+    assert list(d["status"]).count("no_static_equilibrium") == 1
+    with pytest.raises(trum.ParameterError, match=r"oscillator, key 'modal_mas_kg': unknown key") as e:
+        trum.resonance(oscillator={"modal_mas_kg": 0.05})
+    assert e.value.key == "modal_mas_kg"
+    with pytest.raises(trum.ParameterError, match=r"key 'damping_ns_per_m': -1 must be finite and > 0"):
+        trum.resonance(oscillator={"damping_ns_per_m": -1})
+    with pytest.raises(trum.InputError, match="frequency_hz"):
+        trum.resonance(frequency_hz=[41000.0, -1.0])
+    with pytest.raises(trum.InputError, match="method 'exact'"):
+        trum.resonance(method="exact")
+    assert trum.hertz_defaults()["modal_mass_kg"] == pytest.approx(0.0577809)
+
+
+def _one_term_waveform(beta, w_mean, amp, f_hz, periods=12, per_period=64):
+    """w = w̄ + X cos(ωt − φ) that satisfies the one-term harmonic balance exactly; returns
+    t, w and the drive and static forces that go with it."""
+    o = trum.hertz_defaults()
+    m, c, k = o["modal_mass_kg"], o["damping_ns_per_m"], o["linear_stiffness_n_per_m"]
+    w = 2 * math.pi * f_hz
+    re = k - m * w * w + beta * (3 * w_mean**2 + 0.75 * amp**2)
+    im = c * w
+    force = amp * math.hypot(re, im)
+    static = k * w_mean + beta * (w_mean**3 + 1.5 * w_mean * amp**2)
+    t = np.arange(periods * per_period) / (per_period * f_hz)
+    return t, w_mean + amp * np.cos(w * t - math.atan2(im, re)), force, static
+
+
+def test_identify_hertz_recovers_beta_exactly_from_a_one_term_solution():
+    beta = -1.0e19
+    t, w, force, static = _one_term_waveform(beta, 1.0e-7, 1.5e-6, 40950.0)
+    r = trum.identify_hertz(t, w, frequency_hz=40950.0, drive_force_n=force, preload_n=static, harmonics=1)
+    assert r.beta_n_per_m3 == pytest.approx(beta, rel=1e-6)
+    assert r.one_term_beta_n_per_m3 == pytest.approx(beta, rel=1e-6)
+    assert r.harmonic_fit_r_squared > 1 - 1e-12 and r.displacement_amplitude_m == pytest.approx(1.5e-6)
+    # the same record as a feedback voltage (2 V/µm) gives the same β
+    rv = trum.identify_hertz(list(t), 2e6 * w, frequency_hz=40950.0, drive_force_n=force, preload_n=static,
+                             feedback_gain_v_per_m=2e6, harmonics=1)
+    assert rv.beta_n_per_m3 == pytest.approx(r.beta_n_per_m3, rel=1e-9)
+    # a wrong drive force shows up in β (it is what balances the fundamental)
+    r2 = trum.identify_hertz(t, w, frequency_hz=40950.0, drive_force_n=1.1 * force, preload_n=static, harmonics=1)
+    assert abs(r2.beta_n_per_m3 / beta - 1) > 0.02
+
+
+def test_identify_hertz_errors():
+    t, w, force, static = _one_term_waveform(-1e19, 1e-7, 1.5e-6, 40950.0)
+    kw = dict(frequency_hz=40950.0, drive_force_n=force)
+    with pytest.raises(trum.InputError, match="input too short"):
+        trum.identify_hertz(t[:20], w[:20], **kw)
+    bad = w.copy()
+    bad[5] = np.nan
+    with pytest.raises(trum.InputError, match="non-finite value"):
+        trum.identify_hertz(t, bad, **kw)
+    with pytest.raises(trum.InputError, match="length mismatch"):
+        trum.identify_hertz(t, w[:-1], **kw)
+    with pytest.raises(trum.InputError, match="give voltage_v or drive_force_n"):
+        trum.identify_hertz(t, w, frequency_hz=40950.0)
+    with pytest.raises(trum.InputError, match="1-D"):
+        trum.identify_hertz(t.reshape(2, -1), w.reshape(2, -1), **kw)
+    with pytest.raises(trum.ParameterError, match="unknown key"):
+        trum.identify_hertz(t, w, oscillator={"k": 1.0}, **kw)
+
+
+def test_step_settles_near_the_steady_solver_and_reverses():
+    r = trum.step("trum60a", snapshot_at_s=[2e-5, 3.5e-3], **FAST)
+    assert r.status == "ok" and r.steady["status"] == "ok"
+    # default layer stiffness: 0-15 % above the rigid-Coulomb steady model (docs/DYNAMICS.md)
+    assert 0.0 < r.speed_difference() < 0.15
+    assert r.metrics["overshoot"] > 0.05 and 0 < r.metrics["delay_s"] < r.metrics["settling_time_s"] < 4e-3
+    s = r.series
+    assert set(s) >= {"time_s", "speed_rpm", "speed_period_mean_rpm", "contact_torque_nm", "amplitude_m"}
+    assert s["time_s"].shape == s["speed_rpm"].shape and s["speed_rpm"][0] == 0.0
+    first, late = r.snapshots
+    assert set(first.state) <= {"stick", "slip"} and set(late.state) == {"stick", "slip", "no_contact"}
+    f, lim = late.tangential_force_n_per_m, late.friction_limit_n_per_m
+    assert np.all(np.abs(f) <= lim * (1 + 1e-12))
+    slip = late.state == "slip"
+    np.testing.assert_allclose(np.abs(f[slip]), lim[slip], rtol=1e-9)
+    back = trum.step("trum60a", phase_difference_deg=-90.0, **FAST)
+    assert back.averages["speed_rpm"] == pytest.approx(-r.averages["speed_rpm"], rel=1e-6)
+    standing = trum.step(trum.Motor("trum60a"), phase_difference_deg=0.0, **FAST)
+    assert standing.status == "not_moving" and standing.metrics["delay_s"] is None
+    assert abs(standing.averages["speed_rpm"]) < 1e-3 * r.averages["speed_rpm"]
+
+
+def test_step_errors():
+    with pytest.raises(trum.InputError, match=r"steps_per_period = 8: must be >= 16"):
+        trum.step("trum60a", steps_per_period=8)
+    with pytest.raises(trum.InputError, match=r"snapshot_at_s = 1: must lie in \[0, duration_s\]"):
+        trum.step("trum60a", snapshot_at_s=[1.0], **FAST)
+    with pytest.raises(trum.InputError, match="time step too large"):
+        trum.step("trum60a", tangential_stiffness_ratio=1e6, **FAST)
+    with pytest.raises(trum.InputError, match="unmodelled effects"):
+        trum.step(trum.Motor("trum60a").with_effects("radial_friction=0.5"), **FAST)
+    with pytest.raises(trum.InputError, match="whole number"):
+        trum.step("trum60a", steps_per_period=64.5)
+    with pytest.raises(trum.ParameterError, match="unknown preset"):
+        trum.step("trum61")
+
+
+def _cli():
+    return shutil.which(os.environ["TRUM_BIN"]) or os.environ["TRUM_BIN"]
+
+
+@pytest.mark.skipif(not os.environ.get("TRUM_BIN"), reason="set TRUM_BIN to a trum CLI binary to compare with it")
+def test_matches_cli_resonance_and_step():
+    out = subprocess.run([_cli(), "resonance", "--voltage-v", "100:300:3", "--preload-n", "300:400:2",
+                          "--frequency-hz", "40850:41000:31", "-o", "-"],
+                         check=True, capture_output=True, text=True).stdout
+    rows = list(csv.DictReader(io.StringIO(out)))
+    d = trum.resonance(voltage_v=(100, 300, 3), preload_n=(300, 400, 2), frequency_hz=(40850, 41000, 31)).to_dict()
+    assert len(rows) == d["frequency_hz"].size
+    for i, row in enumerate(rows):
+        assert row["branch"] == d["branch"][i] and row["status"] == d["status"][i]
+        for col in ("voltage_v", "preload_n", "frequency_hz", "amplitude_m", "phase_lag_rad"):
+            # shortest round-trip CSV numbers: equal bit for bit; empty cells are NaN here
+            want = d[col][i]
+            assert (row[col] == "" and math.isnan(want)) or float(row[col]) == want, (i, col)
+    out = subprocess.run([_cli(), "step", "--motor", "trum60a", "--duration-s", "0.004", "--nodes-per-wavelength",
+                          "64", "--voltage-v", "150:200:2", "--table", "-"],
+                         check=True, capture_output=True, text=True).stdout
+    rows = list(csv.DictReader(io.StringIO(out)))
+    for row, v in zip(rows, (150.0, 200.0)):
+        r = trum.step("trum60a", voltage_v=v, **FAST)
+        assert row["status"] == r.status
+        assert float(row["final_speed_rpm"]) == r.averages["speed_rpm"]
+        assert float(row["delay_s"]) == r.metrics["delay_s"]
+        assert float(row["steady_speed_rpm"]) == r.steady["speed_rpm"]
