@@ -6,7 +6,9 @@
 //! rewrites the confusion matrix in docs/DIAGNOSIS.md (between the `blind:begin` and
 //! `blind:end` markers) and the per-case table docs/data/blind_cases.csv.
 //! `cargo bench --bench blind -- --slice` runs only the test suite's slice; `--no-write`
-//! prints without touching the docs; `--signals` prints only each case's signal χ². Each case's CSV and JSON stay in target/blind/.
+//! prints without touching the docs; `--signals` prints only each case's signal χ²;
+//! `--only NAME` keeps the cases whose injected set contains NAME (`--only +`: the pairs).
+//! Each case's CSV and JSON stay in target/blind/.
 
 #[path = "../tests/support/blind.rs"]
 mod blind;
@@ -24,11 +26,15 @@ fn main() {
         .and_then(|i| args.get(i + 1))
         .and_then(|s| s.parse().ok())
         .unwrap_or(2);
-    let cases = if slice { blind::slice_cases() } else { blind::full_cases() };
+    let mut cases = if slice { blind::slice_cases() } else { blind::full_cases() };
+    // `--only NAME`: the cases whose injected set contains NAME (`+` for the pairs)
+    if let Some(only) = args.iter().position(|a| a == "--only").and_then(|i| args.get(i + 1)) {
+        cases.retain(|c| c.truth().contains(only.as_str()));
+    }
     if args.iter().any(|a| a == "--signals") {
         // only what each case's injected effects leave after a baseline calibration
         for c in &cases {
-            let sig: Vec<String> = c.effects.iter().map(|e| format!("{e} {:.0}", c.signal_chi2(e))).collect();
+            let sig: Vec<String> = c.effects.iter().zip(c.signals()).map(|(e, s)| format!("{e} {s:.0}")).collect();
             println!("{:<16} x{} noise {:<4} seed {}: {}", c.campaign, c.factor, c.noise, c.seed, sig.join(", "));
         }
         return;

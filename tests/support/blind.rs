@@ -66,7 +66,15 @@ impl Case {
     /// no baseline parameter can mimic. Below 25 (a 5σ total signal) no diagnosis can be
     /// expected to see the effect; a time-series effect in a campaign without time gives 0.
     pub fn signal_chi2(&self, name: &str) -> f64 {
-        use trum_core::calibrate::{baseline_params, calibrate, FitOptions, ObservedRow};
+        self.leftover_chi2(&[name], &[])
+    }
+
+    /// χ² left when the baseline plus the candidate forms of `fitted` (strengths free, from
+    /// their true values) is calibrated to the noise-free readings of the motor with
+    /// `injected` in their truth forms, σ as in [`Case::signal_chi2`]. Starts at the true
+    /// baseline parameters: the best any calibration could do.
+    fn leftover_chi2(&self, injected: &[&str], fitted: &[&str]) -> f64 {
+        use trum_core::calibrate::{baseline_params, calibrate, effect_params, FitOptions, ObservedRow};
         use trum_core::synth::{reading_noise, synthesize, true_motor, Campaign, SynthConfig};
         let cfg = SynthConfig {
             campaign: Campaign::from_name(self.campaign).expect("campaign"),
@@ -74,7 +82,7 @@ impl Case {
             seed: self.seed,
             ..SynthConfig::default()
         };
-        let rows: Vec<ObservedRow> = synthesize(&self.motor_with(&[name]), &cfg)
+        let rows: Vec<ObservedRow> = synthesize(&self.motor_with(injected), &cfg)
             .expect("synth")
             .iter()
             .map(|r| ObservedRow {
@@ -83,11 +91,37 @@ impl Case {
                 ambient_c: r.ambient_c,
             })
             .collect();
-        // start at the true baseline parameters: the best any calibration could do
-        let start = true_motor(&self.motor_with(&[]), &cfg);
-        let params = baseline_params(&trum_core::presets::preset(MOTOR).expect("preset"), &rows);
+        let mut start = true_motor(&self.motor_with(fitted), &cfg);
+        start.effects.set_truth_forms(false);
+        let mut params = baseline_params(&trum_core::presets::preset(MOTOR).expect("preset"), &rows);
+        for name in fitted {
+            params.extend(effect_params(trum_core::effects::Effect::from_name(name).expect("effect name")));
+        }
         let opts = FitOptions { huber_k: f64::INFINITY, irls_passes: 0, max_evaluations: 400 };
         calibrate(&start, &rows, &params, &opts).map(|c| c.chi2).unwrap_or(f64::NAN)
+    }
+
+    /// Signal of each injected effect. For a single effect its [`Case::signal_chi2`]; in a
+    /// combination, what the effect adds beyond the others: the χ² the others' candidates
+    /// leave minus the χ² all candidates together leave (0 when its own signal is below
+    /// 25). An effect another one (or the others' form error) swamps cannot be expected.
+    pub fn signals(&self) -> Vec<f64> {
+        let own: Vec<f64> = self.effects.iter().map(|e| self.signal_chi2(e)).collect();
+        if self.effects.len() < 2 {
+            return own;
+        }
+        let all = self.leftover_chi2(&self.effects, &self.effects);
+        self.effects
+            .iter()
+            .zip(&own)
+            .map(|(e, &s)| {
+                if s < 25.0 {
+                    return s;
+                }
+                let others: Vec<&str> = self.effects.iter().copied().filter(|o| o != e).collect();
+                (self.leftover_chi2(&self.effects, &others) - all).max(0.0).min(s)
+            })
+            .collect()
     }
 
     /// The injected effects the campaign can show (signal χ² ≥ 25, given each effect's
@@ -210,7 +244,7 @@ pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
     let shrink_of = |name: &str| {
         ranking.iter().find(|r| r["effect"].as_str().is_some_and(|e| same_set(e, name))).and_then(|r| r["shrink"].as_f64())
     };
-    let signal: Vec<f64> = case.effects.iter().map(|e| case.signal_chi2(e)).collect();
+    let signal = case.signals();
     let expected = case.expected(&signal);
     let (before, noise) =
         (v["gap"]["baseline_heldout_nrmse"].as_f64().unwrap_or(f64::NAN), v["gap"]["noise_nrmse"].as_f64().unwrap_or(f64::NAN));
