@@ -180,12 +180,16 @@ pub fn unit_of(name: &str) -> Option<&'static str> {
 
 /// Where a command writes a file: `-` is stdout, anything else a temporary file in the
 /// same directory that is renamed over the target only when the run succeeded, so a
-/// failed run leaves no partial file behind.
+/// failed run leaves no partial file behind. An existing target that is not a regular
+/// file (`/dev/null`, a FIFO, a terminal) is written in place: renaming over it would
+/// replace the device with a regular file.
 pub enum OutputTarget {
     /// Standard output.
     Stdout,
     /// A temporary file and the final path.
     File(tempfile::NamedTempFile, PathBuf),
+    /// An existing special file, written directly.
+    Device(PathBuf),
 }
 
 impl OutputTarget {
@@ -194,8 +198,13 @@ impl OutputTarget {
         if path.as_os_str() == "-" {
             return Ok(OutputTarget::Stdout);
         }
-        if path.is_dir() {
-            bail!("output '{}' is a directory", path.display());
+        if let Ok(meta) = std::fs::metadata(path) {
+            if meta.is_dir() {
+                bail!("output '{}' is a directory", path.display());
+            }
+            if !meta.is_file() {
+                return Ok(OutputTarget::Device(path.to_path_buf()));
+            }
         }
         let dir = match path.parent() {
             Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
@@ -217,6 +226,30 @@ impl OutputTarget {
         let tmp =
             b.tempfile_in(&dir).with_context(|| format!("cannot create a temporary file in '{}'", dir.display()))?;
         Ok(OutputTarget::File(tmp, path.to_path_buf()))
+    }
+
+    /// The file to write into (`None`: standard output).
+    pub fn open(&self) -> Result<Option<std::fs::File>> {
+        match self {
+            OutputTarget::Stdout => Ok(None),
+            OutputTarget::File(tmp, path) => {
+                tmp.reopen().map(Some).with_context(|| format!("cannot write '{}'", path.display()))
+            }
+            OutputTarget::Device(path) => std::fs::OpenOptions::new()
+                .write(true)
+                .open(path)
+                .map(Some)
+                .with_context(|| format!("cannot write '{}'", path.display())),
+        }
+    }
+
+    /// The path a drawing backend writes to (`None`: standard output).
+    pub fn draw_path(&self) -> Option<&Path> {
+        match self {
+            OutputTarget::Stdout => None,
+            OutputTarget::File(tmp, _) => Some(tmp.path()),
+            OutputTarget::Device(path) => Some(path),
+        }
     }
 
     /// Moves the finished temporary file to its final name.

@@ -42,12 +42,9 @@ pub fn num(v: f64) -> Value {
 /// Writes `text` to `path` through a temporary file renamed at the end (`-`: stdout).
 pub fn write_atomic(path: &Path, suffix: &str, text: &str, out: &mut dyn Write) -> Result<()> {
     let target = OutputTarget::create(path, suffix)?;
-    match &target {
-        OutputTarget::Stdout => out.write_all(text.as_bytes())?,
-        OutputTarget::File(tmp, p) => {
-            let mut f = tmp.reopen().with_context(|| format!("cannot write '{}'", p.display()))?;
-            f.write_all(text.as_bytes()).with_context(|| format!("writing '{}'", p.display()))?;
-        }
+    match target.open()? {
+        None => out.write_all(text.as_bytes())?,
+        Some(mut f) => f.write_all(text.as_bytes()).with_context(|| format!("writing '{}'", path.display()))?,
     }
     target.finish()
 }

@@ -80,14 +80,13 @@ pub fn run(a: &MapArgs, out: &mut dyn Write, _err: &mut dyn Write) -> Result<i32
     let threads = a.threads.unwrap_or(0);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start worker threads")?;
     let mut progress = Progress::new(grid.len(), "points", a.quiet);
-    let result = match &target {
-        OutputTarget::Stdout => write_map(&motor, &grid, &cols, a.chunk_points, &pool, out, &mut progress),
-        OutputTarget::File(tmp, path) => {
-            let file = tmp.reopen().with_context(|| format!("cannot write '{}'", path.display()))?;
+    let result = match target.open()? {
+        None => write_map(&motor, &grid, &cols, a.chunk_points, &pool, out, &mut progress),
+        Some(file) => {
             let mut w = BufWriter::with_capacity(1 << 20, file);
             write_map(&motor, &grid, &cols, a.chunk_points, &pool, &mut w, &mut progress)
                 .and_then(|()| w.flush().map_err(Into::into))
-                .with_context(|| format!("writing '{}'", path.display()))
+                .with_context(|| format!("writing '{}'", a.output.display()))
         }
     };
     progress.finish();

@@ -122,11 +122,11 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
             }
             w.flush()
         };
-        match &t {
-            OutputTarget::Stdout => write(out)?,
-            OutputTarget::File(tmp, path) => {
-                let f = tmp.reopen().with_context(|| format!("cannot write '{}'", path.display()))?;
-                write(&mut BufWriter::new(f)).with_context(|| format!("writing '{}'", path.display()))?;
+        match t.open()? {
+            None => write(out)?,
+            Some(f) => {
+                let name = a.output.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+                write(&mut BufWriter::new(f)).with_context(|| format!("writing '{name}'"))?
             }
         }
         t.finish()?;

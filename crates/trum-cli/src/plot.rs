@@ -199,14 +199,14 @@ pub fn write_figure(output: &Path, fig: &impl Figure, err: &mut dyn Write) -> Re
         writeln!(err, "warning: no usable system font found (plotters' ttf); the plot is drawn without text")?;
     }
     let target = OutputTarget::create(output, &format!(".{ext}"))?;
-    let OutputTarget::File(tmp, _) = &target else { bail!("a plot cannot be written to stdout; give a file name") };
+    let Some(draw_path) = target.draw_path() else { bail!("a plot cannot be written to stdout; give a file name") };
     if ext == "svg" {
-        let root = SVGBackend::new(tmp.path(), SIZE_PX).into_drawing_area();
+        let root = SVGBackend::new(draw_path, SIZE_PX).into_drawing_area();
         root.fill(&WHITE).map_err(de)?;
         fig.draw(&root, labels, err)?;
         root.present().map_err(de)?;
     } else {
-        let root = BitMapBackend::new(tmp.path(), SIZE_PX).into_drawing_area();
+        let root = BitMapBackend::new(draw_path, SIZE_PX).into_drawing_area();
         root.fill(&WHITE).map_err(de)?;
         fig.draw(&root, labels, err)?;
         root.present().map_err(de)?;

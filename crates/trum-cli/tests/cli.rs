@@ -227,6 +227,37 @@ fn failed_map_leaves_no_file() {
     assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0);
 }
 
+
+/// `-o /dev/null` or a named pipe is written in place: the atomic rename used for regular
+/// files would replace the special file with a regular one (a FIFO stands in for
+/// /dev/null so that a regression cannot damage the machine running the test).
+#[cfg(unix)]
+#[test]
+fn special_output_files_are_written_in_place() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let fifo = dir.path().join("pipe.csv");
+    let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo");
+    assert!(made.success());
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read_to_string(fifo).expect("read fifo"))
+    };
+    let args = ["map", "--motor", "trum60a", "--preload-n", "100:300:3", "--torque-nm", "0:1:4"];
+    let o = fifo.to_str().unwrap_or_default();
+    let r = trum(&[&args[..], &["-o", o]].concat());
+    assert_eq!(r.status.code(), Some(0), "{}", stderr(&r));
+    let kind = std::fs::symlink_metadata(&fifo).expect("stat").file_type();
+    assert!(kind.is_fifo(), "the FIFO was replaced by {kind:?}");
+    let text = reader.join().expect("reader");
+    assert_eq!(text, ok(&[&args[..], &["-o", "-"]].concat()));
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 1, "no temporary file left");
+    // and /dev/null itself stays a character device
+    if std::fs::metadata("/dev/null").is_ok_and(|m| m.file_type().is_char_device()) {
+        ok(&[&args[..], &["-o", "/dev/null"]].concat());
+        assert!(std::fs::metadata("/dev/null").expect("stat").file_type().is_char_device());
+    }
+}
 #[test]
 fn motor_file_errors_name_file_line_and_key() {
     let dir = tempfile::tempdir().expect("tempdir");
