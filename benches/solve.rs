@@ -59,7 +59,19 @@ fn map_csv(c: &mut Criterion) {
     g.bench_function("csv_all_columns/10000", |b| {
         b.iter(|| {
             out.clear();
-            let args = ["trum", "map", "--motor", "trum60a", "--preload-n", "100:500:100", "--torque-nm", "0:1.2:100", "-q", "-o", "-"];
+            let args = [
+                "trum",
+                "map",
+                "--motor",
+                "trum60a",
+                "--preload-n",
+                "100:500:100",
+                "--torque-nm",
+                "0:1.2:100",
+                "-q",
+                "-o",
+                "-",
+            ];
             let code = trum_cli::run_with_io(args, &mut out, &mut std::io::sink());
             assert_eq!(code, 0);
             black_box(out.len())

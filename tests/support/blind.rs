@@ -87,7 +87,11 @@ impl Case {
             .iter()
             .map(|r| ObservedRow {
                 op: r.op,
-                readings: r.readings.iter().map(|&(o, v)| (o, v, (self.noise * reading_noise(o, v)).max(1e-12))).collect(),
+                readings: r
+                    .readings
+                    .iter()
+                    .map(|&(o, v)| (o, v, (self.noise * reading_noise(o, v)).max(1e-12)))
+                    .collect(),
                 ambient_c: r.ambient_c,
             })
             .collect();
@@ -97,7 +101,8 @@ impl Case {
         for name in fitted {
             params.extend(effect_params(trum_core::effects::Effect::from_name(name).expect("effect name")));
         }
-        let opts = FitOptions { huber_k: f64::INFINITY, irls_passes: 0, max_evaluations: 400 };
+        // a generous budget: this is the reference the verdicts are judged against
+        let opts = FitOptions { huber_k: f64::INFINITY, irls_passes: 0, max_evaluations: 4000 };
         calibrate(&start, &rows, &params, &opts).map(|c| c.chi2).unwrap_or(f64::NAN)
     }
 
@@ -127,8 +132,7 @@ impl Case {
     /// The injected effects the campaign can show (signal χ² ≥ 25, given each effect's
     /// signal in `signal`), as a verdict would name them: `none` when there are none.
     pub fn expected(&self, signal: &[f64]) -> String {
-        let seen: Vec<&str> =
-            self.effects.iter().zip(signal).filter(|(_, s)| !(**s < 25.0)).map(|(e, _)| *e).collect();
+        let seen: Vec<&str> = self.effects.iter().zip(signal).filter(|(_, s)| !(**s < 25.0)).map(|(e, _)| *e).collect();
         if seen.is_empty() {
             "none".into()
         } else {
@@ -202,14 +206,8 @@ fn trum(args: &[String]) -> String {
 
 /// Synthesises the case's data and diagnoses it blind.
 pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
-    let tag = format!(
-        "{}-{}-{}-{}-{}",
-        case.truth().replace('+', "_"),
-        case.factor,
-        case.campaign,
-        case.noise,
-        case.seed
-    );
+    let tag =
+        format!("{}-{}-{}-{}-{}", case.truth().replace('+', "_"), case.factor, case.campaign, case.noise, case.seed);
     let data = dir.join(format!("{tag}.csv"));
     let json = dir.join(format!("{tag}.json"));
     let mut args: Vec<String> = vec!["synth".into(), "--motor".into(), MOTOR.into()];
@@ -238,16 +236,26 @@ pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
     let text = std::fs::read_to_string(&json).expect("diagnosis JSON");
     let v: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
     let verdict = v["verdict"].as_str().expect("verdict").to_string();
-    let confounded =
-        v["confounded_with"].as_array().expect("confounded_with").iter().filter_map(|x| x.as_str()).map(String::from).collect();
+    let confounded = v["confounded_with"]
+        .as_array()
+        .expect("confounded_with")
+        .iter()
+        .filter_map(|x| x.as_str())
+        .map(String::from)
+        .collect();
     let ranking = v["ranking"].as_array().expect("ranking");
     let shrink_of = |name: &str| {
-        ranking.iter().find(|r| r["effect"].as_str().is_some_and(|e| same_set(e, name))).and_then(|r| r["shrink"].as_f64())
+        ranking
+            .iter()
+            .find(|r| r["effect"].as_str().is_some_and(|e| same_set(e, name)))
+            .and_then(|r| r["shrink"].as_f64())
     };
     let signal = case.signals();
     let expected = case.expected(&signal);
-    let (before, noise) =
-        (v["gap"]["baseline_heldout_nrmse"].as_f64().unwrap_or(f64::NAN), v["gap"]["noise_nrmse"].as_f64().unwrap_or(f64::NAN));
+    let (before, noise) = (
+        v["gap"]["baseline_heldout_nrmse"].as_f64().unwrap_or(f64::NAN),
+        v["gap"]["noise_nrmse"].as_f64().unwrap_or(f64::NAN),
+    );
     let excess = |x: f64| (x * x - noise * noise).max(0.0).sqrt();
     let after_of = |name: &str| {
         ranking
@@ -324,7 +332,8 @@ pub fn full_cases() -> Vec<Case> {
 /// no time series, so `none` is right), one null case and one pair. Seeds differ from the
 /// full run's.
 pub fn slice_cases() -> Vec<Case> {
-    let one = |e: &'static str, seed| Case { effects: vec![e], factor: 1.0, campaign: "preload-torque", noise: 1.0, seed };
+    let one =
+        |e: &'static str, seed| Case { effects: vec![e], factor: 1.0, campaign: "preload-torque", noise: 1.0, seed };
     vec![
         one("radial_friction", 901),
         one("preload_stiffening", 902),

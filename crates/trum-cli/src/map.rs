@@ -226,7 +226,8 @@ mod tests {
             exact += usize::from(got == want);
             total += 1;
         };
-        for v in [0.0, -0.0, 1.0, -1.0, 0.1, 1e-7, 1.5e20, 1e21, 123.456, 5e-324, f64::MAX, f64::MIN_POSITIVE, 43000.0] {
+        for v in [0.0, -0.0, 1.0, -1.0, 0.1, 1e-7, 1.5e20, 1e21, 123.456, 5e-324, f64::MAX, f64::MIN_POSITIVE, 43000.0]
+        {
             check(v);
         }
         // Random bit patterns over the whole finite range, and values of map magnitudes.

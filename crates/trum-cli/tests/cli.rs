@@ -227,7 +227,6 @@ fn failed_map_leaves_no_file() {
     assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0);
 }
 
-
 /// `-o /dev/null` or a named pipe is written in place: the atomic rename used for regular
 /// files would replace the special file with a regular one (a FIFO stands in for
 /// /dev/null so that a regression cannot damage the machine running the test).

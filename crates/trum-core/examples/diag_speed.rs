@@ -15,7 +15,8 @@ fn main() {
     }
     let (mut rows, mut groups) = (Vec::new(), Vec::new());
     for seed in 0..7 {
-        let cfg = SynthConfig { campaign: Campaign::Combined, seed: 40 + seed, perturbation: 0.0, ..SynthConfig::default() };
+        let cfg =
+            SynthConfig { campaign: Campaign::Combined, seed: 40 + seed, perturbation: 0.0, ..SynthConfig::default() };
         for r in synthesize(&truth, &cfg).expect("synth") {
             rows.push(r.observed());
             groups.push(format!("{}-{seed}", r.run_id));

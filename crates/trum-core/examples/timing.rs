@@ -21,7 +21,14 @@ fn main() {
     let sets: &[&str] = if baseline_only {
         &["none"]
     } else {
-        &["none", "radial_friction=1", "tangential_compliance=1", "thermal_drift=-4e-4", "voltage_sag=150", "eccentricity=2e-5"]
+        &[
+            "none",
+            "radial_friction=1",
+            "tangential_compliance=1",
+            "thermal_drift=-4e-4",
+            "voltage_sag=150",
+            "eccentricity=2e-5",
+        ]
     };
     let rows = if baseline_only { 400 } else { 40 };
     for fx in sets {
@@ -31,7 +38,8 @@ fn main() {
         for i in 0..rows {
             let t0 = Instant::now();
             for j in 0..25 {
-                let mut op = OperatingPoint::new(100.0 + 200.0 * i as f64 / rows as f64, j as f64 / 25.0, 200.0, 43000.0);
+                let mut op =
+                    OperatingPoint::new(100.0 + 200.0 * i as f64 / rows as f64, j as f64 / 25.0, 200.0, 43000.0);
                 op.elapsed_s = 60.0;
                 let s = solve(&m, &op);
                 it += s.iterations as u64;
@@ -39,7 +47,11 @@ fn main() {
             }
             per_row.push(t0.elapsed().as_secs_f64() / 25.0);
         }
-        println!("{fx:26} cold  {:.3} us/point (median), mean evals {:.2}", median(per_row) * 1e6, it as f64 / n as f64);
+        println!(
+            "{fx:26} cold  {:.3} us/point (median), mean evals {:.2}",
+            median(per_row) * 1e6,
+            it as f64 / n as f64
+        );
     }
     if baseline_only {
         let m = presets::preset("trum60a").expect("preset");
@@ -57,7 +69,12 @@ fn main() {
             solve_range(&m, &p, &g, r * 25..(r + 1) * 25, |_, _, s| it += s.iterations as u64);
             per_row.push(t0.elapsed().as_secs_f64() / 25.0);
         }
-        println!("{:26} sweep {:.3} us/point (median), mean evals {:.2}", "none", median(per_row) * 1e6, it as f64 / g.len() as f64);
+        println!(
+            "{:26} sweep {:.3} us/point (median), mean evals {:.2}",
+            "none",
+            median(per_row) * 1e6,
+            it as f64 / g.len() as f64
+        );
         // Prepared once, no neighbour: the solver alone, without Prepared::new.
         let mut per_row = Vec::new();
         for i in 0..rows {

@@ -8,10 +8,11 @@
 //!    random rows, so a held-out block is an operating region the fit never saw.
 //! 2. The baseline is calibrated on each training set and predicts its held-out block;
 //!    the held-out normalised error is compared with the noise level.
-//! 3. Every candidate effect (and pairs of the best candidates when no single one closes
-//!    the gap) is refitted together with the baseline parameters the same way and scored
-//!    by its held-out error and by the BIC of the full-data fit (evidence = ½·ΔBIC, a log
-//!    Bayes factor: > 3 strong, > 5 very strong).
+//! 3. Every candidate effect is refitted together with the baseline parameters the same
+//!    way and scored by its held-out error and by the BIC of the full-data fit (evidence =
+//!    ½·ΔBIC, a log Bayes factor: > 3 strong, > 5 very strong). Pairs of the best
+//!    candidates follow when no single one closes the gap or when two are supported, and
+//!    win only by beating the best single on held-out data as well as in evidence.
 //! 4. Where: baseline residuals grouped by quantity and region; a group is reported when
 //!    its mean normalised residual is more than 3.5 standard errors from zero (z-test;
 //!    3.5 keeps the family-wise false-alarm rate near 1 % over ~50 groups).
@@ -20,11 +21,11 @@ use crate::calibrate::{
     baseline_params, calibrate, effect_params, residuals, Calibration, FitOptions, FitParam, FittedParam, Observable,
     ObservedRow,
 };
-use nalgebra::{DMatrix, DVector};
 use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
 use crate::params::Motor;
 use crate::solve::{solve_prepared, Prepared, Status};
+use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
@@ -56,7 +57,7 @@ impl Default for DiagnoseOptions {
             try_pairs: true,
             bootstrap: 200,
             seed: 7,
-            fit: FitOptions { huber_k: 3.0, irls_passes: 1, max_evaluations: 120 },
+            fit: FitOptions { huber_k: 3.0, irls_passes: 1, max_evaluations: 300 },
             exact_cv: false,
         }
     }
@@ -290,9 +291,11 @@ fn fit_params(
                 || n.ends_with("force_factor_n_per_v")
         });
     }
-    for &e in effects {
+    let already = start.effects.active();
+    for &e in effects.iter().filter(|e| !already.contains(e)) {
         // start inside the range (a strength of exactly 0 sits on the bound, where the
-        // transformed gradient vanishes)
+        // transformed gradient vanishes); an effect the start already carries (the lead
+        // effect of a pair, fitted alone) keeps its fitted strength
         let info = e.info();
         let start: Vec<f64> =
             info.params.iter().enumerate().map(|(i, p)| if i == 0 { 0.5 * p.typical } else { p.typical }).collect();
@@ -342,20 +345,21 @@ fn cross_validate(
     CvResult { preds }
 }
 
-/// Normalised held-out errors: (NRMSE with the quantity scales, mean squared residual in σ).
-fn errors(rows: &[ObservedRow], preds: &[Vec<f64>], sc: &BTreeMap<Observable, f64>) -> (f64, f64, Vec<f64>) {
+/// Normalised held-out errors: (NRMSE with the quantity scales, mean squared residual in σ,
+/// per-reading squared scaled residuals, per-reading squared residuals in σ).
+fn errors(rows: &[ObservedRow], preds: &[Vec<f64>], sc: &BTreeMap<Observable, f64>) -> (f64, f64, Vec<f64>, Vec<f64>) {
     let mut e2 = Vec::new();
-    let mut z2 = 0.0;
+    let mut z2 = Vec::new();
     for (r, p) in rows.iter().zip(preds) {
         for (&(o, v, s), &y) in r.readings.iter().zip(p) {
             let y = if y.is_finite() { y } else { 0.0 };
             let d = y - v;
             e2.push((d / sc[&o]).powi(2));
-            z2 += (d / s).powi(2);
+            z2.push((d / s).powi(2));
         }
     }
     let n = e2.len().max(1) as f64;
-    ((e2.iter().sum::<f64>() / n).sqrt(), z2 / n, e2)
+    ((e2.iter().sum::<f64>() / n).sqrt(), z2.iter().sum::<f64>() / n, e2, z2)
 }
 
 /// Diagnoses `rows` (with `groups[i]` the run of row i; empty strings are fine) against
@@ -448,7 +452,7 @@ pub fn diagnose(
     } else {
         approx_cv(&base_cal, rows, &folds, k, &opts.fit)
     };
-    let (base_nrmse, base_z2, base_e2) = errors(rows, &base_cv.preds, &sc);
+    let (base_nrmse, base_z2, base_e2, _) = errors(rows, &base_cv.preds, &sc);
     let bic = |chi2: f64, kpar: usize| chi2 + kpar as f64 * (n_read as f64).ln();
     let base_bic = bic(base_cal.chi2, bparams.len());
 
@@ -482,16 +486,49 @@ pub fn diagnose(
     }
 
     // candidates in parallel; each returns its entry and its held-out predictions
-    let score = |effects: &[Effect]| -> (RankEntry, Vec<Vec<f64>>) {
+    // An effect that moves no prediction of these rows (thermal_drift without a time
+    // series) cannot be tested: it is ranked with the baseline's fit and its parameter
+    // penalty, not fitted, and joins no pair.
+    let base_res = residuals(&start, rows);
+    let untestable: Vec<Effect> = opts
+        .candidates
+        .iter()
+        .copied()
+        .filter(|&e| {
+            let mut probe = start.clone();
+            let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
+            probe.effects.set(e, &typical);
+            residuals(&probe, rows) == base_res
+        })
+        .collect();
+    // `from`: the start of the fit (the calibrated baseline; for a pair, the lead effect's
+    // own fit, so the pair starts where the single ended).
+    type Scored = (RankEntry, Vec<Vec<f64>>, Option<Motor>);
+    let score = |effects: &[Effect], from: &Motor| -> Scored {
         // Two starts: the calibrated baseline with the effect weak, and the nominal motor
         // with the effect at its typical strength. The baseline calibration may have bent
         // its parameters to mimic part of the effect, a valley the first start can stay in.
-        let (s0, params) = fit_params(motor, &start, rows, effects, reduced);
+        let (s0, params) = fit_params(motor, from, rows, effects, reduced);
         let kpar = params.len();
+        let name = effects.iter().map(|e| e.name()).collect::<Vec<_>>().join("+");
+        if effects.iter().any(|e| untestable.contains(e)) {
+            let entry = RankEntry {
+                effect: name,
+                evidence: 0.5 * (base_bic - bic(base_cal.chi2, kpar)),
+                heldout_nrmse_after: base_nrmse,
+                heldout_chi2_after: base_z2,
+                shrink: 0.0,
+                shrink_interval: (0.0, 0.0),
+                params: Vec::new(),
+            };
+            return (entry, base_cv.preds.clone(), None);
+        }
         let mut cal = calibrate(&s0, rows, &params, &opts.fit);
-        // The second start is needed only when the first did not reach the noise level.
+        // The second start is needed only when the first did not reach the noise level and
+        // found no clear evidence (a supported effect is not rejected for a shallower valley).
+        let first_ev = cal.as_ref().map(|c| 0.5 * (base_bic - bic(c.chi2, kpar))).unwrap_or(f64::NEG_INFINITY);
         let at_noise = cal.as_ref().is_ok_and(|c| c.chi2 <= 1.5 * n_read as f64);
-        if !at_noise {
+        if !at_noise && first_ev <= 5.0 {
             let mut s1 = motor.clone();
             for &e in effects {
                 let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
@@ -503,7 +540,7 @@ pub fn diagnose(
                 }
             }
         }
-        let (evidence, fitted, preds) = match cal {
+        let (evidence, fitted, preds, fitted_motor) = match cal {
             // Nested models: the effect at zero strength is the baseline, so a fit that ends
             // worse than the baseline's χ² is a local minimum; the baseline stands in for it.
             Ok(c) if c.chi2 <= base_cal.chi2 || opts.exact_cv => {
@@ -512,19 +549,19 @@ pub fn diagnose(
                 } else {
                     approx_cv(&c, rows, &folds, k, &opts.fit).preds
                 };
-                (0.5 * (base_bic - bic(c.chi2.min(base_cal.chi2), kpar)), c.params, preds)
+                (0.5 * (base_bic - bic(c.chi2.min(base_cal.chi2), kpar)), c.params, preds, Some(c.motor))
             }
             Ok(c) => {
                 let zero = c.params.into_iter().map(|p| FittedParam { value: 0.0, ..p }).collect();
-                (0.5 * (base_bic - bic(base_cal.chi2, kpar)), zero, base_cv.preds.clone())
+                (0.5 * (base_bic - bic(base_cal.chi2, kpar)), zero, base_cv.preds.clone(), None)
             }
-            Err(_) => (f64::NEG_INFINITY, Vec::new(), base_cv.preds.clone()),
+            Err(_) => (f64::NEG_INFINITY, Vec::new(), base_cv.preds.clone(), None),
         };
-        let (after, chi2_after, e2) = errors(rows, &preds, &sc);
+        let (after, chi2_after, e2, _) = errors(rows, &preds, &sc);
         let shrink = 1.0 - after / base_nrmse.max(1e-300);
         let interval = bootstrap_shrink(&base_e2, &e2, opts.bootstrap, opts.seed);
         let entry = RankEntry {
-            effect: effects.iter().map(|e| e.name()).collect::<Vec<_>>().join("+"),
+            effect: name,
             evidence,
             heldout_nrmse_after: after,
             heldout_chi2_after: chi2_after,
@@ -532,19 +569,27 @@ pub fn diagnose(
             shrink_interval: interval,
             params: fitted.into_iter().filter(|p| p.name.starts_with("effects.")).map(|p| (p.name, p.value)).collect(),
         };
-        (entry, preds)
+        (entry, preds, fitted_motor)
     };
     let mut cv_preds: BTreeMap<String, Vec<Vec<f64>>> = BTreeMap::new();
-    let mut collect = |scored: Vec<(RankEntry, Vec<Vec<f64>>)>| -> Vec<RankEntry> {
+    let mut fitted_motors: BTreeMap<String, Motor> = BTreeMap::new();
+    let collect = |cv_preds: &mut BTreeMap<String, Vec<Vec<f64>>>,
+                   fitted_motors: &mut BTreeMap<String, Motor>,
+                   scored: Vec<Scored>|
+     -> Vec<RankEntry> {
         scored
             .into_iter()
-            .map(|(e, p)| {
+            .map(|(e, p, m)| {
                 cv_preds.insert(e.effect.clone(), p);
+                if let Some(m) = m {
+                    fitted_motors.insert(e.effect.clone(), m);
+                }
                 e
             })
             .collect()
     };
-    let mut ranking: Vec<RankEntry> = collect(opts.candidates.par_iter().map(|&e| score(&[e])).collect());
+    let mut ranking: Vec<RankEntry> =
+        collect(&mut cv_preds, &mut fitted_motors, opts.candidates.par_iter().map(|&e| score(&[e], &start)).collect());
     sort_ranking(&mut ranking);
 
     // A candidate is supported when the full-data evidence is very strong (½ΔBIC > 5)
@@ -561,53 +606,93 @@ pub fn diagnose(
     let mut confounded = Vec::new();
     if gap {
         let best_single = ranking.iter().find(|r| supported(r)).cloned();
-        if let Some(b) = best_single.as_ref().filter(|b| closes(b)) {
-            verdict = b.effect.clone();
-        } else if opts.try_pairs && ranking.len() >= 2 {
-            let top: Vec<Effect> = ranking.iter().take(3).filter_map(|r| Effect::from_name(&r.effect).ok()).collect();
-            let mut pairs = Vec::new();
-            for i in 0..top.len() {
-                for j in i + 1..top.len() {
-                    pairs.push([top[i], top[j]]);
+        let single_closes = best_single.as_ref().is_some_and(closes);
+        let n_supported = ranking.iter().filter(|r| supported(r)).count();
+        // Pairs are tried when no single effect closes the gap, and also when a second
+        // effect is supported on its own: the best single may close the gap on average yet
+        // leave another effect's signature in one quantity or corner of the data.
+        let mut best_pair: Option<RankEntry> = None;
+        if opts.try_pairs && ranking.len() >= 2 && (!single_closes || n_supported >= 2) {
+            // Forward selection: the best single joined with every other candidate (a
+            // second effect can have no evidence on its own while the first one's gap
+            // dominates the fit), plus pairs of the three strongest when no single closes.
+            let names: Vec<Effect> = ranking
+                .iter()
+                .filter_map(|r| Effect::from_name(&r.effect).ok())
+                .filter(|e| !untestable.contains(e))
+                .collect();
+            let mut pairs: Vec<[Effect; 2]> = Vec::new();
+            let mut push = |a: Effect, b: Effect| {
+                if a != b && !pairs.iter().any(|p| (p[0] == a && p[1] == b) || (p[0] == b && p[1] == a)) {
+                    pairs.push([a, b]);
+                }
+            };
+            let lead = best_single.as_ref().and_then(|b| Effect::from_name(&b.effect).ok()).unwrap_or(names[0]);
+            for &e in &names {
+                push(lead, e);
+            }
+            if !single_closes {
+                for i in 0..names.len().min(3) {
+                    for j in i + 1..names.len().min(3) {
+                        push(names[i], names[j]);
+                    }
                 }
             }
-            let mut pr: Vec<RankEntry> = collect(pairs.par_iter().map(|p| score(p)).collect());
+            let from = fitted_motors.get(lead.name()).cloned().unwrap_or_else(|| start.clone());
+            let mut pr: Vec<RankEntry> = collect(
+                &mut cv_preds,
+                &mut fitted_motors,
+                pairs.par_iter().map(|p| score(p, if p[0] == lead { &from } else { &start })).collect(),
+            );
             sort_ranking(&mut pr);
-            let best_pair = pr.first().cloned();
+            best_pair = pr.first().cloned();
             ranking.extend(pr);
             sort_ranking(&mut ranking);
-            // A pair must close the gap and beat the best single effect clearly, in evidence
-            // and on held-out data (parsimony: a pair that only polishes a single effect's
-            // fit is not two effects).
-            let (single_ev, single_after) = best_single
-                .as_ref()
-                .map(|b| (b.evidence, b.heldout_nrmse_after))
-                .unwrap_or((0.0, base_nrmse));
-            match best_pair {
-                Some(bp)
-                    if supported(&bp)
-                        && closes(&bp)
-                        && bp.evidence > single_ev + 5.0
-                        && bp.heldout_nrmse_after <= 0.8 * single_after =>
-                {
-                    // name the stronger single effect first
-                    let ev = |n: &str| {
-                        ranking.iter().find(|r| r.effect == n).map(|r| r.evidence).unwrap_or(f64::NEG_INFINITY)
-                    };
-                    let mut ns: Vec<&str> = bp.effect.split('+').collect();
-                    ns.sort_by(|a, b| ev(b).total_cmp(&ev(a)));
-                    let joined = ns.join("+");
-                    for r in ranking.iter_mut() {
-                        if r.effect == bp.effect {
-                            r.effect = joined.clone();
-                        }
-                    }
-                    verdict = joined;
-                }
-                _ => verdict = "unexplained".into(),
+        }
+        // A pair is two effects only when it beats the best single effect clearly, in
+        // evidence (½ΔBIC > 5 over the single) and on held-out data: no worse in either
+        // held-out measure, at least a third of what the single leaves beyond noise gone
+        // in one of them, and that gain above zero at the bootstrap 5 % bound. (Parsimony:
+        // a second effect that only polishes the first one's form error is not an effect.)
+        let pair_beats_single = |bp: &RankEntry| -> bool {
+            if !supported(bp) {
+                return false;
             }
-        } else {
-            verdict = "unexplained".into();
+            let Some(single) = best_single.as_ref() else { return closes(bp) };
+            if bp.evidence <= single.evidence + 5.0
+                || bp.heldout_nrmse_after > single.heldout_nrmse_after
+                || bp.heldout_chi2_after > single.heldout_chi2_after
+            {
+                return false;
+            }
+            let excess_nrmse = |x: f64| (x * x - noise_nrmse * noise_nrmse).max(0.0).sqrt();
+            let excess_chi2 = |x: f64| (x - 1.0).max(0.0).sqrt();
+            let gain = |s: f64, p: f64| if s > 1e-12 { 1.0 - p / s } else { 0.0 };
+            let gain_nrmse = gain(excess_nrmse(single.heldout_nrmse_after), excess_nrmse(bp.heldout_nrmse_after));
+            let gain_chi2 = gain(excess_chi2(single.heldout_chi2_after), excess_chi2(bp.heldout_chi2_after));
+            let held = |name: &str| cv_preds.iter().find(|(n, _)| same_set(n, name)).map(|(_, p)| errors(rows, p, &sc));
+            let (Some(hs), Some(hp)) = (held(&single.effect), held(&bp.effect)) else { return false };
+            let real =
+                |before: &[f64], after: &[f64]| bootstrap_shrink(before, after, opts.bootstrap, opts.seed).0 > 0.0;
+            (gain_nrmse >= PAIR_GAIN && real(&hs.2, &hp.2)) || (gain_chi2 >= PAIR_GAIN && real(&hs.3, &hp.3))
+        };
+        match best_pair.filter(|bp| pair_beats_single(bp) && closes(bp)) {
+            Some(bp) => {
+                // name the stronger single effect first
+                let ev =
+                    |n: &str| ranking.iter().find(|r| r.effect == n).map(|r| r.evidence).unwrap_or(f64::NEG_INFINITY);
+                let mut ns: Vec<&str> = bp.effect.split('+').collect();
+                ns.sort_by(|a, b| ev(b).total_cmp(&ev(a)));
+                let joined = ns.join("+");
+                for r in ranking.iter_mut() {
+                    if r.effect == bp.effect {
+                        r.effect = joined.clone();
+                    }
+                }
+                verdict = joined;
+            }
+            None if single_closes => verdict = best_single.as_ref().map(|b| b.effect.clone()).unwrap_or_default(),
+            None => verdict = "unexplained".into(),
         }
         if verdict == "unexplained" {
             if let Some(b) = best_single.as_ref() {
@@ -645,13 +730,6 @@ pub fn diagnose(
     let gap_where = locate_gap(&base_cal.motor, rows);
     // held-out predictions with the verdict's effects (pairs were scored under the
     // unsorted name, so look up by the set of names)
-    let same_set = |a: &str, b: &str| {
-        let mut x: Vec<&str> = a.split('+').collect();
-        let mut y: Vec<&str> = b.split('+').collect();
-        x.sort_unstable();
-        y.sort_unstable();
-        x == y
-    };
     let after_preds = cv_preds
         .iter()
         .find(|(name, _)| same_set(name, &verdict))
@@ -686,6 +764,19 @@ pub fn diagnose(
         heldout,
     })
 }
+
+/// Two effect lists (`a+b`) name the same set.
+fn same_set(a: &str, b: &str) -> bool {
+    let mut x: Vec<&str> = a.split('+').collect();
+    let mut y: Vec<&str> = b.split('+').collect();
+    x.sort_unstable();
+    y.sort_unstable();
+    x == y
+}
+
+/// Part of what the best single effect leaves beyond noise on held-out data (in NRMSE or
+/// in σ) that a pair must remove to count as two effects.
+const PAIR_GAIN: f64 = 1.0 / 3.0;
 
 fn sort_ranking(r: &mut [RankEntry]) {
     r.sort_by(|a, b| b.evidence.total_cmp(&a.evidence).then(a.heldout_nrmse_after.total_cmp(&b.heldout_nrmse_after)));

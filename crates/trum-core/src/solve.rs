@@ -433,7 +433,11 @@ fn general_interface(
             lo - flo * (hi - lo) / (fhi - flo)
         } else {
             let rf = lo - flo * (hi - lo) / (fhi - flo);
-            if rf > lo && rf < hi { rf } else { 0.5 * (lo + hi) }
+            if rf > lo && rf < hi {
+                rf
+            } else {
+                0.5 * (lo + hi)
+            }
         };
         if (next - u).abs() < 1e-15 {
             break;

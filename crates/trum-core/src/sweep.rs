@@ -160,7 +160,11 @@ mod tests {
                     if c.status.is_valid() {
                         for q in QUANTITIES {
                             let (a, b) = ((q.get)(s), (q.get)(&c));
-                            assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-300), "{name} {op:?} {}: {a} vs {b}", q.name);
+                            assert!(
+                                (a - b).abs() <= 1e-9 * b.abs().max(1e-300),
+                                "{name} {op:?} {}: {a} vs {b}",
+                                q.name
+                            );
                         }
                     }
                 });
