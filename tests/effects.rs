@@ -107,6 +107,46 @@ fn hertz_softening_shifts_resonance_down_with_amplitude() {
     assert!(hi < lo, "softening grows with voltage: {hi} vs {lo}");
 }
 
+/// Seed 003 section 3: a softening stator has a band below its linear resonance where
+/// three steady amplitudes coexist (the middle one unstable); the band widens towards
+/// lower frequencies with the drive voltage; outside it, and without the effect, there is
+/// one. The solver's amplitude is always one of the stable branches.
+#[test]
+fn hertz_softening_has_a_multivalued_band_with_jump_frequencies() {
+    use trum_core::solve::{amplitude_branches, jump_frequencies_hz};
+    let m = with(Effect::HertzSoftening, &[1e18, 0.004]);
+    let op = |v: f64, f: f64| OperatingPoint::new(250.0, 0.0, v, f);
+    let b = amplitude_branches(&m, &op(200.0, 37e3));
+    assert_eq!(b.len(), 3, "{b:?}");
+    assert_eq!(b.iter().map(|x| x.stable).collect::<Vec<_>>(), [true, false, true]);
+    assert!(b[0].amplitude_m < b[1].amplitude_m && b[1].amplitude_m < b[2].amplitude_m);
+    for f in [37e3, 41e3, 44e3] {
+        let s = solve(&m, &op(200.0, f));
+        let stable: Vec<f64> =
+            amplitude_branches(&m, &op(200.0, f)).iter().filter(|x| x.stable).map(|x| x.amplitude_m).collect();
+        assert!(
+            stable.iter().any(|w| (w - s.amplitude_m).abs() <= 1e-8 * w),
+            "{f} Hz: solver {} not on a stable branch {stable:?}",
+            s.amplitude_m
+        );
+    }
+    assert_eq!(amplitude_branches(&m, &op(200.0, 41e3)).len(), 1);
+    // The band lies below the linear resonance (40.75 kHz) and its upper edge (jump-up)
+    // moves down with voltage. Its lower edge lies below the scan: the cubic term keeps
+    // the upper branch alive as long as ¾βW² can cancel k − mω² (docs/EFFECTS.md).
+    let fr = m.stator.resonance_frequency_hz;
+    let (down2, up2) = jump_frequencies_hz(&m, &op(200.0, 0.0), 30e3, 46e3, 160).expect("a band at 200 V");
+    let (_, up1) = jump_frequencies_hz(&m, &op(100.0, 0.0), 30e3, 46e3, 160).expect("a band at 100 V");
+    assert!(down2 == 30e3 && up2 < fr, "{down2} {up2} {fr}");
+    assert!(up2 < up1 - 500.0, "jump-up at 200 V {up2} vs 100 V {up1}");
+    // at the edge the count of stable branches changes
+    let stable_at = |f: f64| amplitude_branches(&m, &op(200.0, f)).iter().filter(|x| x.stable).count();
+    assert_eq!((stable_at(up2 - 1.0), stable_at(up2 + 1.0)), (2, 1));
+    // no softening, no band
+    let base = preset("trum60a").unwrap();
+    assert_eq!(jump_frequencies_hz(&base, &op(200.0, 0.0), 30e3, 46e3, 160), None);
+}
+
 /// Seed 000 eq. 11 and section 4.2: the motor warms over a run and the speed drifts down.
 #[test]
 fn thermal_drift_makes_speed_fall_over_a_run() {
