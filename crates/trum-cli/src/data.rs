@@ -3,7 +3,6 @@
 
 use crate::args::OutputTarget;
 use anyhow::{anyhow, bail, Context, Result};
-use serde_json::{json, Value};
 use std::io::Write;
 use std::path::Path;
 use trum_core::bench::{observations, BenchData};
@@ -31,13 +30,7 @@ pub fn read_data(path: &str, motor: &Motor, err: &mut dyn Write) -> Result<(Meas
 }
 
 /// A JSON number, or `null` when not finite (JSON has no NaN).
-pub fn num(v: f64) -> Value {
-    if v.is_finite() {
-        json!(v)
-    } else {
-        Value::Null
-    }
-}
+pub use trum_core::diagnose::json::num;
 
 /// Writes `text` to `path` through a temporary file renamed at the end (`-`: stdout).
 pub fn write_atomic(path: &Path, suffix: &str, text: &str, out: &mut dyn Write) -> Result<()> {

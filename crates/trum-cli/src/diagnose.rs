@@ -4,23 +4,19 @@
 //! report on request.
 
 use crate::args::{fmt_sig, load_motor};
-use crate::data::{num, read_data, write_atomic};
+use crate::data::{read_data, write_atomic};
 use crate::table::{write_table, Align};
 use anyhow::{anyhow, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget};
-use serde_json::{json, Value};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::time::Duration;
-use trum_core::bench::BenchData;
+use trum_core::diagnose::json::{to_json, Provenance};
 use trum_core::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
-use trum_core::measurements::Column;
 use trum_core::Motor;
 
-/// How to read `evidence` (also in the JSON and the report).
-pub const EVIDENCE_SCALE: &str =
-    "evidence = ½·ΔBIC vs the calibrated baseline (log Bayes factor): > 3 strong, > 5 very strong";
+pub use trum_core::diagnose::json::{unit, EVIDENCE_SCALE};
 
 #[derive(Args, Debug)]
 pub struct DiagnoseArgs {
@@ -56,7 +52,8 @@ pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     let d = d.map_err(|e| anyhow!("cannot diagnose '{}': {e}", a.data))?;
     let json_stdout = a.json.as_ref().is_some_and(|p| p.as_os_str() == "-");
     if let Some(p) = &a.json {
-        let doc = to_json(&d, &motor, &a.motor, &a.data, &bench);
+        let src = Provenance { motor_name: &motor.name, motor_source: &a.motor, data: &a.data, lines: &bench.lines };
+        let doc = to_json(&d, &src);
         write_atomic(p, ".json", &(serde_json::to_string_pretty(&doc)? + "\n"), out)?;
     }
     if let Some(p) = &a.report {
@@ -78,60 +75,6 @@ fn spinner() -> ProgressBar {
     b.set_message("diagnosing: calibrating the baseline and every candidate effect on held-out regions");
     b.enable_steady_tick(Duration::from_millis(120));
     b
-}
-
-/// Unit of a measured column (empty when dimensionless or unknown).
-pub fn unit(column: &str) -> &'static str {
-    Column::from_name(column).map(|c| c.spec().unit).unwrap_or("")
-}
-
-/// The spec's JSON plus extras; non-finite numbers are `null`.
-pub fn to_json(d: &Diagnosis, motor: &Motor, motor_arg: &str, data: &str, bench: &BenchData) -> Value {
-    let pairs =
-        |v: &[(String, f64)]| -> Vec<Value> { v.iter().map(|(n, x)| json!({"name": n, "value": num(*x)})).collect() };
-    json!({
-        "verdict": d.verdict,
-        "confounded_with": d.confounded_with,
-        "gap": {
-            "baseline_heldout_nrmse": num(d.baseline_heldout_nrmse),
-            "noise_nrmse": num(d.noise_nrmse),
-            "baseline_heldout_chi2_per_reading": num(d.baseline_heldout_chi2_per_reading),
-            "noise_scale": d.noise_scale.iter().map(|(q, f, n)| json!({"quantity": q, "factor": num(*f), "residuals": n})).collect::<Vec<_>>(),
-            "where": d.gap_where.iter().map(|g| json!({
-                "quantity": g.quantity,
-                "region": g.region,
-                "mean_residual": num(g.mean_residual),
-                "unit": unit(&g.quantity),
-                "n": g.n,
-                "z": num(g.z),
-            })).collect::<Vec<_>>(),
-        },
-        "ranking": d.ranking.iter().map(|r| json!({
-            "effect": r.effect,
-            "evidence": num(r.evidence),
-            "heldout_nrmse_after": num(r.heldout_nrmse_after),
-            "heldout_chi2_after": num(r.heldout_chi2_after),
-            "shrink": num(r.shrink),
-            "shrink_interval": [num(r.shrink_interval.0), num(r.shrink_interval.1)],
-            "params": pairs(&r.params),
-        })).collect::<Vec<_>>(),
-        "evidence_scale": EVIDENCE_SCALE,
-        "notes": d.notes,
-        "n_rows": d.n_rows,
-        "n_readings": d.n_readings,
-        "folds": d.folds,
-        "baseline_params": pairs(&d.baseline_params),
-        "motor": { "name": motor.name, "source": motor_arg },
-        "data": data,
-        "heldout": d.heldout.iter().map(|h| json!({
-            "row": h.row,
-            "line": bench.lines.get(h.row),
-            "quantity": h.observable.column(),
-            "measured": num(h.measured),
-            "baseline": num(h.baseline),
-            "after": num(h.after),
-        })).collect::<Vec<_>>(),
-    })
 }
 
 /// `0.1234` as `12.3 %`.

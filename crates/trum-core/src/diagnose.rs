@@ -17,6 +17,8 @@
 //!    its mean normalised residual is more than 3.5 standard errors from zero (z-test;
 //!    3.5 keeps the family-wise false-alarm rate near 1 % over ~50 groups).
 
+pub mod json;
+
 use crate::calibrate::{
     baseline_params, calibrate, effect_params, residuals, Calibration, FitOptions, FitParam, FittedParam, Observable,
     ObservedRow,

@@ -3,6 +3,7 @@
 //! trum-core: motors, vectorised solves with the GIL released, maps and the criterion.
 //! Errors are raised as `trum.ParameterError` / `trum.InputError` with the core's message.
 
+pub mod diagnosis;
 pub mod dynamics;
 pub mod vector;
 
@@ -535,6 +536,7 @@ fn _trum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dynamics::hertz_response, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::hertz_identify, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::step, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnosis::diagnose_csv, m)?)?;
     m.add("STATUS_NAMES", vector::STATUS_NAMES.to_vec())?;
     m.add("INPUTS", vector::INPUTS.to_vec())?;
     m.add("AXES", AXES.to_vec())?;

@@ -26,6 +26,7 @@ from ._registry import (
 from ._result import Result
 from ._motor import Motor
 from ._api import Optimum, map, optimize
+from ._diagnosis import diagnose
 from ._dynamics import (
     HertzIdentification,
     Resonance,
@@ -48,6 +49,7 @@ __all__ = [
     "resonance",
     "identify_hertz",
     "step",
+    "diagnose",
     "hertz_defaults",
     "Resonance",
     "ResonanceCurve",

@@ -111,3 +111,6 @@ def step(
     record_every: int,
     snapshot_at_s: Sequence[float],
 ) -> Dict[str, Any]: ...
+def diagnose_csv(
+    motor: Motor, data: bytes, source: str, motor_source: str, exact_cv: bool = False
+) -> Tuple[str, List[str]]: ...

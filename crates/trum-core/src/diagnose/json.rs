@@ -1,0 +1,86 @@
+//! The diagnosis as the JSON document of `shared/spec/diagnose.md` (the spec's fields
+//! plus extras). Built here so that `trum diagnose --json` and Python's `trum.diagnose`
+//! give the same document; writing it anywhere is the caller's business.
+
+use super::Diagnosis;
+use crate::measurements::Column;
+use serde_json::{json, Value};
+
+/// How to read `evidence` (in the JSON, the CLI summary and the report).
+pub const EVIDENCE_SCALE: &str =
+    "evidence = ½·ΔBIC vs the calibrated baseline (log Bayes factor): > 3 strong, > 5 very strong";
+
+/// A JSON number, or `null` when not finite (JSON has no NaN).
+pub fn num(v: f64) -> Value {
+    if v.is_finite() {
+        json!(v)
+    } else {
+        Value::Null
+    }
+}
+
+/// Unit of a measured column (empty when dimensionless or unknown).
+pub fn unit(column: &str) -> &'static str {
+    Column::from_name(column).map(|c| c.spec().unit).unwrap_or("")
+}
+
+/// Where the diagnosis came from, for the document's `motor` and `data` fields.
+pub struct Provenance<'a> {
+    /// Motor name.
+    pub motor_name: &'a str,
+    /// The motor as the user gave it (file path or preset name).
+    pub motor_source: &'a str,
+    /// The measurement file as the user gave it.
+    pub data: &'a str,
+    /// File line of each data row (for `heldout[].line`).
+    pub lines: &'a [usize],
+}
+
+/// The spec's JSON document plus extras; non-finite numbers are `null`.
+pub fn to_json(d: &Diagnosis, src: &Provenance<'_>) -> Value {
+    let pairs =
+        |v: &[(String, f64)]| -> Vec<Value> { v.iter().map(|(n, x)| json!({"name": n, "value": num(*x)})).collect() };
+    json!({
+        "verdict": d.verdict,
+        "confounded_with": d.confounded_with,
+        "gap": {
+            "baseline_heldout_nrmse": num(d.baseline_heldout_nrmse),
+            "noise_nrmse": num(d.noise_nrmse),
+            "baseline_heldout_chi2_per_reading": num(d.baseline_heldout_chi2_per_reading),
+            "noise_scale": d.noise_scale.iter().map(|(q, f, n)| json!({"quantity": q, "factor": num(*f), "residuals": n})).collect::<Vec<_>>(),
+            "where": d.gap_where.iter().map(|g| json!({
+                "quantity": g.quantity,
+                "region": g.region,
+                "mean_residual": num(g.mean_residual),
+                "unit": unit(&g.quantity),
+                "n": g.n,
+                "z": num(g.z),
+            })).collect::<Vec<_>>(),
+        },
+        "ranking": d.ranking.iter().map(|r| json!({
+            "effect": r.effect,
+            "evidence": num(r.evidence),
+            "heldout_nrmse_after": num(r.heldout_nrmse_after),
+            "heldout_chi2_after": num(r.heldout_chi2_after),
+            "shrink": num(r.shrink),
+            "shrink_interval": [num(r.shrink_interval.0), num(r.shrink_interval.1)],
+            "params": pairs(&r.params),
+        })).collect::<Vec<_>>(),
+        "evidence_scale": EVIDENCE_SCALE,
+        "notes": d.notes,
+        "n_rows": d.n_rows,
+        "n_readings": d.n_readings,
+        "folds": d.folds,
+        "baseline_params": pairs(&d.baseline_params),
+        "motor": { "name": src.motor_name, "source": src.motor_source },
+        "data": src.data,
+        "heldout": d.heldout.iter().map(|h| json!({
+            "row": h.row,
+            "line": src.lines.get(h.row),
+            "quantity": h.observable.column(),
+            "measured": num(h.measured),
+            "baseline": num(h.baseline),
+            "after": num(h.after),
+        })).collect::<Vec<_>>(),
+    })
+}

@@ -1,0 +1,52 @@
+"""The sim-to-real diagnosis (shared/spec/diagnose.md) from Python."""
+from __future__ import annotations
+
+import json
+import os
+import warnings
+from typing import Any, Dict, Union
+
+from . import _trum
+from ._api import _motor
+from ._errors import InputError
+from ._motor import Motor
+
+
+def diagnose(
+    motor: Union[Motor, str],
+    data: Union[str, "os.PathLike[str]", bytes],
+    *,
+    exact_cv: bool = False,
+) -> Dict[str, Any]:
+    """Where the calibrated baseline misses the measurements, which unmodelled effect
+    causes it, and how far the held-out gap shrinks once it is added.
+
+    ``motor`` is the nominal motor (a ``trum.Motor`` or a preset name); ``data`` a
+    measurement CSV in the layout of shared/spec/measurements.md, as a path or as the
+    file's bytes. Returns the JSON document of ``trum diagnose --json`` as a dict
+    (``verdict``, ``confounded_with``, ``gap``, ``ranking``, ``notes``, ...; method and
+    scales in docs/DIAGNOSIS.md). Columns the reader ignores are reported with
+    ``warnings.warn``. A bad file, or data that cannot support a held-out test, raises
+    ``trum.InputError`` naming the file, line and column. The GIL is released while it runs.
+    """
+    m = _motor(motor)
+    if isinstance(data, (bytes, bytearray)):
+        raw, source = bytes(data), "<bytes>"
+    elif isinstance(data, (str, os.PathLike)):
+        source = os.fspath(data)
+        if os.path.isdir(source):
+            raise InputError(f"measurement file '{source}' is a directory")
+        try:
+            with open(source, "rb") as f:
+                raw = f.read()
+        except FileNotFoundError:
+            raise InputError(f"measurement file '{source}' does not exist") from None
+        except OSError as e:
+            raise InputError(f"cannot read measurement file '{source}': {e.strerror}") from None
+    else:
+        raise TypeError(f"data: expected a path or bytes, got {type(data).__name__}")
+    motor_source = motor if isinstance(motor, str) else (m.preset or m.name)
+    text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv))
+    for w in notes:
+        warnings.warn(w, stacklevel=2)
+    return json.loads(text)
