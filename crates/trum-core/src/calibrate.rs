@@ -175,7 +175,8 @@ impl FitParam {
 
 /// The uncertain baseline parameters of a motor and their bounds (docs/DIAGNOSIS.md):
 /// friction coefficient, friction-layer modulus, modal damping, force factor, free
-/// resonance, and the feedback gain and loss tangent when the data can see them.
+/// resonance; the feedback gain, the clamped capacitance and the thermal network's heat
+/// capacity and heat-transfer coefficient when the data can see them.
 pub fn baseline_params(motor: &Motor, rows: &[ObservedRow]) -> Vec<FitParam> {
     let has = |o: Observable| rows.iter().any(|r| r.readings.iter().any(|x| x.0 == o));
     let mut v = vec![
@@ -190,6 +191,12 @@ pub fn baseline_params(motor: &Motor, rows: &[ObservedRow]) -> Vec<FitParam> {
     }
     if has(Observable::InputPowerW) || has(Observable::CurrentA) {
         v.push(fit_rel(motor, "electrical.clamped_capacitance_f", 0.5, 2.0));
+    }
+    // A temperature time series sees the thermal network itself (seed 000 eq. 11: time
+    // constant C/(αS), final rise P/(αS)), which the papers give only roughly.
+    if has(Observable::TemperatureC) && rows.iter().any(|r| r.op.elapsed_s > 0.0) {
+        v.push(fit_rel(motor, "thermal.heat_capacity_j_per_k", 0.3, 3.0));
+        v.push(fit_rel(motor, "thermal.heat_transfer_coefficient_w_per_m2k", 0.3, 3.0));
     }
     v
 }

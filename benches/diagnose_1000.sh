@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# The issue-5 speed benchmark: a diagnosis of about 1000 rows with all seven candidates
+# and block cross-validation (docs/PERFORMANCE.md). Builds eight `combined` campaigns of
+# trum60a (radial_friction injected, nominal noise) at drive voltages 165-235 V, joins
+# them into one file (run ids prefixed with the voltage) and times `trum diagnose`.
+#   bash benches/diagnose_1000.sh            # release build, then the timed run
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release -q -p trum-cli
+T=target/release/trum
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+out="$dir/bench1000.csv"
+i=0
+for v in 165 175 185 195 205 215 225 235; do
+    i=$((i + 1))
+    "$T" synth --motor trum60a --effect radial_friction=1 --campaign combined --noise 1 --seed "$i" \
+        --voltage-v "$v" -o "$dir/c$i.csv" > /dev/null
+    if [ "$i" = 1 ]; then head -n 1 "$dir/c$i.csv" > "$out"; fi
+    # prefix every run id (the last column) with the voltage so runs stay distinct
+    tail -n +2 "$dir/c$i.csv" | awk -F, -v OFS=, -v p="v$v-" '{ $NF = p $NF; print }' >> "$out"
+done
+echo "rows: $(($(wc -l < "$out") - 1))"
+/usr/bin/time -f "wall %e s, CPU %U s user, peak RSS %M KB" "$T" diagnose --motor trum60a --data "$out" | sed -n 1,5p
