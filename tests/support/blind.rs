@@ -164,13 +164,7 @@ pub struct Outcome {
     pub seconds: f64,
 }
 
-fn same_set(a: &str, b: &str) -> bool {
-    let mut x: Vec<&str> = a.split('+').collect();
-    let mut y: Vec<&str> = b.split('+').collect();
-    x.sort_unstable();
-    y.sort_unstable();
-    x == y
-}
+use trum_core::diagnose::same_set;
 
 impl Outcome {
     /// The verdict names the injected effect(s) exactly (`none` for a null case; also for an

@@ -775,7 +775,7 @@ pub fn diagnose(
 }
 
 /// Two effect lists (`a+b`) name the same set.
-fn same_set(a: &str, b: &str) -> bool {
+pub fn same_set(a: &str, b: &str) -> bool {
     let mut x: Vec<&str> = a.split('+').collect();
     let mut y: Vec<&str> = b.split('+').collect();
     x.sort_unstable();

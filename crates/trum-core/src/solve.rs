@@ -329,6 +329,20 @@ struct Drive {
     ks: f64,
 }
 
+impl Drive {
+    /// The drive as set at `op`, before any effect acts on it.
+    fn at(p: &Prepared, op: &OperatingPoint) -> Drive {
+        Drive {
+            f_n: op.preload_n,
+            t_load: op.torque_nm,
+            v: op.voltage_v,
+            omega: stator::angular_frequency(op.frequency_hz),
+            mu: p.mu,
+            ks: p.ks,
+        }
+    }
+}
+
 /// Baseline 2-D Coulomb interface: closed forms (seed 001 eq. 10-11; crate::contact).
 /// `sc0` = (sin φ0, cos φ0). Returns (θs, v_r, stalled, torque factor 2χ(θs) − χ(φ0),
 /// power factor 2E(θs) − E(φ0), stall torque factor). χ and E are written out here with
@@ -515,14 +529,7 @@ pub fn solve_prepared(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: O
 /// voltage from the current) are solved by fixed-point iteration around the amplitude
 /// solve; both maps are contractions for physical strengths (a few passes).
 fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
-    let mut d = Drive {
-        f_n: op.preload_n,
-        t_load: op.torque_nm,
-        v: op.voltage_v,
-        omega: stator::angular_frequency(op.frequency_hz),
-        mu: p.mu,
-        ks: p.ks,
-    };
+    let mut d = Drive::at(p, op);
     let thermal = (p.thermal.0 != 0.0 || p.thermal.1 != 0.0) && op.elapsed_s > 0.0;
     let sag = p.sag_ohm > 0.0;
     if !thermal && !sag {
@@ -907,14 +914,7 @@ pub fn amplitude_branches(motor: &Motor, op: &OperatingPoint) -> Vec<AmplitudeBr
         return Vec::new();
     }
     let p = Prepared::new(motor);
-    let d = Drive {
-        f_n: op.preload_n,
-        t_load: op.torque_nm,
-        v: op.voltage_v,
-        omega: stator::angular_frequency(op.frequency_hz),
-        mu: p.mu,
-        ks: p.ks,
-    };
+    let d = Drive::at(&p, op);
     let r = |w: f64| {
         let t = trial(&p, &d, w, None, None);
         t.w - t.w_next
