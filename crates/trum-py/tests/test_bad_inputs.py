@@ -88,7 +88,18 @@ def test_non_utf8_motor_file_raises_trum_error(path):
 
 
 def test_measurement_corpus_from_python():
-    readers = [n for n in ("parse_measurements", "read_measurements", "Measurements") if hasattr(trum, n)]
-    if not readers:
-        pytest.skip("the trum Python module has no measurement (CSV) reader; the corpus is checked in Rust")
-    pytest.fail(f"trum now has {readers}: check tests/data/bad/measurements/ through it here")
+    """Every bad measurement file raises trum.InputError through trum.diagnose with the
+    reader's exact message (the same `.expected` text the CLI test checks)."""
+    bad = sorted((ROOT / "tests" / "data" / "bad" / "measurements").glob("*.csv"))
+    assert len(bad) >= 20
+    problems = []
+    for path in bad:
+        expected = path.with_suffix(".expected").read_text(encoding="utf-8").rstrip("\n")
+        expected = expected.replace("{source}", str(path))
+        try:
+            trum.diagnose("trum60a", path)
+            problems.append(f"{path.name}: no error")
+        except trum.InputError as e:
+            if expected not in str(e):
+                problems.append(f"{path.name}:\n   got      {e}\n   expected {expected}")
+    assert not problems, "\n".join(problems)
