@@ -637,9 +637,12 @@ pub fn diagnose(
                     pairs.push([a, b]);
                 }
             };
-            let lead = best_single.as_ref().and_then(|b| Effect::from_name(&b.effect).ok()).unwrap_or(names[0]);
-            for &e in &names {
-                push(lead, e);
+            // (no testable candidate at all: no lead, no pairs)
+            let lead = best_single.as_ref().and_then(|b| Effect::from_name(&b.effect).ok()).or(names.first().copied());
+            if let Some(lead) = lead {
+                for &e in &names {
+                    push(lead, e);
+                }
             }
             if !single_closes {
                 for i in 0..names.len().min(3) {
@@ -648,11 +651,11 @@ pub fn diagnose(
                     }
                 }
             }
-            let from = fitted_motors.get(lead.name()).cloned().unwrap_or_else(|| start.clone());
+            let from = lead.and_then(|l| fitted_motors.get(l.name()).cloned()).unwrap_or_else(|| start.clone());
             let mut pr: Vec<RankEntry> = collect(
                 &mut cv_preds,
                 &mut fitted_motors,
-                pairs.par_iter().map(|p| score(p, if p[0] == lead { &from } else { &start })).collect(),
+                pairs.par_iter().map(|p| score(p, if Some(p[0]) == lead { &from } else { &start })).collect(),
             );
             sort_ranking(&mut pr);
             best_pair = pr.first().cloned();
