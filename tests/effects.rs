@@ -164,6 +164,38 @@ fn thermal_drift_makes_speed_fall_over_a_run() {
     }
 }
 
+/// `thermal_drift`'s damping term: a stator whose damping grows as it warms (its
+/// mechanical quality factor falls) loses amplitude, so more damping loss per amplitude²
+/// and a lower speed late in a run; each of the three coefficients acts on its own.
+#[test]
+fn thermal_drift_damping_grows_with_temperature_and_slows_the_rotor() {
+    let run = |coefs: &[f64], t: f64| {
+        let mut m = preset("trum60a").unwrap();
+        m.effects.set(Effect::ThermalDrift, coefs);
+        let mut op = OperatingPoint::new(250.0, 0.3, 200.0, 43e3);
+        op.elapsed_s = t;
+        solve(&m, &op)
+    };
+    let (cold, warm) = (run(&[0.0, 0.0, 5e-3], 0.0), run(&[0.0, 0.0, 5e-3], 600.0));
+    assert!(warm.temperature_rise_at_elapsed_k > 1.0, "{}", warm.temperature_rise_at_elapsed_k);
+    assert!(warm.amplitude_m < cold.amplitude_m && warm.speed_rpm < cold.speed_rpm);
+    // damping loss = c·ω²·W²: the effective damping coefficient rose by the linear law
+    let c_eff = |s: &Solution| s.damping_loss_w / s.amplitude_m.powi(2);
+    let expected = 1.0 + 5e-3 * warm.temperature_rise_at_elapsed_k;
+    assert!(
+        (c_eff(&warm) / c_eff(&cold) / expected - 1.0).abs() < 1e-9,
+        "{} vs {expected}",
+        c_eff(&warm) / c_eff(&cold)
+    );
+    // each coefficient alone moves the warm point; together they differ from any one
+    let alone: Vec<f64> =
+        [[-4e-4, 0.0, 0.0], [0.0, -2e-3, 0.0], [0.0, 0.0, 2e-3]].iter().map(|c| run(c, 600.0).speed_rpm).collect();
+    let base = run(&[0.0, 0.0, 0.0], 600.0).speed_rpm;
+    for s in &alone {
+        assert!((s - base).abs() > 1e-3 * base, "{alone:?} vs {base}");
+    }
+}
+
 /// Seed 001 section 3.1: the electrode voltage falls as the load current grows with
 /// preload and torque.
 #[test]

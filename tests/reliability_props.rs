@@ -238,11 +238,11 @@ proptest! {
         op.elapsed_s = elapsed;
         let s = solve(&m, &op);
         // thermal_drift's candidate form leaves the model's domain when a·ΔT or b·ΔT
-        // reaches -1 (negative stiffness or friction): a known bug
+        // reaches -1 (negative stiffness, friction or damping): a known bug
         // (tests/reliability_known_bugs.rs); such points are not judged here.
-        let (a, b) = (m.effects.value(Effect::ThermalDrift, 0), m.effects.value(Effect::ThermalDrift, 1));
+        let coef = (0..3).map(|i| m.effects.value(Effect::ThermalDrift, i).abs()).fold(0.0, f64::max);
         let rise = s.temperature_rise_at_elapsed_k.abs();
-        prop_assume!(!m.effects.is_on(Effect::ThermalDrift) || m.effects.truth_forms() || !rise.is_finite() || (a.abs().max(b.abs()) * rise) < 0.9);
+        prop_assume!(!m.effects.is_on(Effect::ThermalDrift) || m.effects.truth_forms() || !rise.is_finite() || (coef * rise) < 0.9);
         prop_assert!(flags_consistent(&s, &op).is_ok(), "{:?} at {:?} of\n{}", flags_consistent(&s, &op), op, m.to_toml());
         if m.effects.is_on(Effect::Eccentricity) && s.status.is_valid() {
             prop_assert!(s.speed_std_rpm.is_finite() && s.speed_std_rpm >= 0.0);

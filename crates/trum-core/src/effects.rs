@@ -1,6 +1,6 @@
 //! The library of named, switchable unmodelled effects (names fixed by
 //! `shared/spec/diagnose.md`). Like PyBaMM's model options: an explicit set of named
-//! effects, each with one or two strength parameters in physical units, `none` by
+//! effects, each with one to three strength parameters in physical units, `none` by
 //! default, validated with errors that list the valid names.
 //!
 //! This module holds the registry and the switch; the physics of each effect lives next
@@ -53,6 +53,9 @@ pub enum Effect {
 
 /// Number of effects in the registry.
 pub const N_EFFECTS: usize = 7;
+
+/// Most strength parameters an effect has (`thermal_drift`: stiffness, damping, friction).
+pub const MAX_PARAMS: usize = 3;
 
 /// All effects, in the order of [`Effect`].
 pub const ALL: [Effect; N_EFFECTS] = [
@@ -117,8 +120,8 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
     },
     EffectInfo {
         name: "thermal_drift",
-        summary: "losses heat the stator over a run; modal stiffness and friction change with \
-                  temperature, so speed drifts",
+        summary: "losses heat the stator over a run; modal stiffness, modal damping and friction \
+                  change with temperature, so speed drifts",
         source: "seed 000 eq. 11 and section 4.2",
         params: &[
             EffectParam {
@@ -133,6 +136,14 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 name: "friction_coefficient_per_k",
                 doc: "relative change of the friction coefficient per kelvin [1/K]",
                 typical: -2.0e-3,
+                min: -0.05,
+                max: 0.05,
+            },
+            EffectParam {
+                name: "damping_coefficient_per_k",
+                doc: "relative change of the modal damping per kelvin [1/K] (positive: the \
+                      piezoceramic's mechanical quality factor falls as it warms)",
+                typical: 2.0e-3,
                 min: -0.05,
                 max: 0.05,
             },
@@ -214,7 +225,7 @@ pub fn valid_names() -> String {
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Effects {
     on: [bool; N_EFFECTS],
-    values: [[f64; 2]; N_EFFECTS],
+    values: [[f64; MAX_PARAMS]; N_EFFECTS],
     truth: bool,
 }
 
@@ -244,7 +255,7 @@ impl Effects {
     /// Switches an effect on with all its parameters (missing ones are 0).
     pub fn set(&mut self, e: Effect, params: &[f64]) {
         self.on[e as usize] = true;
-        let mut v = [0.0; 2];
+        let mut v = [0.0; MAX_PARAMS];
         for (slot, p) in v.iter_mut().zip(params) {
             *slot = *p;
         }
@@ -254,7 +265,7 @@ impl Effects {
     /// Switches an effect on with its primary parameter, the others at their typical value.
     pub fn set_strength(&mut self, e: Effect, strength: f64) {
         let info = e.info();
-        let mut v = [0.0; 2];
+        let mut v = [0.0; MAX_PARAMS];
         for (i, p) in info.params.iter().enumerate() {
             v[i] = if i == 0 { strength } else { p.typical };
         }
@@ -264,7 +275,7 @@ impl Effects {
     /// Switches an effect off.
     pub fn clear(&mut self, e: Effect) {
         self.on[e as usize] = false;
-        self.values[e as usize] = [0.0; 2];
+        self.values[e as usize] = [0.0; MAX_PARAMS];
     }
 
     /// True when the effect is switched on.
@@ -536,11 +547,12 @@ mod tests {
     fn assignment_forms() {
         let mut fx = Effects::none();
         fx.parse_assignment("thermal_drift:stiffness_coefficient_per_k=-1e-4,friction_coefficient_per_k=0").unwrap();
-        assert_eq!(fx.get(Effect::ThermalDrift), Some(&[-1e-4, 0.0][..]));
+        // the parameter not named keeps its typical value
+        assert_eq!(fx.get(Effect::ThermalDrift), Some(&[-1e-4, 0.0, 2e-3][..]));
         fx.parse_assignment("radial_friction=0.3").unwrap();
         assert_eq!(fx.value(Effect::RadialFriction, 0), 0.3);
         assert_eq!(fx.active().len(), 2);
-        assert_eq!(fx.to_string(), "radial_friction(radial_velocity_ratio=0.3) + thermal_drift(stiffness_coefficient_per_k=-0.0001, friction_coefficient_per_k=0)");
+        assert_eq!(fx.to_string(), "radial_friction(radial_velocity_ratio=0.3) + thermal_drift(stiffness_coefficient_per_k=-0.0001, friction_coefficient_per_k=0, damping_coefficient_per_k=0.002)");
         fx.parse_assignment("none").unwrap();
         assert!(fx.is_none());
     }

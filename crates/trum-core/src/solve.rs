@@ -248,7 +248,8 @@ pub struct Prepared {
     pub(crate) beta_gain: f64,
     pub(crate) law: crate::interface::Law,
     pub(crate) compliance: f64,
-    pub(crate) thermal: (f64, f64),
+    /// `thermal_drift`: relative change per kelvin of (stiffness, friction, damping).
+    pub(crate) thermal: [f64; 3],
     pub(crate) sag_ohm: f64,
     pub(crate) runout_m: f64,
     pub(crate) truth: bool,
@@ -287,7 +288,7 @@ impl Prepared {
                 truth: fx.truth_forms(),
             },
             compliance: fx.value(Effect::TangentialCompliance, 0),
-            thermal: (fx.value(Effect::ThermalDrift, 0), fx.value(Effect::ThermalDrift, 1)),
+            thermal: [0, 1, 2].map(|i| fx.value(Effect::ThermalDrift, i)),
             sag_ohm: fx.value(Effect::VoltageSag, 0),
             runout_m: fx.value(Effect::Eccentricity, 0),
             truth: fx.truth_forms(),
@@ -327,6 +328,8 @@ struct Drive {
     omega: f64,
     mu: f64,
     ks: f64,
+    /// Modal damping [N·s/m] (temperature dependent under `thermal_drift`).
+    c: f64,
 }
 
 impl Drive {
@@ -339,6 +342,7 @@ impl Drive {
             omega: stator::angular_frequency(op.frequency_hz),
             mu: p.mu,
             ks: p.ks,
+            c: p.c,
         }
     }
 }
@@ -500,7 +504,7 @@ fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>, phi_guess: Opti
         let growth = if p.truth { (1.0 + p.beta_gain * d.f_n).powf(1.3) } else { 1.0 + p.beta_gain * d.f_n };
         k_eff -= 0.75 * p.beta * growth * w * w;
     }
-    let z = (k_eff - p.m * d.omega * d.omega, d.omega * p.c + ct_omega);
+    let z = (k_eff - p.m * d.omega * d.omega, d.omega * d.c + ct_omega);
     let w_next = p.theta * d.v / (z.0 * z.0 + z.1 * z.1).sqrt();
     Trial { w, contact: ct, ts, vr, stalled, a, v0, tf, pf, rf, tf0, z, k_eff, w_next }
 }
@@ -530,7 +534,7 @@ pub fn solve_prepared(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: O
 /// solve; both maps are contractions for physical strengths (a few passes).
 fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
     let mut d = Drive::at(p, op);
-    let thermal = (p.thermal.0 != 0.0 || p.thermal.1 != 0.0) && op.elapsed_s > 0.0;
+    let thermal = p.thermal.iter().any(|&x| x != 0.0) && op.elapsed_s > 0.0;
     let sag = p.sag_ohm > 0.0;
     if !thermal && !sag {
         return solve_drive(p, &d, op, guess);
@@ -553,14 +557,12 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
         rise = new_rise;
         d.v = new_v;
         if thermal {
-            let (a, b) = p.thermal;
-            (d.ks, d.mu) = if p.truth {
-                (p.ks * (a * rise).exp(), p.mu * (b * rise).exp())
-            } else {
-                // linear laws, floored at 5 % of nominal so a large drift cannot make the
-                // stiffness or the friction coefficient non-physical
-                (p.ks * (1.0 + a * rise).max(0.05), p.mu * (1.0 + b * rise).max(0.05))
-            };
+            // each relative coefficient scales its nominal value: exponential laws in the
+            // truth form, linear ones (floored at 5 % of nominal so a large drift cannot make
+            // a stiffness, damping or friction coefficient non-physical) in the candidate
+            let law = |x: f64| if p.truth { (x * rise).exp() } else { (1.0 + x * rise).max(0.05) };
+            let [a, b, g] = p.thermal;
+            (d.ks, d.mu, d.c) = (p.ks * law(a), p.mu * law(b), p.c * law(g));
         }
         let prev = s.clone();
         s = solve_drive(p, &d, op, Some(&prev).filter(|g| g.status.is_valid()));
@@ -692,7 +694,7 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
     let rtol = if p.law.radial_ratio == 0.0 && p.compliance == 0.0 { 1e-12 } else { 1e-10 };
     // Upper bound: |Z| ≥ ω·c, so W' ≤ Θ·V/(ω·c). Softening could in principle exceed it;
     // the bracket is then grown below.
-    let w_hi0 = p.theta * d.v / (d.omega * p.c);
+    let w_hi0 = p.theta * d.v / (d.omega * d.c);
     let mut evals = 0u32;
     let mut ts_guess = guess.map(|g| g.stick_half_angle_rad).filter(|t| t.is_finite());
     // The inner root finds (contact and stick angles) have unique roots: starting them
@@ -837,7 +839,7 @@ fn finish_unchecked(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, sta
     let friction = if clamped { 0.0 } else { (scale * (t.v0 * t.pf - vr * t.tf)).max(0.0) };
     let radial = if clamped { 0.0 } else { scale * t.v0 * t.rf };
     let omega = d.omega;
-    let damping = p.c * omega * omega * w * w;
+    let damping = d.c * omega * omega * w * w;
     let dielectric = crate::losses::dielectric_loss_w(omega, p.c0, p.tan_d, d.v);
     let rotor = p.dr * speed * speed;
     let output = if t.stalled { 0.0 } else { op.torque_nm * speed };
@@ -919,7 +921,7 @@ pub fn amplitude_branches(motor: &Motor, op: &OperatingPoint) -> Vec<AmplitudeBr
         let t = trial(&p, &d, w, None, None);
         t.w - t.w_next
     };
-    let mut w_hi = p.theta * d.v / (d.omega * p.c);
+    let mut w_hi = p.theta * d.v / (d.omega * d.c);
     // softening can lift the response above the linear bound: grow until r > 0
     for _ in 0..60 {
         if r(w_hi) > 0.0 {
