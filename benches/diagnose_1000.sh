@@ -21,4 +21,4 @@ for v in 165 175 185 195 205 215 225 235; do
     tail -n +2 "$dir/c$i.csv" | awk -F, -v OFS=, -v p="v$v-" '{ $NF = p $NF; print }' >> "$out"
 done
 echo "rows: $(($(wc -l < "$out") - 1))"
-/usr/bin/time -f "wall %e s, CPU %U s user, peak RSS %M KB" "$T" diagnose --motor trum60a --data "$out" | sed -n 1,5p
+/usr/bin/time -f "wall %e s, CPU %U s user, peak RSS %M KB" "$T" diagnose --motor trum60a --data "$out" | sed -n 1,40p

@@ -164,14 +164,21 @@ pub fn write_summary(d: &Diagnosis, motor: &Motor, data: &str, out: &mut dyn Wri
                 fmt_sig(r.heldout_nrmse_after, 3),
                 pct(r.shrink),
                 format!("[{}, {}]", pct(r.shrink_interval.0), pct(r.shrink_interval.1)),
+                r.signature_match.map(|x| format!("{x:+.2}")).unwrap_or_default(),
+                r.signature_overlap.map(|x| format!("{x:.2}")).unwrap_or_default(),
             ]
         })
         .collect();
     write_table(
         out,
-        &["effect", "evidence", "NRMSE after", "shrink", "90 % interval"],
-        &[Align::Left, Align::Right, Align::Right, Align::Right, Align::Left],
+        &["effect", "evidence", "NRMSE after", "shrink", "90 % interval", "signature match", "overlap"],
+        &[Align::Left, Align::Right, Align::Right, Align::Right, Align::Left, Align::Right, Align::Right],
         &rows,
+    )?;
+    writeln!(
+        out,
+        "signature match: cos of the baseline's residual and the effect's first-order change (+1: exactly the \
+         missing shape); overlap: |cos| with the verdict's signature (1: the data see one shape)"
     )?;
     if !d.notes.is_empty() {
         writeln!(out)?;

@@ -13,11 +13,16 @@
 //!    ½·ΔBIC, a log Bayes factor: > 3 strong, > 5 very strong). Pairs of the best
 //!    candidates follow when no single one closes the gap or when two are supported, and
 //!    win only by beating the best single on held-out data as well as in evidence.
+//!    Each candidate's sensitivity signature (`signature`) is compared with the baseline's
+//!    residual pattern (a score test) and with the verdict's signature: effects whose
+//!    signatures the data see as one shape are reported as confounded; at the lead effect's
+//!    fit the same test screens which second effects are worth a pair fit.
 //! 4. Where: baseline residuals grouped by quantity and region; a group is reported when
 //!    its mean normalised residual is more than 3.5 standard errors from zero (z-test;
 //!    3.5 keeps the family-wise false-alarm rate near 1 % over ~50 groups).
 
 pub mod json;
+mod signature;
 
 use crate::calibrate::{
     baseline_params, calibrate, effect_params, residuals, Calibration, FitOptions, FitParam, FittedParam, Observable,
@@ -97,6 +102,14 @@ pub struct RankEntry {
     pub shrink_interval: (f64, f64),
     /// Fitted effect parameters on the full data (name, value).
     pub params: Vec<(String, f64)>,
+    /// Score test at the calibrated baseline (single effects): cos of the angle between
+    /// the baseline's residual and the effect's signature, signed so that +1 means the
+    /// effect, raised from zero, moves the model exactly towards the data.
+    pub signature_match: Option<f64>,
+    /// Score test at the calibrated baseline: the χ² the effect removes to first order.
+    pub linear_chi2_drop: Option<f64>,
+    /// |cos| between this effect's signature and the verdict's (1: the data see one shape).
+    pub signature_overlap: Option<f64>,
 }
 
 /// The diagnosis.
@@ -506,9 +519,23 @@ pub fn diagnose(
             residuals(&probe, rows) == base_res
         })
         .collect();
+    // Score tests at the calibrated baseline: each testable candidate's signature against
+    // the baseline's residual (one model pass per effect parameter).
+    let base_sigs: BTreeMap<Effect, signature::Signature> = opts
+        .candidates
+        .par_iter()
+        .filter(|e| !untestable.contains(e))
+        .filter_map(|&e| signature::signature(&base_cal, rows, e).map(|s| (e, s)))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect();
+    let single_sig = |effects: &[Effect]| match effects {
+        [e] => base_sigs.get(e),
+        _ => None,
+    };
     // `from`: the start of the fit (the calibrated baseline; for a pair, the lead effect's
     // own fit, so the pair starts where the single ended).
-    type Scored = (RankEntry, Vec<Vec<f64>>, Option<Motor>);
+    type Scored = (RankEntry, Vec<Vec<f64>>, Option<Calibration>);
     let score = |effects: &[Effect], from: &Motor| -> Scored {
         // Two starts: the calibrated baseline with the effect weak, and the nominal motor
         // with the effect at its typical strength. The baseline calibration may have bent
@@ -525,6 +552,9 @@ pub fn diagnose(
                 shrink: 0.0,
                 shrink_interval: (0.0, 0.0),
                 params: Vec::new(),
+                signature_match: None,
+                linear_chi2_drop: None,
+                signature_overlap: None,
             };
             return (entry, base_cv.preds.clone(), None);
         }
@@ -554,7 +584,7 @@ pub fn diagnose(
                 } else {
                     approx_cv(&c, rows, &folds, k, &opts.fit).preds
                 };
-                (0.5 * (base_bic - bic(c.chi2.min(base_cal.chi2), kpar)), c.params, preds, Some(c.motor))
+                (0.5 * (base_bic - bic(c.chi2.min(base_cal.chi2), kpar)), c.params.clone(), preds, Some(c))
             }
             Ok(c) => {
                 let zero = c.params.into_iter().map(|p| FittedParam { value: 0.0, ..p }).collect();
@@ -573,13 +603,16 @@ pub fn diagnose(
             shrink,
             shrink_interval: interval,
             params: fitted.into_iter().filter(|p| p.name.starts_with("effects.")).map(|p| (p.name, p.value)).collect(),
+            signature_match: single_sig(effects).map(|s| s.matched),
+            linear_chi2_drop: single_sig(effects).map(|s| s.linear_chi2_drop),
+            signature_overlap: None,
         };
         (entry, preds, fitted_motor)
     };
     let mut cv_preds: BTreeMap<String, Vec<Vec<f64>>> = BTreeMap::new();
-    let mut fitted_motors: BTreeMap<String, Motor> = BTreeMap::new();
+    let mut fits: BTreeMap<String, Calibration> = BTreeMap::new();
     let collect = |cv_preds: &mut BTreeMap<String, Vec<Vec<f64>>>,
-                   fitted_motors: &mut BTreeMap<String, Motor>,
+                   fits: &mut BTreeMap<String, Calibration>,
                    scored: Vec<Scored>|
      -> Vec<RankEntry> {
         scored
@@ -587,14 +620,14 @@ pub fn diagnose(
             .map(|(e, p, m)| {
                 cv_preds.insert(e.effect.clone(), p);
                 if let Some(m) = m {
-                    fitted_motors.insert(e.effect.clone(), m);
+                    fits.insert(e.effect.clone(), m);
                 }
                 e
             })
             .collect()
     };
     let mut ranking: Vec<RankEntry> =
-        collect(&mut cv_preds, &mut fitted_motors, opts.candidates.par_iter().map(|&e| score(&[e], &start)).collect());
+        collect(&mut cv_preds, &mut fits, opts.candidates.par_iter().map(|&e| score(&[e], &start)).collect());
     sort_ranking(&mut ranking);
 
     // A candidate is supported when the full-data evidence is very strong (½ΔBIC > 5)
@@ -614,6 +647,7 @@ pub fn diagnose(
     let gap = base_z2 > 2.0 || ranking.iter().any(supported);
     let mut verdict = String::from("none");
     let mut confounded = Vec::new();
+    let mut screened_note = None;
     if gap {
         let best_single = ranking.iter().find(|r| supported(r)).cloned();
         let single_closes = best_single.as_ref().is_some_and(closes);
@@ -639,9 +673,31 @@ pub fn diagnose(
             };
             // (no testable candidate at all: no lead, no pairs)
             let lead = best_single.as_ref().and_then(|b| Effect::from_name(&b.effect).ok()).or(names.first().copied());
+            // Screening: at the lead's own fit, a second effect whose score test (the χ² it
+            // removes to first order) is below a quarter of what a pair needs to beat the
+            // single (½ΔBIC > 5: Δχ² > 10 + k·ln n) is not worth a pair fit.
+            let lead_fit = lead.and_then(|l| fits.get(l.name()));
+            let needed = |e: Effect| 10.0 + e.info().params.len() as f64 * (n_read as f64).ln();
+            let second: Vec<(Effect, bool)> = names
+                .par_iter()
+                .filter(|&&e| Some(e) != lead)
+                .map(|&e| {
+                    let drop = lead_fit.and_then(|c| signature::signature(c, rows, e)).map(|s| s.linear_chi2_drop);
+                    (e, drop.is_none_or(|d| d >= 0.25 * needed(e)))
+                })
+                .collect();
             if let Some(lead) = lead {
-                for &e in &names {
-                    push(lead, e);
+                for &(e, worth) in &second {
+                    if worth {
+                        push(lead, e);
+                    }
+                }
+                let skipped: Vec<&str> = second.iter().filter(|x| !x.1).map(|x| x.0.name()).collect();
+                if !skipped.is_empty() {
+                    screened_note = Some(format!(
+                        "not fitted as a second effect to {lead} (score test at its fit below a quarter of what a pair needs): {}",
+                        skipped.join(", ")
+                    ));
                 }
             }
             if !single_closes {
@@ -651,10 +707,10 @@ pub fn diagnose(
                     }
                 }
             }
-            let from = lead.and_then(|l| fitted_motors.get(l.name()).cloned()).unwrap_or_else(|| start.clone());
+            let from = lead_fit.map(|c| c.motor.clone()).unwrap_or_else(|| start.clone());
             let mut pr: Vec<RankEntry> = collect(
                 &mut cv_preds,
-                &mut fitted_motors,
+                &mut fits,
                 pairs.par_iter().map(|p| score(p, if Some(p[0]) == lead { &from } else { &start })).collect(),
             );
             sort_ranking(&mut pr);
@@ -716,14 +772,22 @@ pub fn diagnose(
                 ));
             }
         } else if !verdict.contains('+') {
+            // Confounded: another supported single effect that explains the data about as
+            // well (held-out error within 15 %, evidence within 5), or one that also closes
+            // the gap while the data see its signature and the verdict's as one shape
+            // (|cos| ≥ 0.95 at the calibrated baseline): then the held-out ranking between
+            // them rests on the candidates' form, not on what the data can separate.
+            let vsig = Effect::from_name(&verdict).ok().and_then(|e| base_sigs.get(&e));
+            for r in ranking.iter_mut() {
+                if let (Some(v), Some(e)) = (vsig, Effect::from_name(&r.effect).ok()) {
+                    r.signature_overlap = base_sigs.get(&e).map(|s| signature::overlap(v, s));
+                }
+            }
             if let Some(best) = ranking.iter().find(|r| r.effect == verdict).cloned() {
                 for r in &ranking {
-                    if r.effect != best.effect
-                        && !r.effect.contains('+')
-                        && supported(r)
-                        && r.heldout_nrmse_after <= 1.15 * best.heldout_nrmse_after
-                        && best.evidence - r.evidence < 5.0
-                    {
+                    let alike = r.heldout_nrmse_after <= 1.15 * best.heldout_nrmse_after && best.evidence - r.evidence < 5.0;
+                    let one_shape = r.signature_overlap.is_some_and(|o| o >= 0.95) && closes(r);
+                    if r.effect != best.effect && !r.effect.contains('+') && supported(r) && (alike || one_shape) {
                         confounded.push(r.effect.clone());
                     }
                 }
@@ -734,6 +798,7 @@ pub fn diagnose(
             "the calibrated baseline predicts the held-out regions at the noise level (mean squared normalised residual {base_z2:.2}) and no candidate effect is supported; no effect is needed"
         ));
     }
+    notes.extend(screened_note);
     if reduced && verdict != "none" {
         notes.push(format!("with so few readings the verdict '{verdict}' is tentative; measure more operating points"));
     }

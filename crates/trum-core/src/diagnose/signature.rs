@@ -1,0 +1,157 @@
+//! Sensitivity signatures: what switching an effect on does to a fit's residuals, beyond
+//! what the fit's own parameters can absorb. Compared with the residual pattern they say
+//! whether the calibrated model misses in the way an effect would move it (a score test:
+//! the χ² the effect could remove to first order, without fitting it), and compared with
+//! each other they say which effects the data cannot tell apart.
+//!
+//! With r the fit's weighted residuals, J their Jacobian in the fitted parameters and S
+//! the effect's columns (one per parameter: the residual change when the effect is
+//! switched on at a tenth of its typical strength, then each further parameter doubled), the
+//! signature is S̃ = (I − J J⁺) S, the part of S orthogonal to what refitting the other
+//! parameters already does. Linearised, adding the effect lowers χ² by ‖P_S̃ r‖², the
+//! projection of r onto the span of S̃ (Rao's score statistic for a least-squares model).
+
+use super::pseudo_inverse;
+use crate::calibrate::{residuals, Calibration, ObservedRow};
+use crate::effects::Effect;
+use nalgebra::{DMatrix, DVector};
+
+/// Probe strength of the primary parameter, as a fraction of its typical value.
+const PROBE: f64 = 0.1;
+
+/// An effect's signature at one fit.
+#[derive(Clone, Debug)]
+pub(crate) struct Signature {
+    /// S̃: one column per effect parameter, rows in reading order (weighted σ units).
+    pub(crate) columns: DMatrix<f64>,
+    /// ‖P_S̃ r‖²: the χ² the effect removes to first order.
+    pub(crate) linear_chi2_drop: f64,
+    /// cos(r, −S̃₀): +1 when the residual is exactly what the effect's primary parameter
+    /// (raised from the fit's value) removes, −1 when it would need the opposite sign.
+    pub(crate) matched: f64,
+}
+
+/// The fit's weighted residuals for `motor` (the fit's final Huber weights).
+fn weighted(cal: &Calibration, motor: &crate::Motor, rows: &[ObservedRow]) -> DVector<f64> {
+    let r = residuals(motor, rows);
+    DVector::from_iterator(r.len(), r.iter().zip(&cal.lin.weights).map(|(x, w)| x * w))
+}
+
+/// The signature of `e` at the fit `cal` (an effect the fit already carries is not probed:
+/// None). Costs one model pass over the rows per effect parameter.
+pub(crate) fn signature(cal: &Calibration, rows: &[ObservedRow], e: Effect) -> Option<Signature> {
+    if cal.motor.effects.is_on(e) {
+        return None;
+    }
+    let info = e.info();
+    let r = &cal.lin.residuals;
+    let mut probe = cal.motor.clone();
+    // A small probe (a tenth of the typical strength): the shape of the effect's leading
+    // term. It changes with strength (radial friction's at its typical strength matches
+    // its own weak residual with cos 0.2 instead of 0.99), and the test is one of first order.
+    let typical: Vec<f64> =
+        info.params.iter().enumerate().map(|(i, p)| if i == 0 { PROBE * p.typical } else { p.typical }).collect();
+    probe.effects.set(e, &typical);
+    let on = weighted(cal, &probe, rows);
+    let mut cols = vec![&on - r];
+    for i in 1..info.params.len() {
+        let mut m = probe.clone();
+        *m.effects.value_mut(e, i) = 2.0 * typical[i];
+        cols.push(weighted(cal, &m, rows) - &on);
+    }
+    let s = DMatrix::from_columns(&cols);
+    if !s.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let j = &cal.lin.jacobian;
+    let st = &s - j * (pseudo_inverse(&(j.transpose() * j)) * (j.transpose() * &s));
+    let g = st.transpose() * r;
+    let linear_chi2_drop = (g.transpose() * pseudo_inverse(&(st.transpose() * &st)) * &g)[(0, 0)].max(0.0);
+    let s0 = st.column(0);
+    let denom = s0.norm() * r.norm();
+    let matched = if denom > 0.0 { -s0.dot(r) / denom } else { 0.0 };
+    Some(Signature { columns: st, linear_chi2_drop, matched })
+}
+
+/// |cos| of the angle between two signatures' primary columns: 1 when the data see the two
+/// effects' first-order changes as one shape (up to scale), 0 when they are orthogonal.
+pub(crate) fn overlap(a: &Signature, b: &Signature) -> f64 {
+    let (x, y) = (a.columns.column(0), b.columns.column(0));
+    let d = x.norm() * y.norm();
+    if d > 0.0 {
+        (x.dot(&y) / d).abs()
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calibrate::{baseline_params, calibrate, FitOptions, Observable};
+    use crate::presets::preset;
+    use crate::OperatingPoint;
+
+    /// Noise-free data of `truth` over a preload × torque grid (speed, power, feedback).
+    fn rows_of(truth: &crate::Motor) -> Vec<ObservedRow> {
+        let mut rows = Vec::new();
+        for f in [100.0, 175.0, 250.0, 325.0, 400.0] {
+            for t in [0.0, 0.15, 0.3, 0.45] {
+                let op = OperatingPoint::new(f, t, 200.0, 43e3);
+                let s = crate::solve(truth, &op);
+                let readings = [Observable::SpeedRpm, Observable::InputPowerW, Observable::FeedbackV]
+                    .iter()
+                    .map(|&o| {
+                        let v = o.predict(&s, 25.0);
+                        (o, v, o.default_sigma(v))
+                    })
+                    .collect();
+                rows.push(ObservedRow { op, readings, ambient_c: 25.0 });
+            }
+        }
+        rows
+    }
+
+    /// The score test against a full refit: on data of the baseline plus weak radial
+    /// friction, radial friction's signature matches the calibrated baseline's residual
+    /// best of all candidates and its first-order χ² drop is close to what fitting it
+    /// removes; on baseline data it finds nothing.
+    #[test]
+    fn the_true_effect_matches_the_residual_and_its_score_is_of_the_fits_order() {
+        let nominal = preset("trum60a").unwrap();
+        let mut truth = nominal.clone();
+        truth.effects.set(Effect::RadialFriction, &[0.3]);
+        let rows = rows_of(&truth);
+        let fit = FitOptions::default();
+        let base = calibrate(&nominal, &rows, &baseline_params(&nominal, &rows), &fit).unwrap();
+        let sig = signature(&base, &rows, Effect::RadialFriction).unwrap();
+        assert!(sig.matched > 0.95, "match {}", sig.matched);
+        for e in crate::effects::ALL.into_iter().filter(|&e| e != Effect::RadialFriction) {
+            let other = signature(&base, &rows, e).unwrap();
+            assert!(other.matched < 0.8 && other.linear_chi2_drop < 0.6 * sig.linear_chi2_drop, "{e}: {other:?}");
+        }
+        // a full refit with the effect: χ² falls to ~0 (noise-free data)
+        let mut params = baseline_params(&nominal, &rows);
+        params.extend(crate::calibrate::effect_params(Effect::RadialFriction));
+        let mut start = base.motor.clone();
+        start.effects.set(Effect::RadialFriction, &[0.1]);
+        let with = calibrate(&start, &rows, &params, &fit).unwrap();
+        let removed = base.chi2 - with.chi2;
+        assert!(removed > 0.0 && with.chi2 < 1e-3 * base.chi2, "{} -> {}", base.chi2, with.chi2);
+        let ratio = sig.linear_chi2_drop / removed;
+        assert!((0.8..=1.05).contains(&ratio), "linear drop {} vs refit {removed}", sig.linear_chi2_drop);
+        // an effect already carried is not probed
+        assert!(signature(&with, &rows, Effect::RadialFriction).is_none());
+
+        // baseline data: the calibrated baseline fits exactly, nothing is left to explain
+        let clean = rows_of(&nominal);
+        let base0 = calibrate(&nominal, &clean, &baseline_params(&nominal, &clean), &fit).unwrap();
+        let s0 = signature(&base0, &clean, Effect::RadialFriction).unwrap();
+        assert!(s0.linear_chi2_drop < 1e-6 * sig.linear_chi2_drop.max(1.0), "{}", s0.linear_chi2_drop);
+        // overlap is symmetric, 1 with itself, within [0, 1]
+        let other = signature(&base, &rows, Effect::VoltageSag).unwrap();
+        assert!((overlap(&sig, &sig) - 1.0).abs() < 1e-12);
+        let (ab, ba) = (overlap(&sig, &other), overlap(&other, &sig));
+        assert!((ab - ba).abs() < 1e-12 && (0.0..=1.0).contains(&ab), "{ab}");
+    }
+}
