@@ -785,7 +785,8 @@ pub fn diagnose(
             }
             if let Some(best) = ranking.iter().find(|r| r.effect == verdict).cloned() {
                 for r in &ranking {
-                    let alike = r.heldout_nrmse_after <= 1.15 * best.heldout_nrmse_after && best.evidence - r.evidence < 5.0;
+                    let alike =
+                        r.heldout_nrmse_after <= 1.15 * best.heldout_nrmse_after && best.evidence - r.evidence < 5.0;
                     let one_shape = r.signature_overlap.is_some_and(|o| o >= 0.95) && closes(r);
                     if r.effect != best.effect && !r.effect.contains('+') && supported(r) && (alike || one_shape) {
                         confounded.push(r.effect.clone());
