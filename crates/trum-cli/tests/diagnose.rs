@@ -179,6 +179,18 @@ fn diagnose_without_effect_says_none() {
         assert!(after >= 0.0);
         assert!((shrink - (1.0 - after / before)).abs() < 1e-9, "{r}");
         assert_eq!(r["shrink_interval"].as_array().map(Vec::len), Some(2));
+        // score test at the calibrated baseline: every single effect that moves a
+        // prediction has one (thermal_drift does not without a time series), a cosine and a
+        // non-negative χ² drop; a pair has none
+        let name = r["effect"].as_str().unwrap_or_default();
+        if name.contains('+') || name == "thermal_drift" {
+            assert!(r["signature_match"].is_null() && r["linear_chi2_drop"].is_null(), "{r}");
+        } else {
+            let m = r["signature_match"].as_f64().expect("signature_match");
+            assert!((-1.0..=1.0).contains(&m) && r["linear_chi2_drop"].as_f64().expect("drop") >= 0.0, "{r}");
+        }
+        // a `none` verdict has no signature to compare with
+        assert!(r["signature_overlap"].is_null(), "{r}");
     }
     assert!(j["evidence_scale"].as_str().expect("scale").contains("> 3 strong, > 5 very strong"));
     assert_eq!(j["n_rows"], 8);
