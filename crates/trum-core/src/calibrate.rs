@@ -521,14 +521,16 @@ pub fn calibrate(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::presets::preset;
 
-    fn rows_from(m: &Motor) -> Vec<ObservedRow> {
+    /// Noise-free readings (speed, input power, feedback voltage at their default σ) of `m`
+    /// over a preload × torque grid at 200 V, 43 kHz.
+    pub(crate) fn rows_on_grid(m: &Motor, preloads: &[f64], torques: &[f64]) -> Vec<ObservedRow> {
         let mut rows = Vec::new();
-        for f in [100.0, 200.0, 300.0, 400.0] {
-            for t in [0.0, 0.2, 0.4] {
+        for &f in preloads {
+            for &t in torques {
                 let op = OperatingPoint::new(f, t, 200.0, 43e3);
                 let s = crate::solve(m, &op);
                 let readings = [Observable::SpeedRpm, Observable::InputPowerW, Observable::FeedbackV]
@@ -542,6 +544,10 @@ mod tests {
             }
         }
         rows
+    }
+
+    fn rows_from(m: &Motor) -> Vec<ObservedRow> {
+        rows_on_grid(m, &[100.0, 200.0, 300.0, 400.0], &[0.0, 0.2, 0.4])
     }
 
     #[test]

@@ -88,28 +88,11 @@ pub(crate) fn overlap(a: &Signature, b: &Signature) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calibrate::{baseline_params, calibrate, FitOptions, Observable};
+    use crate::calibrate::{baseline_params, calibrate, FitOptions};
     use crate::presets::preset;
-    use crate::OperatingPoint;
 
-    /// Noise-free data of `truth` over a preload × torque grid (speed, power, feedback).
     fn rows_of(truth: &crate::Motor) -> Vec<ObservedRow> {
-        let mut rows = Vec::new();
-        for f in [100.0, 175.0, 250.0, 325.0, 400.0] {
-            for t in [0.0, 0.15, 0.3, 0.45] {
-                let op = OperatingPoint::new(f, t, 200.0, 43e3);
-                let s = crate::solve(truth, &op);
-                let readings = [Observable::SpeedRpm, Observable::InputPowerW, Observable::FeedbackV]
-                    .iter()
-                    .map(|&o| {
-                        let v = o.predict(&s, 25.0);
-                        (o, v, o.default_sigma(v))
-                    })
-                    .collect();
-                rows.push(ObservedRow { op, readings, ambient_c: 25.0 });
-            }
-        }
-        rows
+        crate::calibrate::tests::rows_on_grid(truth, &[100.0, 175.0, 250.0, 325.0, 400.0], &[0.0, 0.15, 0.3, 0.45])
     }
 
     /// The score test against a full refit: on data of the baseline plus weak radial
