@@ -54,9 +54,9 @@ pub(crate) fn signature(cal: &Calibration, rows: &[ObservedRow], e: Effect) -> O
     probe.effects.set(e, &typical);
     let on = weighted(cal, &probe, rows);
     let mut cols = vec![&on - r];
-    for i in 1..info.params.len() {
+    for (i, &v) in typical.iter().enumerate().skip(1) {
         let mut m = probe.clone();
-        *m.effects.value_mut(e, i) = 2.0 * typical[i];
+        *m.effects.value_mut(e, i) = 2.0 * v;
         cols.push(weighted(cal, &m, rows) - &on);
     }
     let s = DMatrix::from_columns(&cols);
