@@ -40,7 +40,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
-use trum_core::effects::{Effect, ALL as ALL_EFFECTS};
+use trum_core::effects::{Effect, ALL as ALL_EFFECTS, MAX_PARAMS};
 use trum_core::measurements::{parse_measurements, Measurements, COLUMNS};
 use trum_core::quantities::QUANTITIES;
 use trum_core::{presets, solve, Motor, OperatingPoint, Status};
@@ -360,7 +360,7 @@ struct Case {
     preset: String,
     op: [f64; 5],
     params: Vec<(String, f64)>,
-    effects: Vec<(Effect, [f64; 2])>,
+    effects: Vec<(Effect, [f64; MAX_PARAMS])>,
     truth: bool,
 }
 
@@ -387,7 +387,7 @@ impl Case {
                 Some("param") if w.len() > 2 => c.params.push((w[1].to_string(), f(2))),
                 Some("effect") if w.len() > 1 => {
                     if let Ok(e) = Effect::from_name(w[1]) {
-                        c.effects.push((e, [f(2), f(3)]));
+                        c.effects.push((e, [2, 3, 4].map(f)));
                     }
                 }
                 Some("truth") => c.truth = true,
@@ -406,7 +406,8 @@ impl Case {
             s.push_str(&format!("param {k} {v:?}\n"));
         }
         for (e, v) in &self.effects {
-            s.push_str(&format!("effect {} {:?} {:?}\n", e.name(), v[0], v[1]));
+            let vals: Vec<String> = v.iter().map(|x| format!("{x:?}")).collect();
+            s.push_str(&format!("effect {} {}\n", e.name(), vals.join(" ")));
         }
         if self.truth {
             s.push_str("truth\n");
@@ -797,7 +798,7 @@ fn mutate_case(c: &mut Case, rng: &mut ChaCha8Rng) {
             }
             6 | 7 => {
                 let e = *pick(rng, &ALL_EFFECTS);
-                let mut v = [0.0; 2];
+                let mut v = [0.0; MAX_PARAMS];
                 for (slot, p) in v.iter_mut().zip(e.info().params) {
                     *slot = if rng.random_bool(0.8) {
                         if rng.random_bool(0.2) {
