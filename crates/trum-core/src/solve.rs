@@ -730,8 +730,13 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
     let mut cur = eval(start, &mut ts_guess);
     let mut prev: Option<Trial> = None;
     let mut converged = false;
-    let mut side_lo = 0; // Illinois bookkeeping
-    let mut side_hi = 0;
+    // Illinois bookkeeping: the residuals used for regula falsi at the bracket's ends.
+    // When one end is kept twice in a row its stored residual is halved again each time
+    // (cumulatively: halving only once stalled into linear convergence at ratio ~0.7, 82
+    // evaluations without reaching the tolerance, found by tests/invariants.rs).
+    let (mut rl_s, mut rh_s) = (0.0, hi.w - hi.w_next);
+    let mut last_side = 0i8; // +1: the last iterate replaced hi, −1: lo
+    let mut stretch = 1.0; // fixed-point step multiplier, doubled per rejected secant
     for _ in 0..80 {
         let r = cur.w - cur.w_next;
         if r.abs() <= rtol * cur.w.max(1e-300) {
@@ -740,12 +745,18 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
         }
         if r > 0.0 {
             hi = cur;
-            side_hi += 1;
-            side_lo = 0;
+            rh_s = r;
+            if last_side == 1 {
+                rl_s *= 0.5;
+            }
+            last_side = 1;
         } else {
             lo = Some(cur);
-            side_lo += 1;
-            side_hi = 0;
+            rl_s = r;
+            if last_side == -1 {
+                rh_s *= 0.5;
+            }
+            last_side = -1;
         }
         if cur.w < 1e-9 * w_hi0 && r > 0.0 && lo.is_none() {
             // Descending towards zero with W' < W: the only fixed point is W = 0 (clamped).
@@ -754,15 +765,7 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
         let next = match lo {
             Some(l) => {
                 // Regula falsi (Illinois) inside [lo, hi].
-                let mut rl = l.w - l.w_next;
-                let mut rh = hi.w - hi.w_next;
-                if side_lo >= 2 {
-                    rh *= 0.5;
-                }
-                if side_hi >= 2 {
-                    rl *= 0.5;
-                }
-                let x = l.w - rl * (hi.w - l.w) / (rh - rl);
+                let x = l.w - rl_s * (hi.w - l.w) / (rh_s - rl_s);
                 if x > l.w && x < hi.w {
                     x
                 } else {
@@ -770,19 +773,26 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
                 }
             }
             None => {
-                // Secant from the previous iterate if it moves down; else a fixed-point step.
-                let fp = cur.w_next;
-                match prev {
-                    Some(pv) => {
-                        let rp = pv.w - pv.w_next;
-                        let x = cur.w - r * (cur.w - pv.w) / (r - rp);
-                        if x.is_finite() && x > 0.0 && x < cur.w {
-                            x
-                        } else {
-                            fp
-                        }
+                // Secant from the previous iterate if it moves down; else a fixed-point step,
+                // lengthened while the secant keeps pointing up: there the residual grows as
+                // W falls and plain steps of r ≈ 10⁻³·W took the whole budget (points near
+                // stall and clamping; found by tests/invariants.rs). The step is at most a
+                // tenth of W so that a root is not stepped over lightly; a step into r < 0
+                // brackets one.
+                let secant = prev.map(|pv| {
+                    let rp = pv.w - pv.w_next;
+                    cur.w - r * (cur.w - pv.w) / (r - rp)
+                });
+                match secant {
+                    Some(x) if x.is_finite() && x > 0.0 && x < cur.w => {
+                        stretch = 1.0;
+                        x
                     }
-                    None => fp,
+                    _ => {
+                        let x = cur.w - (r * stretch).min(0.1 * cur.w).max(r);
+                        stretch *= 2.0;
+                        x
+                    }
                 }
             }
         };

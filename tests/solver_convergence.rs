@@ -1,0 +1,91 @@
+//! The amplitude solve converges on the points that used to end in `no_convergence`
+//! (solve.rs, `solve_drive`): a regula falsi whose Illinois halving did not accumulate
+//! (linear convergence at ratio ≈ 0.7 near a stall root), and plain fixed-point steps of
+//! ≈ 10⁻³·W where the residual grows as W falls (near stall and clamping). Each answer is
+//! checked against an independent route: `amplitude_branches`, a 400-point scan of the
+//! amplitude map with bisection, whose largest stable root is the steady amplitude; no
+//! root at all means the stator is clamped.
+
+use trum_core::presets::preset;
+use trum_core::solve::amplitude_branches;
+use trum_core::sweep::{Axis, Grid};
+use trum_core::{solve, Motor, OperatingPoint, Status};
+
+fn assert_largest_branch(m: &Motor, op: &OperatingPoint, want: Status) {
+    let s = solve(m, op);
+    assert_eq!(s.status, want, "{} at {op:?} after {} evaluations", m.name, s.iterations);
+    let largest = amplitude_branches(m, op).iter().filter(|b| b.stable).map(|b| b.amplitude_m).fold(0.0, f64::max);
+    if want == Status::Clamped {
+        assert_eq!(largest, 0.0, "{} at {op:?}: the scan finds a running branch", m.name);
+    } else {
+        let rel = (s.amplitude_m - largest).abs() / largest;
+        assert!(rel < 1e-9, "{} at {op:?}: solve {} m, scan {} m", m.name, s.amplitude_m, largest);
+    }
+    // converged well inside the budget, not at its edge
+    assert!(s.iterations <= 60, "{} evaluations", s.iterations);
+}
+
+/// tests/invariants.rs `physical_invariants` drew this motor and point (trum60a scaled):
+/// 82 evaluations, no_convergence, deep in stall just below resonance.
+#[test]
+fn stall_root_that_stalled_the_regula_falsi() {
+    let mut m = preset("trum60a").unwrap();
+    for (k, v) in [
+        ("geometry.contact_width_m", 2.92983e-3),
+        ("geometry.neutral_plane_distance_m", 2.1856469648e-3),
+        ("friction_layer.youngs_modulus_pa", 1.2623163e8),
+        ("friction_layer.thickness_m", 4.4041826e-4),
+        ("friction_layer.friction_coefficient", 0.3306360642),
+        ("stator.resonance_frequency_hz", 41656.759),
+        ("stator.modal_damping_ns_per_m", 11.4715976),
+        ("stator.force_factor_n_per_v", 0.4939273614),
+        ("electrical.clamped_capacitance_f", 3.787e-9),
+        ("electrical.dielectric_loss_tangent", 0.00245),
+        ("rotor.viscous_damping_nms", 6.744218e-4),
+    ] {
+        *m.param_mut(k).unwrap() = v;
+    }
+    assert_largest_branch(&m, &OperatingPoint::new(457.8879, 1.6161788, 148.1236, 41640.818), Status::Stall);
+}
+
+/// Points of the dense preset maps (docs/PERFORMANCE.md) that were `no_convergence`.
+#[test]
+fn dense_map_points_near_stall_and_clamping() {
+    for (name, f, t, v, hz, want) in [
+        ("generic60", 470.0, 1.35, 150.0, 42_000.0, Status::Stall),
+        ("generic60", 595.0, 1.075, 200.0, 43_000.0, Status::Ok),
+        ("generic60", 630.0, 2.325, 200.0, 40_750.0, Status::Clamped),
+        ("generic60", 300.0, 0.725, 88.0, 41_300.0, Status::Clamped),
+        ("trum60-qut", 145.0, 0.3, 150.0, 42_000.0, Status::Clamped),
+        ("trum60a", 635.0, 1.55, 200.0, 40_750.0, Status::Clamped),
+    ] {
+        assert_largest_branch(&preset(name).unwrap(), &OperatingPoint::new(f, t, v, hz), want);
+    }
+}
+
+/// The dense maps themselves, solved cold: 3 presets × 5 drives × 140 preloads (5-700 N)
+/// × 101 torques (0-2.5 N·m), 212 100 points through ok, stall and clamped regions; 38 of
+/// them were `no_convergence` before, none may be now.
+#[test]
+fn dense_preset_maps_have_no_unconverged_point() {
+    let mut bad = Vec::new();
+    for name in ["trum60a", "trum60-qut", "generic60"] {
+        let m = preset(name).unwrap();
+        for (v, hz) in [(88.0, 41_300.0), (200.0, 40_750.0), (200.0, 43_000.0), (150.0, 42_000.0), (300.0, 44_000.0)] {
+            let g = Grid {
+                preload_n: Axis::linspace(5.0, 700.0, 140),
+                voltage_v: Axis::fixed(v),
+                frequency_hz: Axis::fixed(hz),
+                torque_nm: Axis::linspace(0.0, 2.5, 101),
+            };
+            for i in 0..g.len() {
+                let op = g.point(i);
+                let s = solve(&m, &op);
+                if !s.status.is_valid() {
+                    bad.push(format!("{name} {op:?}: {}", s.status));
+                }
+            }
+        }
+    }
+    assert!(bad.is_empty(), "{} points:\n{}", bad.len(), bad.join("\n"));
+}
