@@ -544,6 +544,8 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
     }
     let mut rise = 0.0;
     let mut s = solve_drive(p, &d, op, guess);
+    let mut settled = false;
+    let mut last_pass: Option<(f64, f64)> = None; // (V, G(V)) of the previous pass
     for _ in 0..100 {
         let (mut new_rise, mut new_v) = (rise, d.v);
         if thermal {
@@ -558,7 +560,26 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
         }
         let done = (new_rise - rise).abs() <= 1e-10 * (1.0 + rise.abs()) && (new_v - d.v).abs() <= 1e-12 * op.voltage_v;
         rise = new_rise;
-        d.v = new_v;
+        let next_v = match last_pass {
+            // The electrode voltage alternates about its fixed point: the sag map V ↦ G(V)
+            // falls with V there (G' ≈ −0.85 near clamping, 100 plain passes reached only
+            // 1e-7), so the fixed point lies between V and G(V) and is unique nearby. Take
+            // the secant root of V − G(V) inside that interval. Where G rises with V plain
+            // passes are kept: there the map can have two fixed points and the one reached
+            // from the set voltage is the answer (an unbounded secant jumped between them).
+            Some((v0, g0)) if (new_v - d.v) * (g0 - v0) < 0.0 && d.v != v0 => {
+                let slope = (new_v - g0) / (d.v - v0);
+                let x = d.v + (new_v - d.v) / (1.0 - slope);
+                if slope < 0.0 && x.is_finite() {
+                    x.clamp(d.v.min(new_v), d.v.max(new_v))
+                } else {
+                    new_v
+                }
+            }
+            _ => new_v,
+        };
+        last_pass = Some((d.v, new_v));
+        d.v = next_v;
         if thermal {
             // each relative coefficient scales its nominal value: exponential laws in the
             // truth form, linear ones (floored at 5 % of nominal so a large drift cannot make
@@ -570,11 +591,17 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
         let prev = s.clone();
         s = solve_drive(p, &d, op, Some(&prev).filter(|g| g.status.is_valid()));
         if done {
+            settled = true;
             break;
         }
         if !s.status.is_valid() {
             break;
         }
+    }
+    if !settled && s.status.is_valid() {
+        // the temperature or electrode voltage still moves after 100 passes: the numbers
+        // belong to no consistent state, so the point says so instead of reporting them
+        s.status = Status::NoConvergence;
     }
     s.temperature_rise_at_elapsed_k = if thermal { rise } else { s.temperature_rise_at_elapsed_k };
     s
