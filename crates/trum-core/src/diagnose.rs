@@ -673,20 +673,33 @@ pub fn diagnose(
             };
             // (no testable candidate at all: no lead, no pairs)
             let lead = best_single.as_ref().and_then(|b| Effect::from_name(&b.effect).ok()).or(names.first().copied());
+            // When no single effect closes the gap, the candidate with the most evidence
+            // leads a forward selection too: a large in-sample gain whose held-out shrink
+            // fails is what a missing partner looks like (its fit extrapolates into a region
+            // the other effect governs; blind slice pair case: radial friction alone
+            // predicts a clamped stator at 400 N where sag keeps it moving).
+            let mut leads: Vec<Effect> = lead.into_iter().collect();
+            if let (false, Some(&top)) = (single_closes, names.first()) {
+                if !leads.contains(&top) {
+                    leads.push(top);
+                }
+            }
             // Screening: at the lead's own fit, a second effect whose score test (the χ² it
             // removes to first order) is below a quarter of what a pair needs to beat the
             // single (½ΔBIC > 5: Δχ² > 10 + k·ln n) is not worth a pair fit.
-            let lead_fit = lead.and_then(|l| fits.get(l.name()));
             let needed = |e: Effect| 10.0 + e.info().params.len() as f64 * (n_read as f64).ln();
-            let second: Vec<(Effect, bool)> = names
-                .par_iter()
-                .filter(|&&e| Some(e) != lead)
-                .map(|&e| {
-                    let drop = lead_fit.and_then(|c| signature::signature(c, rows, e)).map(|s| s.linear_chi2_drop);
-                    (e, drop.is_none_or(|d| d >= 0.25 * needed(e)))
-                })
-                .collect();
-            if let Some(lead) = lead {
+            let mut lead_starts: Vec<(Effect, Motor)> = Vec::new();
+            let mut skipped_notes: Vec<String> = Vec::new();
+            for &lead in &leads {
+                let lead_fit = fits.get(lead.name());
+                let second: Vec<(Effect, bool)> = names
+                    .par_iter()
+                    .filter(|&&e| e != lead)
+                    .map(|&e| {
+                        let drop = lead_fit.and_then(|c| signature::signature(c, rows, e)).map(|s| s.linear_chi2_drop);
+                        (e, drop.is_none_or(|d| d >= 0.25 * needed(e)))
+                    })
+                    .collect();
                 for &(e, worth) in &second {
                     if worth {
                         push(lead, e);
@@ -694,11 +707,15 @@ pub fn diagnose(
                 }
                 let skipped: Vec<&str> = second.iter().filter(|x| !x.1).map(|x| x.0.name()).collect();
                 if !skipped.is_empty() {
-                    screened_note = Some(format!(
+                    skipped_notes.push(format!(
                         "not fitted as a second effect to {lead} (score test at its fit below a quarter of what a pair needs): {}",
                         skipped.join(", ")
                     ));
                 }
+                lead_starts.push((lead, lead_fit.map(|c| c.motor.clone()).unwrap_or_else(|| start.clone())));
+            }
+            if !skipped_notes.is_empty() {
+                screened_note = Some(skipped_notes.join("; "));
             }
             if !single_closes {
                 for i in 0..names.len().min(3) {
@@ -707,12 +724,10 @@ pub fn diagnose(
                     }
                 }
             }
-            let from = lead_fit.map(|c| c.motor.clone()).unwrap_or_else(|| start.clone());
-            let mut pr: Vec<RankEntry> = collect(
-                &mut cv_preds,
-                &mut fits,
-                pairs.par_iter().map(|p| score(p, if Some(p[0]) == lead { &from } else { &start })).collect(),
-            );
+            // a pair led by a lead starts from that lead's own fit
+            let from = |p: &[Effect; 2]| lead_starts.iter().find(|(l, _)| *l == p[0]).map(|x| &x.1).unwrap_or(&start);
+            let mut pr: Vec<RankEntry> =
+                collect(&mut cv_preds, &mut fits, pairs.par_iter().map(|p| score(p, from(p))).collect());
             sort_ranking(&mut pr);
             best_pair = pr.first().cloned();
             ranking.extend(pr);

@@ -532,9 +532,13 @@ pub fn solve_prepared(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: O
 /// Effects that depend on the solution itself (temperature from the losses, electrode
 /// voltage from the current) are solved by fixed-point iteration around the amplitude
 /// solve, starting from the set voltage and the cold motor as the bench does. Near
-/// clamping the sag map can have two fixed points (a clamped stator at a lower electrode
-/// voltage, a moving one at a higher); plain passes settle on the one reached from the
-/// switch-on state, where secant acceleration (tried: 1.6× faster) jumped between them.
+/// clamping the electrode voltage alternates between passes: a clamped stator draws
+/// little current (with the truth form's reactive source the electrode voltage even
+/// rises above the set one), a moving one more, so V ↦ G(V) falls with V. Plain passes
+/// there either crawl (ratio ≈ −0.85) or cycle for ever between a clamped and a moving
+/// state (trum60a-like truth motor, 400 N: 200 V → clamped → 217.9 V → moving → 204.0 V →
+/// clamped …); the one consistent state lies between V and G(V) (210.1 V, moving). An
+/// unbounded secant on every pass (tried: 1.6× faster) left that interval.
 fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
     let mut d = Drive::at(p, op);
     let thermal = p.thermal.iter().any(|&x| x != 0.0) && op.elapsed_s > 0.0;
