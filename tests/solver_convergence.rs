@@ -162,3 +162,34 @@ fn voltage_sag_maps_converge_everywhere() {
     }
     assert!(bad.is_empty(), "{} points:\n{}", bad.len(), bad.join("\n"));
 }
+
+/// A strong `thermal_drift` (5 × the typical coefficients): hotter → softer and more
+/// damped → fewer losses → cooler, so the temperature passes alternated (88 K, 10 K, 73 K,
+/// … at 450 N, 250 V, 600 s) and 100 of them were reported as converged 1e-7 away. Every
+/// point must now settle, and the reported temperature rise must be the one its own losses
+/// produce: ΔT(t) = P_loss/(h·S)·(1 − e^(−t·h·S/C)) (seed 000 eq. 11, the candidate form).
+#[test]
+fn thermal_drift_fixed_point_is_self_consistent() {
+    use trum_core::effects::Effect;
+    let mut m = preset("trum60a").unwrap();
+    m.effects.set(Effect::ThermalDrift, &[-0.002, -0.01, 0.01]);
+    let hs = m.thermal.heat_transfer_coefficient_w_per_m2k * m.thermal.surface_area_m2;
+    let mut bad = Vec::new();
+    for f in [50.0, 150.0, 250.0, 350.0, 450.0, 550.0] {
+        for t in [0.0, 0.4, 0.8] {
+            for elapsed in [60.0, 600.0, 3600.0] {
+                let mut op = OperatingPoint::new(f, t, 250.0, 43_000.0);
+                op.elapsed_s = elapsed;
+                let s = solve(&m, &op);
+                let want = s.temperature_rise_k * (1.0 - (-elapsed * hs / m.thermal.heat_capacity_j_per_k).exp());
+                if !s.status.is_valid() || (s.temperature_rise_at_elapsed_k - want).abs() > 1e-8 * want {
+                    bad.push(format!(
+                        "{op:?}: {} ΔT {} K, from its losses {want} K",
+                        s.status, s.temperature_rise_at_elapsed_k
+                    ));
+                }
+            }
+        }
+    }
+    assert!(bad.is_empty(), "{} points:\n{}", bad.len(), bad.join("\n"));
+}

@@ -549,7 +549,8 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
     let mut rise = 0.0;
     let mut s = solve_drive(p, &d, op, guess);
     let mut settled = false;
-    let mut last_pass: Option<(f64, f64)> = None; // (V, G(V)) of the previous pass
+    // (x, G(x)) of the previous pass, for the temperature rise and the electrode voltage
+    let mut last_pass: Option<((f64, f64), (f64, f64))> = None;
     for _ in 0..100 {
         let (mut new_rise, mut new_v) = (rise, d.v);
         if thermal {
@@ -563,27 +564,12 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
             new_v = op.voltage_v / re.hypot(im);
         }
         let done = (new_rise - rise).abs() <= 1e-10 * (1.0 + rise.abs()) && (new_v - d.v).abs() <= 1e-12 * op.voltage_v;
-        rise = new_rise;
-        let next_v = match last_pass {
-            // The electrode voltage alternates about its fixed point: the sag map V ↦ G(V)
-            // falls with V there (G' ≈ −0.85 near clamping, 100 plain passes reached only
-            // 1e-7), so the fixed point lies between V and G(V) and is unique nearby. Take
-            // the secant root of V − G(V) inside that interval. Where G rises with V plain
-            // passes are kept: there the map can have two fixed points and the one reached
-            // from the set voltage is the answer (an unbounded secant jumped between them).
-            Some((v0, g0)) if (new_v - d.v) * (g0 - v0) < 0.0 && d.v != v0 => {
-                let slope = (new_v - g0) / (d.v - v0);
-                let x = d.v + (new_v - d.v) / (1.0 - slope);
-                if slope < 0.0 && x.is_finite() {
-                    x.clamp(d.v.min(new_v), d.v.max(new_v))
-                } else {
-                    new_v
-                }
-            }
-            _ => new_v,
-        };
-        last_pass = Some((d.v, new_v));
-        d.v = next_v;
+        let next = (
+            bracketed_secant(rise, new_rise, last_pass.map(|l| l.0)),
+            bracketed_secant(d.v, new_v, last_pass.map(|l| l.1)),
+        );
+        last_pass = Some(((rise, new_rise), (d.v, new_v)));
+        (rise, d.v) = next;
         if thermal {
             // each relative coefficient scales its nominal value: exponential laws in the
             // truth form, linear ones (floored at 5 % of nominal so a large drift cannot make
@@ -609,6 +595,29 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
     }
     s.temperature_rise_at_elapsed_k = if thermal { rise } else { s.temperature_rise_at_elapsed_k };
     s
+}
+
+/// The next iterate of a scalar fixed-point pass x ↦ G(x) given the previous pass
+/// (x₀, G(x₀)). When the passes alternate about the fixed point, G falls with x there, so
+/// the fixed point lies between x and G(x) and is unique nearby: take the secant root of
+/// x − G(x), kept inside that interval. Found near clamping, where plain passes crawled at
+/// a ratio of ≈ −0.85 (electrode voltage under `voltage_sag`; the temperature rise under a
+/// strong `thermal_drift`: hotter → softer, detuned → fewer losses → cooler) or cycled
+/// between a clamped and a moving stator. Where G rises with x the plain pass is kept: the
+/// approach from the switch-on state is then monotone.
+fn bracketed_secant(x: f64, gx: f64, last: Option<(f64, f64)>) -> f64 {
+    match last {
+        Some((x0, g0)) if (gx - x) * (g0 - x0) < 0.0 && x != x0 => {
+            let slope = (gx - g0) / (x - x0);
+            let next = x + (gx - x) / (1.0 - slope);
+            if slope < 0.0 && next.is_finite() {
+                next.clamp(x.min(gx), x.max(gx))
+            } else {
+                gx
+            }
+        }
+        _ => gx,
+    }
 }
 
 /// Temperature rise driving `thermal_drift`: seed 000 eq. 11 (one lumped capacity) for
