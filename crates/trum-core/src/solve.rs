@@ -551,7 +551,12 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
     let mut settled = false;
     // (x, G(x)) of the previous pass, for the temperature rise and the electrode voltage
     let mut last_pass: Option<((f64, f64), (f64, f64))> = None;
-    for _ in 0..100 {
+    // With one of the two effects on, the residual x − G(x) of its scalar is watched for a
+    // sign change; passes that have not settled after BRACKET_AFTER switch to regula falsi
+    // inside the latest sign change.
+    let mut bracket = SignBracket::default();
+    let scale = if thermal { 1.0 } else { op.voltage_v };
+    for pass in 0..100 {
         let (mut new_rise, mut new_v) = (rise, d.v);
         if thermal {
             new_rise = temperature_rise_for_drift(p, s.total_loss_w(), op.elapsed_s);
@@ -564,11 +569,30 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
             new_v = op.voltage_v / re.hypot(im);
         }
         let done = (new_rise - rise).abs() <= 1e-10 * (1.0 + rise.abs()) && (new_v - d.v).abs() <= 1e-12 * op.voltage_v;
-        let next = (
+        let mut next = (
             bracketed_secant(rise, new_rise, last_pass.map(|l| l.0)),
             bracketed_secant(d.v, new_v, last_pass.map(|l| l.1)),
         );
         last_pass = Some(((rise, new_rise), (d.v, new_v)));
+        if thermal != sag && !done {
+            let (x, gx) = if thermal { (rise, new_rise) } else { (d.v, new_v) };
+            bracket.record(x, x - gx, pass >= BRACKET_AFTER);
+            if pass >= BRACKET_AFTER {
+                if bracket.width().is_some_and(|w| w <= 1e-12 * scale.max(x.abs())) {
+                    // The sign change has shrunk to a point without the residual vanishing:
+                    // G jumps there (the stator clamps on one side and moves on the other),
+                    // so there is no steady state, only an oscillation between the two.
+                    break;
+                }
+                if let Some(x) = bracket.regula_falsi() {
+                    if thermal {
+                        next.0 = x;
+                    } else {
+                        next.1 = x;
+                    }
+                }
+            }
+        }
         (rise, d.v) = next;
         if thermal {
             // each relative coefficient scales its nominal value: exponential laws in the
@@ -595,6 +619,50 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
     }
     s.temperature_rise_at_elapsed_k = if thermal { rise } else { s.temperature_rise_at_elapsed_k };
     s
+}
+
+/// Passes of the effects' fixed point before it falls back to regula falsi inside a sign
+/// change of x − G(x). Normal points settle within ~15 passes and never reach it.
+const BRACKET_AFTER: usize = 30;
+
+/// The latest points on either side of a sign change of a scalar residual h(x) = x − G(x),
+/// with Illinois halving of a kept end once the bracket is being used.
+#[derive(Default)]
+struct SignBracket {
+    neg: Option<(f64, f64)>,
+    pos: Option<(f64, f64)>,
+    last_side: i8,
+}
+
+impl SignBracket {
+    fn record(&mut self, x: f64, h: f64, illinois: bool) {
+        if !(x.is_finite() && h.is_finite()) || h == 0.0 {
+            return;
+        }
+        let side = if h < 0.0 { -1 } else { 1 };
+        if illinois && side == self.last_side {
+            let other = if side < 0 { &mut self.pos } else { &mut self.neg };
+            if let Some(o) = other.as_mut() {
+                o.1 *= 0.5;
+            }
+        }
+        if side < 0 {
+            self.neg = Some((x, h));
+        } else {
+            self.pos = Some((x, h));
+        }
+        self.last_side = side;
+    }
+
+    fn width(&self) -> Option<f64> {
+        Some((self.pos?.0 - self.neg?.0).abs())
+    }
+
+    fn regula_falsi(&self) -> Option<f64> {
+        let ((a, ha), (b, hb)) = (self.neg?, self.pos?);
+        let x = a - ha * (b - a) / (hb - ha);
+        Some(if x.is_finite() && (x - a) * (x - b) < 0.0 { x } else { 0.5 * (a + b) })
+    }
 }
 
 /// The next iterate of a scalar fixed-point pass x ↦ G(x) given the previous pass
