@@ -626,7 +626,8 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
 const BRACKET_AFTER: usize = 30;
 
 /// The latest points on either side of a sign change of a scalar residual h(x) = x − G(x),
-/// with Illinois halving of a kept end once the bracket is being used.
+/// with Illinois halving of a kept end once the bracket is being used (the amplitude solve
+/// from its first step, the effects' fixed point after [`BRACKET_AFTER`] passes).
 #[derive(Default)]
 struct SignBracket {
     neg: Option<(f64, f64)>,
@@ -838,12 +839,11 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
     let mut cur = eval(start, &mut ts_guess);
     let mut prev: Option<Trial> = None;
     let mut converged = false;
-    // Illinois bookkeeping: the residuals used for regula falsi at the bracket's ends.
-    // When one end is kept twice in a row its stored residual is halved again each time
-    // (cumulatively: halving only once stalled into linear convergence at ratio ~0.7, 82
-    // evaluations without reaching the tolerance, found by tests/invariants.rs).
-    let (mut rl_s, mut rh_s) = (0.0, hi.w - hi.w_next);
-    let mut last_side = 0i8; // +1: the last iterate replaced hi, −1: lo
+    // Illinois bookkeeping of the bracket's residuals. When one end is kept twice in a row
+    // its stored residual is halved again each time (cumulatively: halving only once
+    // stalled into linear convergence at ratio ~0.7, 82 evaluations without reaching the
+    // tolerance, found by tests/invariants.rs).
+    let mut bracket = SignBracket { neg: None, pos: Some((hi.w, hi.w - hi.w_next)), last_side: 0 };
     let mut stretch = 1.0; // fixed-point step multiplier, doubled per rejected secant
     for _ in 0..80 {
         let r = cur.w - cur.w_next;
@@ -851,35 +851,19 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
             converged = true;
             break;
         }
+        bracket.record(cur.w, r, true);
         if r > 0.0 {
             hi = cur;
-            rh_s = r;
-            if last_side == 1 {
-                rl_s *= 0.5;
-            }
-            last_side = 1;
         } else {
             lo = Some(cur);
-            rl_s = r;
-            if last_side == -1 {
-                rh_s *= 0.5;
-            }
-            last_side = -1;
         }
         if cur.w < 1e-9 * w_hi0 && r > 0.0 && lo.is_none() {
             // Descending towards zero with W' < W: the only fixed point is W = 0 (clamped).
             break;
         }
         let next = match lo {
-            Some(l) => {
-                // Regula falsi (Illinois) inside [lo, hi].
-                let x = l.w - rl_s * (hi.w - l.w) / (rh_s - rl_s);
-                if x > l.w && x < hi.w {
-                    x
-                } else {
-                    0.5 * (l.w + hi.w)
-                }
-            }
+            // Regula falsi (Illinois) inside [lo, hi].
+            Some(l) => bracket.regula_falsi().unwrap_or(0.5 * (l.w + hi.w)),
             None => {
                 // Secant from the previous iterate if it moves down; else a fixed-point step,
                 // lengthened while the secant keeps pointing up: there the residual grows as
