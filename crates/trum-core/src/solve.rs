@@ -868,9 +868,9 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
                 // Secant from the previous iterate if it moves down; else a fixed-point step,
                 // lengthened while the secant keeps pointing up: there the residual grows as
                 // W falls and plain steps of r ≈ 10⁻³·W took the whole budget (points near
-                // stall and clamping; found by tests/invariants.rs). The step is at most a
-                // tenth of W so that a root is not stepped over lightly; a step into r < 0
-                // brackets one.
+                // stall and clamping of the dense preset maps, tests/solver_convergence.rs).
+                // The step is at most a tenth of W so that a root is not stepped over
+                // lightly; a step into r < 0 brackets one.
                 let secant = prev.map(|pv| {
                     let rp = pv.w - pv.w_next;
                     cur.w - r * (cur.w - pv.w) / (r - rp)
