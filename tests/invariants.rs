@@ -3,34 +3,15 @@
 //! consistency.
 
 use proptest::prelude::*;
-use trum_core::presets::preset;
 use trum_core::{solve, Motor, OperatingPoint, Status};
+
+#[path = "support/scaled.rs"]
+mod scaled;
 
 /// A preset with every continuous parameter scaled by a factor in [0.7, 1.4].
 fn motor_strategy() -> impl Strategy<Value = Motor> {
-    (0usize..3, proptest::collection::vec(0.7f64..1.4, 12)).prop_map(|(i, f)| {
-        let mut m = preset(["trum60a", "trum60-qut", "generic60"][i]).unwrap();
-        let keys = [
-            "geometry.neutral_plane_distance_m",
-            "geometry.contact_width_m",
-            "friction_layer.youngs_modulus_pa",
-            "friction_layer.thickness_m",
-            "friction_layer.friction_coefficient",
-            "stator.modal_mass_kg",
-            "stator.modal_damping_ns_per_m",
-            "stator.force_factor_n_per_v",
-            "electrical.clamped_capacitance_f",
-            "electrical.dielectric_loss_tangent",
-            "rotor.viscous_damping_nms",
-            "stator.resonance_frequency_hz",
-        ];
-        for (k, s) in keys.iter().zip(f) {
-            // keep resonance within a few kHz of nominal
-            let s = if k.ends_with("resonance_frequency_hz") { 0.97 + (s - 0.7) * 0.06 / 0.7 } else { s };
-            *m.param_mut(k).unwrap() *= s;
-        }
-        m
-    })
+    (0usize..3, proptest::collection::vec(0.7f64..1.4, scaled::SCALED_KEYS.len()))
+        .prop_map(|(i, f)| scaled::scaled_preset(i, &f))
 }
 
 fn op_strategy() -> impl Strategy<Value = OperatingPoint> {

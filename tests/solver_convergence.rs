@@ -7,6 +7,9 @@
 //! root at all means the stator is clamped.
 
 use trum_core::presets::preset;
+
+#[path = "support/scaled.rs"]
+mod scaled;
 use trum_core::solve::amplitude_branches;
 use trum_core::sweep::{Axis, Grid};
 use trum_core::{solve, Motor, OperatingPoint, Status};
@@ -212,29 +215,12 @@ fn stress(n: usize, seed: u64, sag: bool, thermal: bool) -> std::collections::BT
         x ^= x << 17;
         (x >> 11) as f64 / (1u64 << 53) as f64
     };
-    let keys = [
-        "geometry.neutral_plane_distance_m",
-        "geometry.contact_width_m",
-        "friction_layer.youngs_modulus_pa",
-        "friction_layer.thickness_m",
-        "friction_layer.friction_coefficient",
-        "stator.modal_mass_kg",
-        "stator.modal_damping_ns_per_m",
-        "stator.force_factor_n_per_v",
-        "electrical.clamped_capacitance_f",
-        "electrical.dielectric_loss_tangent",
-        "rotor.viscous_damping_nms",
-        "stator.resonance_frequency_hz",
-    ];
     let mut counts = std::collections::BTreeMap::new();
     for _ in 0..n {
-        let name = ["trum60a", "trum60-qut", "generic60"][((rnd() * 3.0) as usize).min(2)];
-        let mut m = preset(name).unwrap();
-        for k in keys {
-            let s = 0.7 + 0.7 * rnd();
-            let s = if k.ends_with("resonance_frequency_hz") { 0.97 + (s - 0.7) * 0.06 / 0.7 } else { s };
-            *m.param_mut(k).unwrap() *= s;
-        }
+        let i = (rnd() * 3.0) as usize;
+        let f: Vec<f64> = scaled::SCALED_KEYS.iter().map(|_| 0.7 + 0.7 * rnd()).collect();
+        let mut m = scaled::scaled_preset(i, &f);
+        let name = scaled::PRESET_NAMES[i.min(2)];
         let mut op = OperatingPoint::new(5.0 + 595.0 * rnd(), 2.0 * rnd(), 30.0 + 270.0 * rnd(), 39e3 + 7e3 * rnd());
         let (z, k) = (10f64.powf(1.0 + 2.0 * rnd()), 5.0 * rnd());
         if sag {
