@@ -333,6 +333,11 @@ struct Problem<'a> {
     u: DVector<f64>,
     weights: Vec<f64>,
     evals: std::cell::Cell<usize>,
+    /// The last weighted residuals and where they were taken: the LM crate asks for the
+    /// residuals at a point and then for the Jacobian there, whose forward differences
+    /// start from the same residuals (one model pass saved per iteration). Cleared when
+    /// the weights change.
+    last: std::cell::RefCell<Option<(DVector<f64>, DVector<f64>)>>,
 }
 
 impl Problem<'_> {
@@ -343,6 +348,17 @@ impl Problem<'_> {
         self.evals.set(self.evals.get() + 1);
         let r = residuals(&self.motor_at(u), self.rows);
         DVector::from_iterator(r.len(), r.iter().zip(&self.weights).map(|(x, w)| x * w))
+    }
+    /// `weighted(u)`, remembered as the latest point.
+    fn weighted_at(&self, u: &DVector<f64>) -> DVector<f64> {
+        if let Some((lu, lr)) = self.last.borrow().as_ref() {
+            if lu == u {
+                return lr.clone();
+            }
+        }
+        let r = self.weighted(u);
+        *self.last.borrow_mut() = Some((u.clone(), r.clone()));
+        r
     }
 }
 
@@ -358,7 +374,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
         self.u.clone()
     }
     fn residuals(&self) -> Option<DVector<f64>> {
-        Some(self.weighted(&self.u))
+        Some(self.weighted_at(&self.u))
     }
     fn jacobian(&self) -> Option<DMatrix<f64>> {
         // Forward differences in the transformed coordinates (step 1e-6 in u, about 2.5e-7 of
@@ -367,7 +383,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
         let n = self.u.len();
         let m = self.rows.iter().map(|r| r.readings.len()).sum();
         let mut j = DMatrix::zeros(m, n);
-        let r0 = self.weighted(&self.u);
+        let r0 = self.weighted_at(&self.u);
         for k in 0..n {
             let h = 1e-6 * (1.0 + self.u[k].abs());
             let mut up = self.u.clone();
@@ -409,6 +425,7 @@ pub fn calibrate(
         u: u0,
         weights: vec![1.0; n_read],
         evals: std::cell::Cell::new(0),
+        last: std::cell::RefCell::new(None),
     };
     // The crate's patience bounds its own residual evaluations at patience·(n + 1), and each
     // accepted step costs a Jacobian of n + 1 more; so patience = budget/(n + 1)² keeps the
@@ -437,6 +454,7 @@ pub fn calibrate(
                 break;
             }
             problem.weights = w;
+            *problem.last.borrow_mut() = None;
         }
     }
     if let Some(t) = last.filter(|t| !t.was_successful()) {
