@@ -210,22 +210,29 @@ pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
             accumulate(&mut f, nodes.sin[k], nodes.cos[k], weight * nodes.weight[k], c, u, rho, law);
         }
     };
-    if law.truth && law.radial_ratio > 0.0 {
-        // Radius-resolved: the radial slope ∂R/∂r of the mode shape, hence ρ, varies
-        // linearly across the contact width (±40 % between inner and outer edge).
-        for &(y, w) in &[
-            (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
-            (-0.538_469_310_105_683, 0.478_628_670_499_366_5),
-            (0.0, 0.568_888_888_888_888_9),
-            (0.538_469_310_105_683, 0.478_628_670_499_366_5),
-            (0.906_179_845_938_664, 0.236_926_885_056_189_1),
-        ] {
-            run(law.radial_ratio * (1.0 + 0.4 * y), 0.5 * w);
-        }
-    } else {
-        run(law.radial_ratio, 1.0);
+    for (rho, weight) in radii(law) {
+        run(rho, weight);
     }
     f
+}
+
+/// Five-point Gauss–Legendre nodes and weights on [−1, 1], across the contact width.
+const WIDTH_NODES: [(f64, f64); 5] = [
+    (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
+    (-0.538_469_310_105_683, 0.478_628_670_499_366_5),
+    (0.0, 0.568_888_888_888_888_9),
+    (0.538_469_310_105_683, 0.478_628_670_499_366_5),
+    (0.906_179_845_938_664, 0.236_926_885_056_189_1),
+];
+
+/// The radial-speed ratios ρ the integral is taken at, with their weights. Truth form:
+/// the radial slope ∂R/∂r of the mode shape, hence ρ, varies linearly across the contact
+/// width (±40 % between inner and outer edge); otherwise one ρ.
+fn radii(law: &Law) -> impl Iterator<Item = (f64, f64)> + '_ {
+    let resolved = law.truth && law.radial_ratio > 0.0;
+    let width =
+        WIDTH_NODES.iter().filter(move |_| resolved).map(|&(y, w)| (law.radial_ratio * (1.0 + 0.4 * y), 0.5 * w));
+    width.chain(std::iter::once((law.radial_ratio, 1.0)).filter(move |_| !resolved))
 }
 
 #[cfg(test)]
@@ -262,17 +269,7 @@ mod tests {
         } else {
             vec![(0.0, ct.half_angle_rad)]
         };
-        let radii: Vec<(f64, f64)> = if law.truth && law.radial_ratio > 0.0 {
-            [(-0.906_179_845_938_664, 0.236_926_885_056_189_1), (0.0, 0.568_888_888_888_888_9)]
-                .iter()
-                .chain(&[(-0.538_469_310_105_683, 0.478_628_670_499_366_5)])
-                .flat_map(|&(y, w)| if y == 0.0 { vec![(y, w)] } else { vec![(y, w), (-y, w)] })
-                .map(|(y, w)| (law.radial_ratio * (1.0 + 0.4 * y), 0.5 * w))
-                .collect()
-        } else {
-            vec![(law.radial_ratio, 1.0)]
-        };
-        for (rho, wr) in radii {
+        for (rho, wr) in radii(law) {
             for &(a, b) in &panels {
                 let h = 0.5 * (b - a);
                 for j in 0..2 {

@@ -424,6 +424,7 @@ fn general_interface(
         *tf0 = fac0.torque;
         (f0, fac0)
     };
+    let stall = |fac0, tf0| (contact::stall_stick_half_angle_rad(ct), 0.0, true, fac0, tf0);
     let (mut u, mut fu, mut fac) = match ts_guess.map(f64::cos).filter(|g| *g > 0.0 && *g < 1.0) {
         Some(g) => {
             let (fg, fac) = f(g);
@@ -432,7 +433,7 @@ fn general_interface(
         None => {
             let (f0, fac0) = at_rest(&mut tf0);
             if f0 < 0.0 {
-                return (contact::stall_stick_half_angle_rad(ct), 0.0, true, fac0, tf0);
+                return stall(fac0, tf0);
             }
             flo = f0;
             let (f1, fac1) = f(1.0);
@@ -455,7 +456,7 @@ fn general_interface(
             // the iterates sank onto u = 0 from above: stall, unless the load is met there
             let (f0, fac0) = at_rest(&mut tf0);
             if f0 < 0.0 {
-                return (contact::stall_stick_half_angle_rad(ct), 0.0, true, fac0, tf0);
+                return stall(fac0, tf0);
             }
             fac = fac0;
             u = 0.0;
@@ -472,7 +473,7 @@ fn general_interface(
             // the step leaves [0, hi]: the rotor at rest decides between stall and a root
             let (f0, fac0) = at_rest(&mut tf0);
             if f0 < 0.0 {
-                return (contact::stall_stick_half_angle_rad(ct), 0.0, true, fac0, tf0);
+                return stall(fac0, tf0);
             }
             flo = f0;
             lo - flo * (hi - lo) / (fhi - flo)
