@@ -102,7 +102,7 @@ fn print_table(
     out: &mut dyn Write,
 ) -> Result<()> {
     writeln!(out, "motor     {}", motor.name)?;
-    writeln!(out, "data      {data} ({} readings, {} residual evaluations)", cal.n_readings, cal.evaluations)?;
+    writeln!(out, "data      {data} ({} readings, {} model passes)", cal.n_readings, cal.evaluations)?;
     writeln!(out, "chi2      {} per reading (1 = fits to within the assumed noise)", fmt_sig(chi2_per, 4))?;
     writeln!(out)?;
     let rows: Vec<Vec<String>> = cal

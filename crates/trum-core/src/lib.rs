@@ -27,6 +27,7 @@ pub mod params;
 pub mod presets;
 pub mod quad;
 pub mod quantities;
+mod sensitivity;
 pub mod solve;
 pub mod stator;
 pub mod sweep;

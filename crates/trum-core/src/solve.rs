@@ -183,7 +183,7 @@ impl Solution {
         self.dielectric_loss_w + self.damping_loss_w + self.friction_loss_w + self.rotor_loss_w
     }
 
-    fn invalid(status: Status) -> Solution {
+    pub(crate) fn invalid(status: Status) -> Solution {
         let n = f64::NAN;
         Solution {
             status,
@@ -225,7 +225,7 @@ impl Solution {
 }
 
 /// Motor constants the solver needs, computed once per motor.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Prepared {
     pub(crate) n: f64,
     pub(crate) r0: f64,
@@ -296,9 +296,28 @@ impl Prepared {
     }
 }
 
+impl Prepared {
+    /// True when a trial amplitude (the contact, interface and amplitude map) comes out the
+    /// same for `self` as for `other` at every state: they differ at most in constants that
+    /// act only on the reported outputs (capacitance, dielectric loss, feedback gain, the
+    /// thermal network) and neither iterates on a solution-dependent input at `op`, through
+    /// which those constants would reach the drive.
+    pub(crate) fn same_trials(&self, other: &Prepared, op: &OperatingPoint) -> bool {
+        let outputs_only = Prepared {
+            c0: other.c0,
+            tan_d: other.tan_d,
+            kfb: other.kfb,
+            alpha_s: other.alpha_s,
+            heat_cap: other.heat_cap,
+            ..self.clone()
+        };
+        outputs_only == *other && iterated(self, op) == (false, false)
+    }
+}
+
 /// Everything that follows from one trial amplitude.
 #[derive(Clone, Copy, Debug)]
-struct Trial {
+pub(crate) struct Trial {
     w: f64,
     contact: Contact,
     ts: f64,
@@ -346,6 +365,26 @@ impl Drive {
             c: p.c,
         }
     }
+
+    /// `thermal_drift`: the stiffness, friction and damping at a temperature rise [K]. Each
+    /// relative coefficient scales its nominal value: exponential laws in the truth form,
+    /// linear ones (floored at 5 % of nominal so a large drift cannot make a stiffness,
+    /// damping or friction coefficient non-physical) in the candidate.
+    fn warm(&mut self, p: &Prepared, rise_k: f64) {
+        let law = |x: f64| if p.truth { (x * rise_k).exp() } else { (1.0 + x * rise_k).max(0.05) };
+        let [a, b, g] = p.thermal;
+        (self.ks, self.mu, self.c) = (p.ks * law(a), p.mu * law(b), p.c * law(g));
+    }
+}
+
+/// `voltage_sag`: the set voltage over |1 + Z_src·Y| with Y = I/V_e the phase admittance
+/// of solution `s` (V_set = V_e·(1 + Z_src·Y)); the truth form's source is partly reactive.
+fn sagged_voltage_v(p: &Prepared, op: &OperatingPoint, s: &Solution) -> f64 {
+    let ve = s.electrode_voltage_v;
+    let (yr, yi) = (s.current_in_phase_a / ve, s.current_quadrature_a / ve);
+    let (zr, zi) = if p.truth { (p.sag_ohm, 0.5 * p.sag_ohm) } else { (p.sag_ohm, 0.0) };
+    let (re, im) = (1.0 + zr * yr - zi * yi, zr * yi + zi * yr);
+    op.voltage_v / re.hypot(im)
 }
 
 /// Baseline 2-D Coulomb interface: closed forms (seed 001 eq. 10-11; crate::contact).
@@ -565,8 +604,13 @@ pub fn solve_prepared(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: O
     if op.invalid_reason().is_some() {
         return Solution::invalid(Status::InvalidInput);
     }
-    let mut s = if p.runout_m > 0.0 { eccentric_average(p, motor, op, guess) } else { solve_effects(p, op, guess) };
-    // Every path (averaged ones too): non-finite numbers never carry a valid status.
+    let s = if p.runout_m > 0.0 { eccentric_average(p, motor, op, guess) } else { solve_effects(p, op, guess) };
+    finite_or_unconverged(s)
+}
+
+/// Every path (averaged and linearised ones too): non-finite numbers never carry a valid
+/// status.
+pub(crate) fn finite_or_unconverged(mut s: Solution) -> Solution {
     if s.status.is_valid() && crate::quantities::QUANTITIES.iter().any(|q| !(q.get)(&s).is_finite()) {
         s.status = Status::NoConvergence;
     }
@@ -583,10 +627,9 @@ pub fn solve_prepared(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: O
 /// state (trum60a-like truth motor, 400 N: 200 V → clamped → 217.9 V → moving → 204.0 V →
 /// clamped …); the one consistent state lies between V and G(V) (210.1 V, moving). An
 /// unbounded secant on every pass (tried: 1.6× faster) left that interval.
-fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
+pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
     let mut d = Drive::at(p, op);
-    let thermal = p.thermal.iter().any(|&x| x != 0.0) && op.elapsed_s > 0.0;
-    let sag = p.sag_ohm > 0.0;
+    let (thermal, sag) = iterated(p, op);
     if !thermal && !sag {
         return solve_drive(p, &d, op, guess);
     }
@@ -606,11 +649,7 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
             new_rise = temperature_rise_for_drift(p, s.total_loss_w(), op.elapsed_s);
         }
         if sag {
-            // V_set = V_e·(1 + Z_src·Y), Y = I/V_e the phase admittance (complex).
-            let (yr, yi) = (s.current_in_phase_a / d.v, s.current_quadrature_a / d.v);
-            let (zr, zi) = if p.truth { (p.sag_ohm, 0.5 * p.sag_ohm) } else { (p.sag_ohm, 0.0) };
-            let (re, im) = (1.0 + zr * yr - zi * yi, zr * yi + zi * yr);
-            new_v = op.voltage_v / re.hypot(im);
+            new_v = sagged_voltage_v(p, op, &s);
         }
         let done = (new_rise - rise).abs() <= 1e-10 * (1.0 + rise.abs()) && (new_v - d.v).abs() <= 1e-12 * op.voltage_v;
         let mut next = (
@@ -639,12 +678,7 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
         }
         (rise, d.v) = next;
         if thermal {
-            // each relative coefficient scales its nominal value: exponential laws in the
-            // truth form, linear ones (floored at 5 % of nominal so a large drift cannot make
-            // a stiffness, damping or friction coefficient non-physical) in the candidate
-            let law = |x: f64| if p.truth { (x * rise).exp() } else { (1.0 + x * rise).max(0.05) };
-            let [a, b, g] = p.thermal;
-            (d.ks, d.mu, d.c) = (p.ks * law(a), p.mu * law(b), p.c * law(g));
+            d.warm(p, rise);
         }
         let prev = s.clone();
         s = solve_drive(p, &d, op, Some(&prev).filter(|g| g.status.is_valid()));
@@ -663,6 +697,54 @@ fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) ->
     }
     s.temperature_rise_at_elapsed_k = if thermal { rise } else { s.temperature_rise_at_elapsed_k };
     s
+}
+
+/// Which solution-dependent inputs [`solve_effects`] iterates on at `op`: (the temperature
+/// rise of `thermal_drift`, the electrode voltage of `voltage_sag`).
+pub(crate) fn iterated(p: &Prepared, op: &OperatingPoint) -> (bool, bool) {
+    (p.thermal.iter().any(|&x| x != 0.0) && op.elapsed_s > 0.0, p.sag_ohm > 0.0)
+}
+
+/// One pass of the steady-state map at the state z = (amplitude W [m], temperature rise
+/// [K], electrode voltage [V]): the trial at W under the drive that z sets, its solution,
+/// and the state it implies (Θ·V/|Z|, the rise from its losses, the sagged voltage); the
+/// components [`iterated`] leaves alone are copied from z. `guess` = (θs, φ0) starts the
+/// inner angle solves, whose roots are unique. A converged [`solve_effects`] is a fixed
+/// point of this map (to its tolerances) and the solution is the one it reported.
+///
+/// `same`: a trial at the same z and operating point of a motor whose trials are this
+/// one's ([`Prepared::same_trials`]), reused instead of computed.
+pub(crate) fn state_map(
+    p: &Prepared,
+    op: &OperatingPoint,
+    z: [f64; 3],
+    guess: (f64, Option<f64>),
+    same: Option<&Trial>,
+) -> ([f64; 3], Solution, Trial) {
+    let (thermal, sag) = iterated(p, op);
+    let mut d = Drive::at(p, op);
+    if thermal {
+        d.warm(p, z[1]);
+    }
+    if sag {
+        d.v = z[2];
+    }
+    let mut t = match same {
+        Some(t) => *t,
+        None => trial(p, &d, z[0], Some(guess.0), guess.1),
+    };
+    // once, so that a reused trial carries it
+    t.tf0 = rest_torque_factor(p, &d, &t);
+    let mut s = finish(p, &d, op, &t, if t.stalled { Status::Stall } else { Status::Ok }, 1);
+    let mut next = [t.w_next, z[1], z[2]];
+    if thermal {
+        s.temperature_rise_at_elapsed_k = z[1];
+        next[1] = temperature_rise_for_drift(p, s.total_loss_w(), op.elapsed_s);
+    }
+    if sag {
+        next[2] = sagged_voltage_v(p, op, &s);
+    }
+    (next, s, t)
 }
 
 /// Passes of the effects' fixed point before it falls back to regula falsi inside a sign
@@ -752,11 +834,24 @@ fn temperature_rise_for_drift(p: &Prepared, loss_w: f64, elapsed_s: f64) -> f64 
 /// speed's time-weighted standard deviation is reported. The truth form adds a
 /// twice-per-revolution component of 30 % (tilted as well as offset rotor).
 fn eccentric_average(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
+    eccentric_average_with(p, motor, op, guess, |o, g| solve_effects(p, o, g))
+}
+
+/// [`eccentric_average`] with `solve_at(op, guess)` in place of the steady-state solve at
+/// each preload (the nominal one first, then the ripple samples in order): crate::sensitivity
+/// passes linearised solves.
+pub(crate) fn eccentric_average_with(
+    p: &Prepared,
+    motor: &Motor,
+    op: &OperatingPoint,
+    guess: Option<&Solution>,
+    mut solve_at: impl FnMut(&OperatingPoint, Option<&Solution>) -> Solution,
+) -> Solution {
     // The trapezoidal rule over a period is exact for trigonometric polynomials below the
     // sample count and the response to a smooth preload ripple is nearly one: 8 samples agree
     // with 16 to 1e-8 of the speed at the typical runout, 1e-6 at four times it.
     const SAMPLES: usize = 8;
-    let nominal = solve_effects(p, op, guess);
+    let nominal = solve_at(op, guess);
     if nominal.status != Status::Ok {
         return nominal;
     }
@@ -775,7 +870,7 @@ fn eccentric_average(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: Op
         let count = if j == 0 || j == SAMPLES / 2 { 1.0 } else { 2.0 };
         let mut o = *op;
         o.preload_n = op.preload_n + ripple * shape;
-        let s = solve_effects(p, &o, Some(&prev));
+        let s = solve_at(&o, Some(&prev));
         if s.status != Status::Ok || s.speed_rad_s <= 0.0 {
             // the rotor sticks in this sector: it stops there
             let mut st = s;
@@ -803,7 +898,7 @@ fn eccentric_average(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: Op
     out
 }
 
-fn map_solution(a: &Solution, b: Option<&Solution>, f: impl Fn(f64, f64) -> f64) -> Solution {
+pub(crate) fn map_solution(a: &Solution, b: Option<&Solution>, f: impl Fn(f64, f64) -> f64) -> Solution {
     let mut o = a.clone();
     let bb = b.unwrap_or(a);
     macro_rules! each {
@@ -987,6 +1082,16 @@ fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {
     }
 }
 
+/// The torque factor with the rotor at rest: the generalised interface leaves this
+/// integral to the converged trial (NaN until then).
+fn rest_torque_factor(p: &Prepared, d: &Drive, t: &Trial) -> f64 {
+    if t.tf0.is_nan() {
+        crate::interface::factors(&t.contact, 0.0, &interface_law(p, d, &t.contact)).torque
+    } else {
+        t.tf0
+    }
+}
+
 fn finish(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, status: Status, evals: u32) -> Solution {
     let mut s = finish_unchecked(p, d, op, t, status, evals);
     // Extreme but valid inputs (1e-300 V, 1e200 Hz resonance, ...) can overflow; such a
@@ -1003,12 +1108,7 @@ fn finish_unchecked(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, sta
     let clamped = status == Status::Clamped;
     let speed = if t.stalled { 0.0 } else { t.vr / p.r0 };
     let vr = speed * p.r0;
-    // the generalised interface leaves the rotor-at-rest integral to the converged trial
-    let tf0 = if t.tf0.is_nan() && !clamped {
-        crate::interface::factors(ct, 0.0, &interface_law(p, d, ct)).torque
-    } else {
-        t.tf0
-    };
+    let tf0 = if clamped { t.tf0 } else { rest_torque_factor(p, d, t) };
     let stall_torque = if clamped { 0.0 } else { p.r0 * d.mu * t.a * tf0 };
     // Friction loss = ∫ μ p |slip| dx = power taken from the wave − power given to the rotor
     // (for the baseline this is crate::losses::friction_loss_coulomb_w, tested against quadrature).
