@@ -298,6 +298,10 @@ def main():
         return min(ts), r
 
     t_trum, res = best_of(5, lambda: motor.solve(preload_n=F, torque_nm=T, voltage_v=V, frequency_hz=f, parallel=False))
+    # The same points as a grid (what a user making a map calls): rows along the torque
+    # axis are warm-started sweeps; the grid's order is the meshgrid's above.
+    t_map, res_map = best_of(5, lambda: trum.map(motor, preload_n=(100.0, 500.0, nf), torque_nm=(0.0, 1.2, nt),
+                                                 voltage_v=V, frequency_hz=f, parallel=False))
     t_np, (st_np, out_np) = best_of(3, lambda: numpy_points(P, F, T, V, f))
     # SciPy: an evenly spread subset of the same points (the whole grid would take minutes).
     idx = np.linspace(0, n - 1, min(a.scipy_points, n)).round().astype(int)
@@ -308,6 +312,10 @@ def main():
     st_trum = np.asarray(res.status)
     worst = {}
     ok = True
+    if not (np.asarray(res_map["status"]) == st_trum).all() or not np.allclose(res_map["preload_n"], F, rtol=1e-15) \
+            or not np.allclose(res_map["torque_nm"], T, rtol=1e-15, atol=1e-15):
+        ok = False
+        print("trum.map differs from motor.solve in its points or statuses")
     if not (st_np == st_trum).all():
         ok = False
         print(f"numpy status differs at {(st_np != st_trum).sum()} points")
@@ -328,21 +336,24 @@ def main():
                 print(f"scipy status {s} != trum {st_trum[i]} at F={F[i]} T={T[i]}")
             elif o is not None:
                 e_sp = max(e_sp, rel_err(o[q], tv[i], floor))
-        worst[q] = (e_np, e_sp)
-        if max(e_np, e_sp) > 1e-9:
+        e_map = rel_err(np.asarray(res_map[q], float)[valid], tv[valid], floor).max()
+        worst[q] = (e_np, e_sp, e_map)
+        if max(e_np, e_sp, e_map) > 1e-9:
             ok = False
 
     per = lambda t, k: t / k * 1e6
     print(f"{a.preset}, {V:g} V, {f:g} Hz, preload 100-500 N x torque 0-1.2 N m; statuses: "
           + ", ".join(f"{s} {int((st_trum == s).sum())}" for s in (OK, STALL, CLAMPED)))
-    print(f"{'implementation':34} {'points':>8} {'us/point':>10} {'trum is x faster':>17}")
     tp = per(t_trum, n)
-    print(f"{'trum (Rust, motor.solve, 1 thread)':34} {n:8d} {tp:10.3f} {1.0:17.1f}")
-    print(f"{'NumPy, vectorised':34} {n:8d} {per(t_np, n):10.3f} {per(t_np, n) / tp:17.1f}")
-    print(f"{'SciPy brentq, per point':34} {len(idx):8d} {per(t_sp, len(idx)):10.3f} {per(t_sp, len(idx)) / tp:17.1f}")
-    print("largest relative difference to trum (numpy, scipy):")
-    for q, (e1, e2) in worst.items():
-        print(f"  {q:24} {e1:9.2e} {e2:9.2e}")
+    tm = per(t_map, n)
+    print(f"{'implementation':34} {'points':>8} {'us/point':>10} {'trum is x faster':>17} {'trum.map is x faster':>21}")
+    print(f"{'trum (Rust, motor.solve, 1 thread)':34} {n:8d} {tp:10.3f} {1.0:17.1f} {tp / tm:21.1f}")
+    print(f"{'trum.map (grid sweep, 1 thread)':34} {n:8d} {tm:10.3f} {tm / tp:17.1f} {1.0:21.1f}")
+    for name, k, t in (("NumPy, vectorised", n, t_np), ("SciPy brentq, per point", len(idx), t_sp)):
+        print(f"{name:34} {k:8d} {per(t, k):10.3f} {per(t, k) / tp:17.1f} {per(t, k) / tm:21.1f}")
+    print("largest relative difference to trum motor.solve (numpy, scipy, trum.map):")
+    for q, (e1, e2, e3) in worst.items():
+        print(f"  {q:24} {e1:9.2e} {e2:9.2e} {e3:9.2e}")
     print("agreement to 1e-9 relative, identical statuses:", "yes" if ok else "NO")
     return 0 if ok else 1
 

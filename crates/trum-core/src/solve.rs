@@ -617,6 +617,45 @@ pub(crate) fn finite_or_unconverged(mut s: Solution) -> Solution {
     s
 }
 
+/// The next point of a sweep after `prev` (same motor): [`solve_prepared`] warm-started
+/// from it, with the amplitude descending from `prev`'s when that is a proven upper bound
+/// of this point's largest fixed point. That holds for the Coulomb interface when only the
+/// load torque has risen: at fixed W the load moves only the stick angle θs ≤ π/2, up,
+/// and with it the friction power factor 2E(θs) − E(φ0) (dE/dθ = cos θ·(cos θ − c) ≥ 0
+/// there), so the friction damping grows, |Z| grows and the map G(W) = Θ·V/|Z| does not
+/// rise; G(W) < W above the old largest fixed point then stays true. Effects that iterate
+/// on the solution (thermal state, voltage sag) or average over a revolution
+/// (eccentricity), and the generalised interface, take the usual descent from the bound.
+///
+/// `prev` = (its point, its solution, the slope of its amplitude residual at the root);
+/// returns this point's solution and slope (None where the descent did not run).
+pub(crate) fn solve_in_sweep(
+    p: &Prepared,
+    motor: &Motor,
+    op: &OperatingPoint,
+    prev: Option<(&OperatingPoint, &Solution, Option<f64>)>,
+) -> (Solution, Option<f64>) {
+    let guess = prev.map(|x| x.1).filter(|g| g.status.is_valid());
+    let top = prev.filter(|(o, g, _)| {
+        matches!(g.status, Status::Ok | Status::Stall)
+            && g.amplitude_m > 0.0
+            && OperatingPoint { torque_nm: op.torque_nm, ..**o } == *op
+            && o.torque_nm <= op.torque_nm
+            && p.law.radial_ratio == 0.0
+            && p.compliance == 0.0
+            && p.runout_m == 0.0
+            && iterated(p, op) == (false, false)
+            && op.invalid_reason().is_none()
+    });
+    match top {
+        Some((_, g, slope)) => {
+            let (s, slope) = solve_drive_below(p, &Drive::at(p, op), op, guess, Some((g.amplitude_m, slope)));
+            (finite_or_unconverged(s), slope)
+        }
+        None => (solve_prepared(p, motor, op, guess), None),
+    }
+}
+
 /// Effects that depend on the solution itself (temperature from the losses, electrode
 /// voltage from the current) are solved by fixed-point iteration around the amplitude
 /// solve, starting from the set voltage and the cold motor as the bench does. Near
@@ -946,6 +985,22 @@ fn add_solution(a: &Solution, b: &Solution) -> Solution {
 }
 
 fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
+    solve_drive_below(p, d, op, guess, None).0
+}
+
+/// [`solve_drive`], the amplitude descending from `top` = (W, slope) instead of the bound
+/// Θ·V/(ω·c) when W is a proven upper bound of the largest fixed point and r(W) ≥ 0 holds
+/// numerically (else from the bound as usual); see [`solve_in_sweep`]. The slope of
+/// r(W) = W − G(W) near W (from the previous point), when positive, makes the first step a
+/// Newton step instead of a fixed-point one. Returns the slope of r at the root (from the
+/// last secant) with the solution.
+fn solve_drive_below(
+    p: &Prepared,
+    d: &Drive,
+    op: &OperatingPoint,
+    guess: Option<&Solution>,
+    top: Option<(f64, Option<f64>)>,
+) -> (Solution, Option<f64>) {
     // The generalised interface integrates numerically (and solves its stick point to
     // 1e-13), so its amplitude map carries ~1e-12 of noise: converge to 1e-10 there.
     let rtol = if p.law.radial_ratio == 0.0 && p.compliance == 0.0 { 1e-12 } else { 1e-10 };
@@ -981,21 +1036,38 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
         t
     };
     // Upper bracket: r(W) = W − W' ≥ 0.
-    let mut hi = eval(w_hi0, &mut ts_guess);
+    let warm = top.map(|(w, _)| eval(w, &mut ts_guess)).filter(|t| t.w >= t.w_next);
+    let mut hi = match warm {
+        Some(t) => t,
+        None => eval(w_hi0, &mut ts_guess),
+    };
     let mut grow = 0;
     while hi.w < hi.w_next && grow < 60 {
         hi = eval(hi.w_next * 1.5, &mut ts_guess);
         grow += 1;
     }
     let mut lo: Option<Trial> = None;
-    // Start: one fixed-point step from the top. The amplitude always descends from the
-    // bound onto the largest fixed point: a warm amplitude from a neighbouring point can
-    // sit below the middle one of several fixed points and fall onto another branch
-    // (found by tests/reliability_known_bugs.rs). The guess still warm-starts the inner
-    // stick-angle solves.
-    let start = hi.w_next;
+    // Start: one fixed-point step from the top. The amplitude always descends from an
+    // upper bound onto the largest fixed point — the bound Θ·V/(ω·c), or a proven one
+    // (`solve_in_sweep`): a warm amplitude from a neighbouring point can sit below the
+    // middle one of several fixed points and fall onto another branch (found by
+    // tests/reliability_known_bugs.rs). The guess still warm-starts the inner stick-angle
+    // solves.
+    let start = match (warm, top.and_then(|t| t.1)) {
+        (Some(h), Some(k)) if k > 0.0 => {
+            let x = h.w - (h.w - h.w_next) / k;
+            if x > 0.0 && x <= h.w {
+                x
+            } else {
+                h.w_next
+            }
+        }
+        _ => hi.w_next,
+    };
     let mut cur = eval(start, &mut ts_guess);
-    let mut prev: Option<Trial> = None;
+    // From a warm top (within a hair of the root) the first secant already uses it; from
+    // the far bound it would be a poor partner (tried: 21 statuses changed in dense maps).
+    let mut prev: Option<Trial> = warm.map(|_| hi);
     let mut converged = false;
     // Illinois bookkeeping of the bracket's residuals. When one end is kept twice in a row
     // its stored residual is halved again each time (cumulatively: halving only once
@@ -1051,16 +1123,17 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
     }
     if !converged {
         if cur.w < 1e-9 * w_hi0 {
-            return finish(p, d, op, &clamped_trial(p, d), Status::Clamped, evals);
+            return (finish(p, d, op, &clamped_trial(p, d), Status::Clamped, evals), None);
         }
         let mut s = finish(p, d, op, &cur, Status::NoConvergence, evals);
         s.status = Status::NoConvergence;
-        return s;
+        return (s, None);
     }
+    let slope = prev.filter(|pv| pv.w != cur.w).map(|pv| ((cur.w - cur.w_next) - (pv.w - pv.w_next)) / (cur.w - pv.w));
     // Use the trial consistent with the converged amplitude for every output.
     let t = cur;
     let status = if t.stalled { Status::Stall } else { Status::Ok };
-    finish(p, d, op, &t, status, evals)
+    (finish(p, d, op, &t, status, evals), slope)
 }
 
 fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {
