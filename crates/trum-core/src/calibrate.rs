@@ -9,6 +9,7 @@
 use crate::effects::Effect;
 use crate::error::TrumError;
 use crate::params::Motor;
+use crate::sensitivity::{solve_kept, Solved};
 #[cfg(test)]
 use crate::solve::Status;
 use crate::solve::{solve_prepared, OperatingPoint, Prepared, Solution};
@@ -348,32 +349,37 @@ pub(crate) fn residual_jacobian(
     moved: &[Motor],
     steps: &[f64],
     rows: &[ObservedRow],
-    solved: Option<&[Solution]>,
+    solved: Option<&[Solved]>,
 ) -> DMatrix<f64> {
     let n = moved.len();
     let pb = Prepared::new(base);
     let pm: Vec<Prepared> = moved.iter().map(Prepared::new).collect();
-    // (row, its base solution when the caller has it)
-    let one = |&(r, known): &(&ObservedRow, Option<&Solution>)| -> Vec<f64> {
-        let lin = crate::sensitivity::linearise(&pb, base, &r.op, known);
+    // (row, its base solves when the caller has them)
+    let one = |&(r, known): &(&ObservedRow, Option<&Solved>)| -> Vec<f64> {
+        let kept;
+        let known = match known {
+            Some(k) => k,
+            None => {
+                kept = solve_kept(&pb, base, &r.op);
+                &kept
+            }
+        };
+        let lin = crate::sensitivity::linearise(&pb, known);
         let near = |p: &Prepared, m: &Motor| lin.as_ref().and_then(|b| crate::sensitivity::solve_near(b, p, m, &r.op));
         let r_near = near(&pb, base).map(|s| row_residuals(r, &s));
-        let mut r_cold: Option<Vec<f64>> = None;
+        let r_cold = row_residuals(r, &known.solution);
         let mut cols: Vec<Vec<f64>> = Vec::with_capacity(n);
         for k in 0..n {
             let (rk, r0) = match (near(&pm[k], &moved[k]), &r_near) {
                 (Some(s), Some(r0)) => (row_residuals(r, &s), r0),
-                _ => {
-                    let rk = row_residuals(r, &solve_prepared(&pm[k], &moved[k], &r.op, None));
-                    (rk, &*r_cold.get_or_insert_with(|| row_residuals(r, &solve_prepared(&pb, base, &r.op, None))))
-                }
+                _ => (row_residuals(r, &solve_prepared(&pm[k], &moved[k], &r.op, None)), &r_cold),
             };
             cols.push(rk.iter().zip(r0).map(|(a, b)| (a - b) / steps[k]).collect());
         }
         // row-major: reading i, then column k
         (0..r.readings.len()).flat_map(|i| cols.iter().map(move |c| c[i])).collect()
     };
-    let items: Vec<(&ObservedRow, Option<&Solution>)> =
+    let items: Vec<(&ObservedRow, Option<&Solved>)> =
         rows.iter().enumerate().map(|(i, r)| (r, solved.map(|s| &s[i]))).collect();
     let flat = per_item(&items, one);
     DMatrix::from_row_slice(flat.len() / n.max(1), n, &flat)
@@ -397,7 +403,7 @@ struct Pass {
     u: DVector<f64>,
     /// Unweighted normalised residuals, readings in row order.
     raw: Vec<f64>,
-    solutions: Vec<Solution>,
+    solved: Vec<Solved>,
 }
 
 impl Problem<'_> {
@@ -412,9 +418,9 @@ impl Problem<'_> {
             let p = Prepared::new(&m);
             // Cold starts: a warm start from a neighbouring row could settle on another fixed
             // point where the amplitude map has several, and the fit must see one model.
-            let solutions = per_row(self.rows, |r| vec![solve_prepared(&p, &m, &r.op, None)]);
-            let raw = self.rows.iter().zip(&solutions).flat_map(|(r, s)| row_residuals(r, s)).collect();
-            *self.last.borrow_mut() = Some(Pass { u: u.clone(), raw, solutions });
+            let solved = per_row(self.rows, |r| vec![solve_kept(&p, &m, &r.op)]);
+            let raw = self.rows.iter().zip(&solved).flat_map(|(r, s)| row_residuals(r, &s.solution)).collect();
+            *self.last.borrow_mut() = Some(Pass { u: u.clone(), raw, solved });
         }
         std::cell::Ref::map(self.last.borrow(), |p| p.as_ref().expect("set above"))
     }
@@ -454,7 +460,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
             })
             .collect();
         let pass = self.pass_at(&self.u);
-        let mut j = residual_jacobian(&self.motor_at(&self.u), &moved, &steps, self.rows, Some(&pass.solutions));
+        let mut j = residual_jacobian(&self.motor_at(&self.u), &moved, &steps, self.rows, Some(&pass.solved));
         for (mut row, w) in j.row_iter_mut().zip(&self.weights) {
             row *= *w;
         }
@@ -699,8 +705,13 @@ pub(crate) mod tests {
             let base = motor_at(&m, &params, &u);
             // the linearised route, not the from-scratch fallback, is what is compared
             let pb = Prepared::new(&base);
-            let linear =
-                rows.iter().filter(|r| crate::sensitivity::linearise(&pb, &base, &r.op, None).is_some()).count();
+            let mut linear = 0;
+            for r in &rows {
+                let kept = solve_kept(&pb, &base, &r.op);
+                // the kept solve is the residuals' solve, bit for bit
+                assert_eq!(kept.solution, solve_prepared(&pb, &base, &r.op, None));
+                linear += usize::from(crate::sensitivity::linearise(&pb, &kept).is_some());
+            }
             let stalled = rows.iter().filter(|r| crate::solve(&base, &r.op).status == Status::Stall).count();
             // (12 rows; the eccentric motor's stalled row stops in a sector and is solved from
             // scratch)

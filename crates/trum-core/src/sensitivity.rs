@@ -116,37 +116,45 @@ pub(crate) struct Base {
     eccentric: bool,
 }
 
-/// Solves `motor` (prepared as `p`) at `op` and linearises the result; None when there is
-/// nothing smooth to linearise (the caller then solves changed motors from scratch).
-/// `known`: the point's solution from `solve_prepared`, when the caller has it (used unless
-/// the motor is eccentric, whose ripple samples are solved again).
-pub(crate) fn linearise(p: &Prepared, motor: &Motor, op: &OperatingPoint, known: Option<&Solution>) -> Option<Base> {
-    if op.invalid_reason().is_some() {
+/// A point's solution with the steady-state solves behind it: (operating point, solution)
+/// of each in call order — one, or the nominal one and the ripple samples of an eccentric
+/// motor.
+pub(crate) struct Solved {
+    pub(crate) solution: Solution,
+    calls: Vec<(OperatingPoint, Solution)>,
+}
+
+/// `solve_prepared(p, motor, op, None)`, keeping the solves behind it for [`linearise`].
+pub(crate) fn solve_kept(p: &Prepared, motor: &Motor, op: &OperatingPoint) -> Solved {
+    let mut calls = Vec::new();
+    let s = if op.invalid_reason().is_some() {
+        Solution::invalid(Status::InvalidInput)
+    } else {
+        let mut solve_at = |o: &OperatingPoint, g: Option<&Solution>| {
+            let s = solve_effects(p, o, g);
+            calls.push((*o, s.clone()));
+            s
+        };
+        if p.runout_m > 0.0 {
+            eccentric_average_with(p, motor, op, None, solve_at)
+        } else {
+            solve_at(op, None)
+        }
+    };
+    Solved { solution: finite_or_unconverged(s), calls }
+}
+
+/// Linearises a point solved by [`solve_kept`] with the motor prepared as `p`; None when
+/// there is nothing smooth to linearise (the caller then solves changed motors from
+/// scratch): no running or stalled state, or an eccentric revolution that stops in a
+/// sector.
+pub(crate) fn linearise(p: &Prepared, solved: &Solved) -> Option<Base> {
+    let eccentric = p.runout_m > 0.0;
+    let ok = if eccentric { Status::Ok == solved.solution.status } else { solved.solution.status.is_valid() };
+    if !ok || solved.calls.is_empty() {
         return None;
     }
-    let mut parts = Vec::new();
-    let eccentric = p.runout_m > 0.0;
-    if eccentric {
-        let mut ok = true;
-        let s = eccentric_average_with(p, motor, op, None, |o, g| {
-            let s = solve_effects(p, o, g);
-            match Linear::at(p, o, &s) {
-                Some(l) => parts.push(l),
-                None => ok = false,
-            }
-            s
-        });
-        // a revolution that stops in a sector is not smooth in the parameters
-        if !ok || s.status != Status::Ok {
-            return None;
-        }
-    } else {
-        let s = match known {
-            Some(s) => s.clone(),
-            None => solve_effects(p, op, None),
-        };
-        parts.push(Linear::at(p, op, &s)?);
-    }
+    let parts = solved.calls.iter().map(|(o, s)| Linear::at(p, o, s)).collect::<Option<Vec<_>>>()?;
     Some(Base { parts, eccentric })
 }
 
