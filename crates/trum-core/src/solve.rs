@@ -1001,9 +1001,12 @@ fn solve_drive_below(
     guess: Option<&Solution>,
     top: Option<(f64, Option<f64>)>,
 ) -> (Solution, Option<f64>) {
-    // The generalised interface integrates numerically (and solves its stick point to
-    // 1e-13), so its amplitude map carries ~1e-12 of noise: converge to 1e-10 there.
-    let rtol = if p.law.radial_ratio == 0.0 && p.compliance == 0.0 { 1e-12 } else { 1e-10 };
+    // The Coulomb interface's map is smooth to rounding: 1e-13 (1e-12 left 1.7e-9 on the
+    // efficiency just below stall, where the speed is a difference of nearly equal torques,
+    // against the Python reference; 1e-13 costs 0.2 evaluations a point). The generalised
+    // interface integrates numerically (and solves its stick point to 1e-13), so its
+    // amplitude map carries ~1e-12 of noise: converge to 1e-10 there.
+    let rtol = if p.law.radial_ratio == 0.0 && p.compliance == 0.0 { 1e-13 } else { 1e-10 };
     // Upper bound: |Z| ≥ ω·c, so W' ≤ Θ·V/(ω·c). Softening could in principle exceed it;
     // the bracket is then grown below.
     let w_hi0 = p.theta * d.v / (d.omega * d.c);
@@ -1037,9 +1040,18 @@ fn solve_drive_below(
     };
     // Upper bracket: r(W) = W − W' ≥ 0.
     let warm = top.map(|(w, _)| eval(w, &mut ts_guess)).filter(|t| t.w >= t.w_next);
+    // Without preload stiffening or Hertz softening the modal stiffness does not depend on
+    // W, and the friction damping c_t·ω is ≥ 0 (the wave gives power to friction and rotor
+    // at a load torque ≥ 0), so |Z(W)| ≥ |k − mω² + iωc| at every W: a bound that also
+    // counts the detuning, closer to the root off resonance.
+    let w_cold = if p.stiffening == 0.0 && p.beta == 0.0 {
+        p.theta * d.v / (d.ks - p.m * d.omega * d.omega).hypot(d.omega * d.c)
+    } else {
+        w_hi0
+    };
     let mut hi = match warm {
         Some(t) => t,
-        None => eval(w_hi0, &mut ts_guess),
+        None => eval(w_cold, &mut ts_guess),
     };
     let mut grow = 0;
     while hi.w < hi.w_next && grow < 60 {
