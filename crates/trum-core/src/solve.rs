@@ -1355,3 +1355,64 @@ pub fn jump_frequencies_hz(
     let up = if last == steps { fs[steps] } else { edge(fs[last + 1], fs[last]) };
     Some((down, up))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effects::Effect;
+    use rand::{RngExt, SeedableRng};
+
+    /// The certificates behind the start points of the amplitude descent: for the Coulomb
+    /// interface the amplitude map G(W) = Θ·V/|Z(W)| does not rise with the load torque at
+    /// any W (`solve_in_sweep` starts from the previous point's amplitude), and without
+    /// stiffening or softening it stays below Θ·V/|k − mω² + iωc| (the cold start). Random
+    /// amplitudes, preloads, drives and torque pairs through running, stalled and
+    /// narrow-contact states, with preload stiffening and Hertz softening too.
+    #[test]
+    fn amplitude_map_falls_with_the_load_and_stays_below_the_detuned_bound() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(14);
+        let (mut stalled, mut moving) = (0, 0);
+        for name in ["trum60a", "trum60-qut", "generic60"] {
+            for fx in [None, Some(Effect::PreloadStiffening), Some(Effect::HertzSoftening)] {
+                let mut m = crate::presets::preset(name).expect("preset");
+                if let Some(e) = fx {
+                    let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
+                    m.effects.set(e, &typical);
+                }
+                let p = Prepared::new(&m);
+                for _ in 0..1500 {
+                    let mut op = OperatingPoint::new(
+                        rng.random_range(5.0..700.0),
+                        0.0,
+                        rng.random_range(60.0..320.0),
+                        rng.random_range(39e3..45e3),
+                    );
+                    let d = Drive::at(&p, &op);
+                    let w = rng.random_range(0.005..1.0) * p.theta * d.v / (d.omega * d.c);
+                    let (a, b): (f64, f64) = (rng.random_range(0.0..2.5), rng.random_range(0.0..2.5));
+                    let mut at = |t: f64| {
+                        op.torque_nm = t;
+                        trial(&p, &Drive::at(&p, &op), w, None, None)
+                    };
+                    let (lo, hi) = (at(a.min(b)), at(a.max(b)));
+                    assert!(
+                        hi.w_next <= lo.w_next * (1.0 + 1e-13),
+                        "{name} {fx:?} {op:?} W {w}: G rises with the load, {} -> {}",
+                        lo.w_next,
+                        hi.w_next
+                    );
+                    if fx.is_none() {
+                        let bound = p.theta * d.v / (d.ks - p.m * d.omega * d.omega).hypot(d.omega * d.c);
+                        assert!(lo.w_next <= bound * (1.0 + 1e-13), "{name} {op:?} W {w}: above the detuned bound");
+                    }
+                    if hi.stalled {
+                        stalled += 1;
+                    } else {
+                        moving += 1;
+                    }
+                }
+            }
+        }
+        assert!(stalled > 500 && moving > 500, "{stalled} stalled, {moving} moving trials");
+    }
+}
