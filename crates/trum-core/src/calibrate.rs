@@ -478,6 +478,9 @@ pub fn calibrate(
     opts: &FitOptions,
 ) -> Result<Calibration, TrumError> {
     let n_read: usize = rows.iter().map(|r| r.readings.len()).sum();
+    if params.is_empty() {
+        return Err(TrumError::input("no parameters to fit: name at least one"));
+    }
     if n_read <= params.len() {
         return Err(TrumError::input(format!(
             "{n_read} readings cannot determine {} parameters; need more measured points",

@@ -104,6 +104,12 @@ impl Linear {
                 out = map_solution(&out, Some(d), |a, b| a + b * dz[j]);
             }
         }
+        if out.status == Status::Ok && out.speed_rad_s < 0.0 {
+            // The status is the changed motor's at the base state; the correction carried a
+            // point within a step of stall across it (found in review: voltage_sag, μ ×
+            // (1 + 1e-4), Ok at −0.002 rpm where the whole solve stalls). Solve it whole.
+            return None;
+        }
         out.efficiency =
             if out.input_power_w > 0.0 { (out.output_power_w / out.input_power_w).clamp(0.0, 1.0) } else { 0.0 };
         Some(out)

@@ -626,6 +626,11 @@ pub(crate) fn finite_or_unconverged(mut s: Solution) -> Solution {
 /// rise; G(W) < W above the old largest fixed point then stays true. Effects that iterate
 /// on the solution (thermal state, voltage sag) or average over a revolution
 /// (eccentricity), and the generalised interface, take the usual descent from the bound.
+/// So do preload stiffening and Hertz softening: G then need not rise with W, the cold
+/// descent can land on a lower branch (docs/EFFECTS.md), and a sweep carrying the branch
+/// of its chunk's first point would differ from the cold solve by whole branches and make
+/// maps depend on their chunking (found in review: generic60 with a strong softening,
+/// 394 rpm in the sweep, 70 rpm cold). A sweep gives the cold answer.
 ///
 /// `prev` = (its point, its solution, the slope of its amplitude residual at the root);
 /// returns this point's solution and slope (None where the descent did not run).
@@ -643,6 +648,8 @@ pub(crate) fn solve_in_sweep(
             && o.torque_nm <= op.torque_nm
             && p.law.radial_ratio == 0.0
             && p.compliance == 0.0
+            && p.stiffening == 0.0
+            && p.beta == 0.0
             && p.runout_m == 0.0
             && iterated(p, op) == (false, false)
             && op.invalid_reason().is_none()
@@ -1038,8 +1045,15 @@ fn solve_drive_below(
         history = [history[1], Some((w, t.ts))];
         t
     };
-    // Upper bracket: r(W) = W − W' ≥ 0.
-    let warm = top.map(|(w, _)| eval(w, &mut ts_guess)).filter(|t| t.w >= t.w_next);
+    // Upper bracket: r(W) = W − W' ≥ 0. The previous root was converged to rtol only, so
+    // r may come out a rounding below zero there; within rtol it is this point's root too
+    // (where the load does not move G at all, in a stall, always).
+    let warm_trial = top.map(|(w, _)| eval(w, &mut ts_guess));
+    if let Some(t) = warm_trial.filter(|t| (t.w - t.w_next).abs() <= rtol * t.w) {
+        let status = if t.stalled { Status::Stall } else { Status::Ok };
+        return (finish(p, d, op, &t, status, evals), top.and_then(|x| x.1));
+    }
+    let warm = warm_trial.filter(|t| t.w >= t.w_next);
     // Without preload stiffening or Hertz softening the modal stiffness does not depend on
     // W, and the friction damping c_t·ω is ≥ 0 (the wave gives power to friction and rotor
     // at a load torque ≥ 0), so |Z(W)| ≥ |k − mω² + iωc| at every W: a bound that also

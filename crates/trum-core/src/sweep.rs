@@ -147,8 +147,8 @@ mod tests {
         let mut seen = std::collections::HashSet::new();
         // (amplitude evaluations of the sweep and of the cold solves, ok and stall points)
         let (mut warm_evals, mut cold_evals) = (0u64, 0u64);
-        // The presets, and trum60a with a softening stator (several amplitude branches: the
-        // warm start descends from the previous amplitude, which must stay above the largest).
+        // The presets, and trum60a with a softening stator (several amplitude branches; no
+        // warm amplitude there, see solve::solve_in_sweep).
         let motors = ["trum60a", "trum60-qut", "generic60", "trum60a+hertz_softening"].map(|name| {
             let mut m = crate::presets::preset(name.split('+').next().unwrap()).expect("preset");
             if name.ends_with("softening") {
@@ -192,6 +192,43 @@ mod tests {
         // the torque-ordered warm start is taken (solve::solve_in_sweep): fewer amplitude
         // evaluations than cold, not the same answer by never leaving the cold path
         assert!(warm_evals * 10 < cold_evals * 8, "sweep {warm_evals} vs cold {cold_evals} amplitude evaluations");
+    }
+
+    /// Review cases (stop 14) where the cold descent of a softening or stiffening stator
+    /// lands on another branch than the largest: a sweep must still give the cold answer
+    /// (no warm amplitude there), whatever the chunks.
+    #[test]
+    fn sweeps_of_multi_branch_stators_give_the_cold_answer_in_any_chunks() {
+        use crate::effects::Effect;
+        use crate::solve::solve;
+        let cases = [
+            (Effect::HertzSoftening, vec![1.021e18, 0.009052], 264.836, 97.255, 38_339.02, 1.0),
+            (Effect::HertzSoftening, vec![3.5365e17, 0.002983], 480.29, 190.41, 38_483.30, 1.348),
+            (Effect::HertzSoftening, vec![9.963e18, 0.006445], 37.78, 52.77, 38_671.89, 4.08),
+            (Effect::PreloadStiffening, vec![0.504], 389.23, 190.38, 40_880.17, 0.8554),
+        ];
+        for (e, values, f, v, hz, t_max) in cases {
+            let mut m = crate::presets::preset("generic60").expect("preset");
+            m.effects.set(e, &values);
+            let p = Prepared::new(&m);
+            let g = Grid {
+                preload_n: Axis::fixed(f),
+                voltage_v: Axis::fixed(v),
+                frequency_hz: Axis::fixed(hz),
+                torque_nm: Axis::linspace(0.0, t_max, 11),
+            };
+            for split in [0, 5] {
+                let mut got = Vec::new();
+                solve_range(&m, &p, &g, 0..split, |_, op, s| got.push((*op, s.clone())));
+                solve_range(&m, &p, &g, split..11, |_, op, s| got.push((*op, s.clone())));
+                for (op, s) in got {
+                    let c = solve(&m, &op);
+                    assert_eq!(s.status, c.status, "{e:?} {op:?} split {split}");
+                    let (a, b) = (s.amplitude_m, c.amplitude_m);
+                    assert!((a - b).abs() <= 1e-9 * b.abs(), "{e:?} {op:?} split {split}: W {a} vs {b}");
+                }
+            }
+        }
     }
 
     #[test]
