@@ -23,8 +23,8 @@
 
 use crate::params::Motor;
 use crate::solve::{
-    eccentric_average_with, finite_or_unconverged, iterated, map_solution, solve_effects, state_map, OperatingPoint,
-    Prepared, Solution, Status, Trial,
+    eccentric_average_with, finite_or_unconverged, iterated, map_solution, solve_effects, solve_prepared_with,
+    state_map, OperatingPoint, Prepared, Solution, Status, Trial,
 };
 use nalgebra::{Matrix3, Vector3};
 
@@ -133,21 +133,12 @@ pub(crate) struct Solved {
 /// `solve_prepared(p, motor, op, None)`, keeping the solves behind it for [`linearise`].
 pub(crate) fn solve_kept(p: &Prepared, motor: &Motor, op: &OperatingPoint) -> Solved {
     let mut calls = Vec::new();
-    let s = if op.invalid_reason().is_some() {
-        Solution::invalid(Status::InvalidInput)
-    } else {
-        let mut solve_at = |o: &OperatingPoint, g: Option<&Solution>| {
-            let s = solve_effects(p, o, g);
-            calls.push((*o, s.clone()));
-            s
-        };
-        if p.runout_m > 0.0 {
-            eccentric_average_with(p, motor, op, None, solve_at)
-        } else {
-            solve_at(op, None)
-        }
-    };
-    Solved { solution: finite_or_unconverged(s), calls }
+    let solution = solve_prepared_with(p, motor, op, None, |o, g| {
+        let s = solve_effects(p, o, g);
+        calls.push((*o, s.clone()));
+        s
+    });
+    Solved { solution, calls }
 }
 
 /// Linearises a point solved by [`solve_kept`] with the motor prepared as `p`; None when

@@ -601,10 +601,23 @@ pub fn solve(motor: &Motor, op: &OperatingPoint) -> Solution {
 /// Solves one operating point, optionally warm-started from a neighbouring solution
 /// (sweeps use this; the result does not depend on the guess beyond the tolerance).
 pub fn solve_prepared(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
+    solve_prepared_with(p, motor, op, guess, |o, g| solve_effects(p, o, g))
+}
+
+/// [`solve_prepared`] with `solve_at(op, guess)` in place of each steady-state solve it
+/// makes (one, or the nominal one and the ripple samples of an eccentric motor):
+/// crate::sensitivity keeps them.
+pub(crate) fn solve_prepared_with(
+    p: &Prepared,
+    motor: &Motor,
+    op: &OperatingPoint,
+    guess: Option<&Solution>,
+    mut solve_at: impl FnMut(&OperatingPoint, Option<&Solution>) -> Solution,
+) -> Solution {
     if op.invalid_reason().is_some() {
         return Solution::invalid(Status::InvalidInput);
     }
-    let s = if p.runout_m > 0.0 { eccentric_average(p, motor, op, guess) } else { solve_effects(p, op, guess) };
+    let s = if p.runout_m > 0.0 { eccentric_average_with(p, motor, op, guess, solve_at) } else { solve_at(op, guess) };
     finite_or_unconverged(s)
 }
 
@@ -879,13 +892,9 @@ fn temperature_rise_for_drift(p: &Prepared, loss_w: f64, elapsed_s: f64) -> f64 
 /// the time spent at each angle (∝ 1/Ω), so the energy balance still holds, and the
 /// speed's time-weighted standard deviation is reported. The truth form adds a
 /// twice-per-revolution component of 30 % (tilted as well as offset rotor).
-fn eccentric_average(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
-    eccentric_average_with(p, motor, op, guess, |o, g| solve_effects(p, o, g))
-}
-
-/// [`eccentric_average`] with `solve_at(op, guess)` in place of the steady-state solve at
-/// each preload (the nominal one first, then the ripple samples in order): crate::sensitivity
-/// passes linearised solves.
+/// `solve_at(op, guess)` is the steady-state solve at each preload (the nominal one first,
+/// then the ripple samples in order): [`solve_effects`] in [`solve_prepared`];
+/// crate::sensitivity records those solves, or passes linearised ones.
 pub(crate) fn eccentric_average_with(
     p: &Prepared,
     motor: &Motor,
