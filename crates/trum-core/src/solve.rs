@@ -916,7 +916,8 @@ pub(crate) fn eccentric_average_with(
     let mut acc: Option<Solution> = None;
     let mut tsum = 0.0;
     // Both ripple shapes are even in φ, so sample j and SAMPLES − j see the same preload:
-    // solve j = 0 ..= SAMPLES/2 and count the inner ones twice (5 solves instead of 8).
+    // solve j = 0 ..= SAMPLES/2 and count the inner ones twice (5 solves instead of 8, 4 for
+    // the candidate form).
     let mut speeds = [(0.0, 0.0); SAMPLES / 2 + 1];
     let mut prev = nominal.clone();
     for (j, sp) in speeds.iter_mut().enumerate() {
@@ -925,7 +926,8 @@ pub(crate) fn eccentric_average_with(
         let count = if j == 0 || j == SAMPLES / 2 { 1.0 } else { 2.0 };
         let mut o = *op;
         o.preload_n = op.preload_n + ripple * shape;
-        let s = solve_at(&o, Some(&prev));
+        // at a quarter turn the candidate's ripple is zero: the nominal solve is that sample
+        let s = if !p.truth && 4 * j == SAMPLES { nominal.clone() } else { solve_at(&o, Some(&prev)) };
         if s.status != Status::Ok || s.speed_rad_s <= 0.0 {
             // the rotor sticks in this sector: it stops there
             let mut st = s;
