@@ -28,6 +28,8 @@ fn main() {
             "thermal_drift=-4e-4",
             "voltage_sag=150",
             "eccentricity=2e-5",
+            "preload_stiffening=0.05",
+            "hertz_softening=1e18",
         ]
     };
     let rows = if baseline_only { 400 } else { 40 };

@@ -555,6 +555,13 @@ fn interface_law(p: &Prepared, d: &Drive, ct: &Contact) -> crate::interface::Law
     law
 }
 
+/// Seed 003: the softening cubic term by harmonic balance, k − (3/4)·β·W²; this returns
+/// (3/4)·β·(its growth with the preload) [N/m³].
+fn softening_per_w2(p: &Prepared, d: &Drive) -> f64 {
+    let growth = if p.truth { (1.0 + p.beta_gain * d.f_n).powf(1.3) } else { 1.0 + p.beta_gain * d.f_n };
+    0.75 * p.beta * growth
+}
+
 fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>, phi_guess: Option<f64>) -> Trial {
     let a = contact::force_scale_n(p.n, p.kf, w, p.k);
     let (ct, s0, c0) = contact::contact_from_ratio_near(d.f_n / a, phi_guess);
@@ -583,9 +590,7 @@ fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>, phi_guess: Opti
             };
     }
     if p.beta != 0.0 {
-        // seed 003: softening cubic term, harmonic balance ⇒ k − (3/4)·β·W².
-        let growth = if p.truth { (1.0 + p.beta_gain * d.f_n).powf(1.3) } else { 1.0 + p.beta_gain * d.f_n };
-        k_eff -= 0.75 * p.beta * growth * w * w;
+        k_eff -= softening_per_w2(p, d) * w * w;
     }
     let z = (k_eff - p.m * d.omega * d.omega, d.omega * d.c + ct_omega);
     let w_next = p.theta * d.v / (z.0 * z.0 + z.1 * z.1).sqrt();
@@ -639,10 +644,10 @@ pub(crate) fn finite_or_unconverged(mut s: Solution) -> Solution {
 /// rise; G(W) < W above the old largest fixed point then stays true. Effects that iterate
 /// on the solution (thermal state, voltage sag) or average over a revolution
 /// (eccentricity), and the generalised interface, take the usual descent from the bound.
-/// So do preload stiffening and Hertz softening: G then need not rise with W, the cold
-/// descent can land on a lower branch (docs/EFFECTS.md), and a sweep carrying the branch
-/// of its chunk's first point would differ from the cold solve by whole branches and make
-/// maps depend on their chunking (found in review: generic60 with a strong softening,
+/// So do preload stiffening and Hertz softening: G then need not rise with W, the previous
+/// amplitude is no bound of the largest fixed point (the cold descent is capped for them,
+/// docs/EFFECTS.md), and a sweep carrying the branch of its chunk's first point would
+/// differ from the cold solve by whole branches and make maps depend on their chunking (found in review: generic60 with a strong softening,
 /// 394 rpm in the sweep, 70 rpm cold). A sweep gives the cold answer.
 ///
 /// `prev` = (its point, its solution, the slope of its amplitude residual at the root);
@@ -1002,6 +1007,10 @@ fn add_solution(a: &Solution, b: &Solution) -> Solution {
     map_solution(a, Some(b), |x, y| x + y)
 }
 
+/// Largest fall of the amplitude per step of a multi-branch descent before a root is
+/// bracketed (see `solve_drive_below`).
+const MULTI_BRANCH_STEP: f64 = 0.8;
+
 fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
     solve_drive_below(p, d, op, guess, None).0
 }
@@ -1068,9 +1077,12 @@ fn solve_drive_below(
     // Without preload stiffening or Hertz softening the modal stiffness does not depend on
     // W, and the friction damping c_t·ω is ≥ 0 (the wave gives power to friction and rotor
     // at a load torque ≥ 0), so |Z(W)| ≥ |k − mω² + iωc| at every W: a bound that also
-    // counts the detuning, closer to the root off resonance.
-    let w_cold = if p.stiffening == 0.0 && p.beta == 0.0 {
-        p.theta * d.v / (d.ks - p.m * d.omega * d.omega).hypot(d.omega * d.c)
+    // counts the detuning, closer to the root off resonance. It holds too where the
+    // W-dependent stiffness only moves the mode away from the drive: stiffening (≥ 0) below
+    // the resonance, softening (≤ 0) above it.
+    let detuning = d.ks - p.m * d.omega * d.omega;
+    let w_cold = if (p.stiffening == 0.0 || detuning >= 0.0) && (p.beta == 0.0 || detuning <= 0.0) {
+        p.theta * d.v / detuning.hypot(d.omega * d.c)
     } else {
         w_hi0
     };
@@ -1101,7 +1113,39 @@ fn solve_drive_below(
         }
         _ => hi.w_next,
     };
-    let mut cur = eval(start, &mut ts_guess);
+    // Where the modal stiffness depends on W (preload stiffening, Hertz softening), G(W)
+    // need not rise with W, and one fixed-point or secant step from far above can jump
+    // over the largest fixed point onto a lower branch (generic60 with stiffening 0.504 at
+    // 389 N, 190 V, 40.88 kHz, 0.42 N·m: the step from the bound, 74 µm, landed at 3.7 µm,
+    // by the unstable middle root, and the descent ended clamped, though the running state
+    // at 10.1 µm is stable; 118 of 600 random multi-branch points were on a lower branch,
+    // test below). Until a root is bracketed such a descent falls by at most a factor
+    // MULTI_BRANCH_STEP per step, down to 1e-3 of the bound (below that it is a clamped
+    // stator's descent to zero, the cap released so that it ends in the budget).
+    let multi_branch = p.stiffening != 0.0 || p.beta != 0.0;
+    let w_top = hi.w;
+    let capped = |x: f64, from: f64| {
+        if multi_branch && from >= 1e-3 * w_top {
+            x.max(MULTI_BRANCH_STEP * from)
+        } else {
+            x
+        }
+    };
+    // G peaks in a spike where the W-dependent stiffness cancels the detuning k − mω²,
+    // narrower than any step cap (10 % wide in W at generic60, β = 3e17): softening
+    // k − ¾βW², and the candidate stiffening k + s·F/W (A·χ(φ0) = F, the preload, seed 001
+    // eq. 8). Above that amplitude |Re Z| only grows with W, so where the spike reaches
+    // r < 0 the largest root is the one root between it and the top: bracket it at once.
+    let spike_w = match (p.stiffening != 0.0, p.beta != 0.0) {
+        (false, true) if detuning > 0.0 => (detuning / softening_per_w2(p, d)).sqrt(),
+        (true, false) if detuning < 0.0 && !p.truth => p.stiffening * d.f_n / -detuning,
+        _ => f64::NAN,
+    };
+    let spike = (spike_w.is_finite() && spike_w > 0.0 && spike_w < hi.w).then(|| eval(spike_w, &mut ts_guess));
+    let mut cur = match spike.filter(|t| t.w < t.w_next) {
+        Some(t) => t,
+        None => eval(capped(start, hi.w), &mut ts_guess),
+    };
     // From a warm top (within a hair of the root) the first secant already uses it; from
     // the far bound it would be a poor partner (tried: 21 statuses changed in dense maps).
     let mut prev: Option<Trial> = warm.map(|_| hi);
@@ -1112,7 +1156,7 @@ fn solve_drive_below(
     // tolerance, found by tests/invariants.rs).
     let mut bracket = SignBracket { neg: None, pos: Some((hi.w, hi.w - hi.w_next)), last_side: 0 };
     let mut stretch = 1.0; // fixed-point step multiplier, doubled per rejected secant
-    for _ in 0..80 {
+    for _ in 0..if multi_branch { 200 } else { 80 } {
         let r = cur.w - cur.w_next;
         if r.abs() <= rtol * cur.w.max(1e-300) {
             converged = true;
@@ -1142,7 +1186,7 @@ fn solve_drive_below(
                     let rp = pv.w - pv.w_next;
                     cur.w - r * (cur.w - pv.w) / (r - rp)
                 });
-                match secant {
+                let x = match secant {
                     Some(x) if x.is_finite() && x > 0.0 && x < cur.w => {
                         stretch = 1.0;
                         x
@@ -1152,7 +1196,8 @@ fn solve_drive_below(
                         stretch *= 2.0;
                         x
                     }
-                }
+                };
+                capped(x, cur.w)
             }
         };
         prev = Some(cur);
@@ -1439,5 +1484,65 @@ mod tests {
             }
         }
         assert!(stalled > 500 && moving > 500, "{stalled} stalled, {moving} moving trials");
+    }
+
+    /// Where G(W) is not monotonic (preload stiffening, Hertz softening) the cold solve
+    /// still reports the largest fixed point, the state reached from above: its amplitude
+    /// is a fixed point of the map and `amplitude_branches` (a fine scan with bisection)
+    /// finds none above it; a clamped answer only where the scan finds none at all. Random
+    /// drives, preloads and torques through multi-branch, stalled and clamped states.
+    /// Before the capped descent and the softening spike probe, 118 of these 600 points
+    /// were on a lower branch or clamped.
+    #[test]
+    fn multi_branch_stators_report_the_largest_fixed_point() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(15);
+        let (mut checked, mut multi, mut clamped, mut wrong) = (0, 0, 0, Vec::new());
+        for (name, fx) in [
+            ("generic60", "preload_stiffening=0.504"),
+            ("trum60a", "preload_stiffening=1"),
+            ("trum60a", "hertz_softening=1e18"),
+            ("generic60", "hertz_softening=3e17"),
+        ] {
+            let mut m = crate::presets::preset(name).expect("preset");
+            m.effects.parse_assignment(fx).expect("effect");
+            let p = Prepared::new(&m);
+            for _ in 0..150 {
+                let op = OperatingPoint::new(
+                    rng.random_range(20.0..600.0),
+                    rng.random_range(0.0..1.5),
+                    rng.random_range(80.0..300.0),
+                    rng.random_range(38e3..45e3),
+                );
+                let s = solve(&m, &op);
+                let branches = amplitude_branches(&m, &op);
+                multi += usize::from(branches.len() > 1);
+                checked += 1;
+                let w = s.amplitude_m;
+                let problem = match s.status {
+                    Status::Clamped => {
+                        clamped += 1;
+                        branches.last().map(|b| format!("clamped, but a fixed point at {:.6e} m", b.amplitude_m))
+                    }
+                    Status::Ok | Status::Stall => {
+                        let t = trial(&p, &Drive::at(&p, &op), w, None, None);
+                        if (t.w - t.w_next).abs() > 1e-9 * w {
+                            Some(format!("{w:.6e} m is not a fixed point (G = {:.6e} m)", t.w_next))
+                        } else {
+                            branches
+                                .iter()
+                                .find(|b| b.amplitude_m > w * (1.0 + 1e-6))
+                                .map(|b| format!("{w:.6e} m, but a fixed point above at {:.6e} m", b.amplitude_m))
+                        }
+                    }
+                    other => Some(format!("status {other:?}")),
+                };
+                if let Some(why) = problem {
+                    wrong.push(format!("{name} {fx} {op:?}: {why} ({} branches)", branches.len()));
+                }
+            }
+        }
+        assert!(wrong.is_empty(), "{} of {checked} points:\n{}", wrong.len(), wrong.join("\n"));
+        // the sample reaches the cases that matter
+        assert!(multi >= 20 && clamped >= 1, "{multi} multi-branch, {clamped} clamped of {checked}");
     }
 }
