@@ -762,19 +762,27 @@ pub(crate) fn finite_or_unconverged(mut s: Solution) -> Solution {
 /// differ from the cold solve by whole branches and make maps depend on their chunking (found in review: generic60 with a strong softening,
 /// 394 rpm in the sweep, 70 rpm cold). A sweep gives the cold answer.
 ///
-/// `prev` = (its point, its solution, the slope of its amplitude residual at the root);
-/// returns this point's solution and slope (None where the descent did not run).
+/// `history` = the points solved before this one, oldest first, each with its solution
+/// and the slope of its amplitude residual at the root (a sweep keeps the last
+/// [`SWEEP_HISTORY`]). The newest is the warm start's bound. Where earlier ones lie on
+/// this point's torque line too, the amplitude extrapolated through them (Lagrange, up to
+/// quadratic) is tried first, with the residual's slope extrapolated linearly for the
+/// first Newton step: within about 1e-6 of the root, where the bound is a whole torque
+/// step (1e-3) away. Where r ≥ 0 at the prediction it is the top of the descent, else it
+/// and the bound bracket the root.
+/// Returns this point's solution and slope (None where the descent did not run).
 pub(crate) fn solve_in_sweep(
     p: &Prepared,
     motor: &Motor,
     op: &OperatingPoint,
-    prev: Option<(&OperatingPoint, &Solution, Option<f64>)>,
+    history: &[(OperatingPoint, Solution, Option<f64>)],
 ) -> (Solution, Option<f64>) {
-    let guess = prev.map(|x| x.1).filter(|g| g.status.is_valid());
+    let prev = history.last();
+    let guess = prev.map(|x| &x.1).filter(|g| g.status.is_valid());
     let top = prev.filter(|(o, g, _)| {
         matches!(g.status, Status::Ok | Status::Stall)
             && g.amplitude_m > 0.0
-            && OperatingPoint { torque_nm: op.torque_nm, ..**o } == *op
+            && OperatingPoint { torque_nm: op.torque_nm, ..*o } == *op
             && o.torque_nm <= op.torque_nm
             && p.law.radial_ratio == 0.0
             && p.compliance == 0.0
@@ -784,13 +792,50 @@ pub(crate) fn solve_in_sweep(
             && iterated(p, op) == (false, false)
             && op.invalid_reason().is_none()
     });
-    match top {
-        Some((_, g, slope)) => {
-            let (s, slope) = solve_drive_below(p, &Drive::at(p, op), op, guess, Some((g.amplitude_m, slope)));
-            (finite_or_unconverged(s), slope)
+    let Some((_, g, slope)) = top else {
+        return (solve_prepared(p, motor, op, guess), None);
+    };
+    // the newest points on this torque line, strictly rising in torque, running or stalled
+    let mut line: Vec<&(OperatingPoint, Solution, Option<f64>)> = Vec::with_capacity(SWEEP_HISTORY);
+    for h in history.iter().rev() {
+        let (o, s, _) = h;
+        let rising = line.last().map_or(o.torque_nm <= op.torque_nm, |l| o.torque_nm < l.0.torque_nm);
+        if !(rising
+            && matches!(s.status, Status::Ok | Status::Stall)
+            && s.amplitude_m > 0.0
+            && OperatingPoint { torque_nm: op.torque_nm, ..*o } == *op)
+        {
+            break;
         }
-        None => (solve_prepared(p, motor, op, guess), None),
+        line.push(h);
     }
+    let at = |x: &[(f64, f64)]| lagrange_at(x, op.torque_nm);
+    let ws: Vec<(f64, f64)> = line.iter().map(|(o, s, _)| (o.torque_nm, s.amplitude_m)).collect();
+    let predicted = (ws.len() >= 2 && ws[0].0 < op.torque_nm).then(|| at(&ws));
+    let ks: Vec<(f64, f64)> = line.iter().map_while(|(o, _, k)| k.map(|k| (o.torque_nm, k))).take(2).collect();
+    let slope =
+        if ks.len() == 2 && ks[0].0 < op.torque_nm { Some(at(&ks)).filter(|k| *k > 0.0).or(*slope) } else { *slope };
+    let warm = WarmTop { bound: g.amplitude_m, slope, predicted };
+    let (s, slope) = solve_drive_below(p, &Drive::at(p, op), op, guess, Some(warm));
+    (finite_or_unconverged(s), slope)
+}
+
+/// Points a sweep keeps for [`solve_in_sweep`]'s extrapolation (quadratic through three).
+pub(crate) const SWEEP_HISTORY: usize = 3;
+
+/// The polynomial through the points `xy` (distinct x), evaluated at `x`.
+fn lagrange_at(xy: &[(f64, f64)], x: f64) -> f64 {
+    xy.iter()
+        .enumerate()
+        .map(|(i, &(xi, yi))| {
+            yi * xy
+                .iter()
+                .enumerate()
+                .filter(|&(j, _)| j != i)
+                .map(|(_, &(xj, _))| (x - xj) / (xi - xj))
+                .product::<f64>()
+        })
+        .sum()
 }
 
 /// Effects that depend on the solution itself (temperature from the losses, electrode
@@ -1133,12 +1178,22 @@ fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solu
 /// r(W) = W − G(W) near W (from the previous point), when positive, makes the first step a
 /// Newton step instead of a fixed-point one. Returns the slope of r at the root (from the
 /// last secant) with the solution.
+/// A sweep's warm start of the amplitude descent (`solve_in_sweep`): a proven upper bound
+/// of the largest fixed point (the previous point's amplitude), the slope of the residual
+/// r(W) = W − G(W) at the previous root, and an amplitude predicted below the bound.
+#[derive(Clone, Copy, Debug)]
+struct WarmTop {
+    bound: f64,
+    slope: Option<f64>,
+    predicted: Option<f64>,
+}
+
 fn solve_drive_below(
     p: &Prepared,
     d: &Drive,
     op: &OperatingPoint,
     guess: Option<&Solution>,
-    top: Option<(f64, Option<f64>)>,
+    top: Option<WarmTop>,
 ) -> (Solution, Option<f64>) {
     // The Coulomb interface's map is smooth to rounding: 1e-13 (1e-12 left 1.7e-9 on the
     // efficiency just below stall, where the speed is a difference of nearly equal torques,
@@ -1180,12 +1235,49 @@ fn solve_drive_below(
     // Upper bracket: r(W) = W − W' ≥ 0. The previous root was converged to rtol only, so
     // r may come out a rounding below zero there; within rtol it is this point's root too
     // (where the load does not move G at all, in a stall, always).
-    let warm_trial = top.map(|(w, _)| eval(w, &mut ts_guess));
-    if let Some(t) = warm_trial.filter(|t| (t.w - t.w_next).abs() <= rtol * t.w) {
+    // The predicted amplitude first: a root within the tolerance there is the answer; with
+    // r ≥ 0 it is the top of the descent (a further root between it and the bound would
+    // need two sign changes within one extrapolation error); with r < 0 the bound is
+    // evaluated too and the two bracket the root.
+    let converged_at = |t: &Trial| (t.w - t.w_next).abs() <= rtol * t.w;
+    let mut below: Option<Trial> = None;
+    let warm_trial = top.map(|wt| match wt.predicted.filter(|&w| w > 0.0 && w < wt.bound) {
+        Some(w) => {
+            let t = eval(w, &mut ts_guess);
+            if t.w >= t.w_next || converged_at(&t) {
+                return t;
+            }
+            // Up to three steps up from below: Newton with the slope, then secants,
+            // inside the bound; the first with r ≥ 0 is the top.
+            let mut b = t;
+            let mut last: Option<Trial> = None;
+            for _ in 0..3 {
+                let rb = b.w - b.w_next;
+                let x = match last {
+                    Some(l) if l.w != b.w => b.w - rb * (b.w - l.w) / (rb - (l.w - l.w_next)),
+                    _ => wt.slope.filter(|&k| k > 0.0).map_or(f64::NAN, |k| b.w - rb / k),
+                };
+                if !(x > b.w && x < wt.bound) {
+                    break;
+                }
+                let u = eval(x, &mut ts_guess);
+                if u.w >= u.w_next || converged_at(&u) {
+                    below = Some(b);
+                    return u;
+                }
+                (last, b) = (Some(b), u);
+            }
+            below = Some(b);
+            eval(wt.bound, &mut ts_guess)
+        }
+        None => eval(wt.bound, &mut ts_guess),
+    });
+    if let Some(t) = warm_trial.filter(converged_at) {
         let status = if t.stalled { Status::Stall } else { Status::Ok };
-        return (finish(p, d, op, &t, status, evals), top.and_then(|x| x.1));
+        return (finish(p, d, op, &t, status, evals), top.and_then(|x| x.slope));
     }
     let warm = warm_trial.filter(|t| t.w >= t.w_next);
+    let below = below.filter(|_| warm.is_some());
     // Without preload stiffening or Hertz softening the modal stiffness does not depend on
     // W, and the friction damping c_t·ω is ≥ 0 (the wave gives power to friction and rotor
     // at a load torque ≥ 0), so |Z(W)| ≥ |k − mω² + iωc| at every W: a bound that also
@@ -1207,14 +1299,25 @@ fn solve_drive_below(
         hi = eval(hi.w_next * 1.5, &mut ts_guess);
         grow += 1;
     }
-    let mut lo: Option<Trial> = None;
+    let mut lo: Option<Trial> = below;
     // Start: one fixed-point step from the top. The amplitude always descends from an
     // upper bound onto the largest fixed point — the bound Θ·V/(ω·c), or a proven one
     // (`solve_in_sweep`): a warm amplitude from a neighbouring point can sit below the
     // middle one of several fixed points and fall onto another branch (found by
     // tests/reliability_known_bugs.rs). The guess still warm-starts the inner stick-angle
     // solves.
-    let start = match (warm, top.and_then(|t| t.1)) {
+    let start = match (warm, top.and_then(|t| t.slope)) {
+        // the predicted amplitude below the root and the bound above it: their secant
+        (Some(h), _) if below.is_some() => {
+            let b = below.map_or(h.w, |b| b.w);
+            let (rb, rh) = (b - below.map_or(0.0, |b| b.w_next), h.w - h.w_next);
+            let x = b - rb * (h.w - b) / (rh - rb);
+            if x > b && x < h.w {
+                x
+            } else {
+                0.5 * (b + h.w)
+            }
+        }
         (Some(h), Some(k)) if k > 0.0 => {
             let x = h.w - (h.w - h.w_next) / k;
             if x > 0.0 && x <= h.w {
@@ -1279,7 +1382,8 @@ fn solve_drive_below(
     // its stored residual is halved again each time (cumulatively: halving only once
     // stalled into linear convergence at ratio ~0.7, 82 evaluations without reaching the
     // tolerance, found by tests/invariants.rs).
-    let mut bracket = SignBracket { neg: None, pos: Some((hi.w, hi.w - hi.w_next)), last_side: 0 };
+    let mut bracket =
+        SignBracket { neg: lo.map(|l| (l.w, l.w - l.w_next)), pos: Some((hi.w, hi.w - hi.w_next)), last_side: 0 };
     let mut stretch = 1.0; // fixed-point step multiplier, doubled per rejected secant
     for _ in 0..if multi_branch { 200 } else { 80 } {
         let r = cur.w - cur.w_next;

@@ -4,7 +4,7 @@
 
 use crate::error::TrumError;
 use crate::params::Motor;
-use crate::solve::{OperatingPoint, Prepared, Solution};
+use crate::solve::{OperatingPoint, Prepared, Solution, SWEEP_HISTORY};
 
 /// The swept input axes, in nesting order (the last varies fastest).
 pub const AXES: [&str; 4] = ["preload_n", "voltage_v", "frequency_hz", "torque_nm"];
@@ -125,12 +125,16 @@ pub fn solve_range<F>(motor: &Motor, prepared: &Prepared, grid: &Grid, range: st
 where
     F: FnMut(u64, &OperatingPoint, &Solution),
 {
-    let mut prev: Option<(OperatingPoint, Solution, Option<f64>)> = None;
+    // the last points solved, oldest first (solve_in_sweep extrapolates through them)
+    let mut history: Vec<(OperatingPoint, Solution, Option<f64>)> = Vec::with_capacity(SWEEP_HISTORY + 1);
     for i in range {
         let op = grid.point(i);
-        let (s, slope) = crate::solve::solve_in_sweep(prepared, motor, &op, prev.as_ref().map(|(o, s, k)| (o, s, *k)));
+        let (s, slope) = crate::solve::solve_in_sweep(prepared, motor, &op, &history);
         sink(i, &op, &s);
-        prev = Some((op, s, slope));
+        if history.len() == SWEEP_HISTORY {
+            history.remove(0);
+        }
+        history.push((op, s, slope));
     }
 }
 
@@ -190,8 +194,10 @@ mod tests {
         }
         assert!([Status::Ok, Status::Stall, Status::Clamped].iter().all(|s| seen.contains(s)), "{seen:?}");
         // the torque-ordered warm start is taken (solve::solve_in_sweep): fewer amplitude
-        // evaluations than cold, not the same answer by never leaving the cold path
-        assert!(warm_evals * 10 < cold_evals * 8, "sweep {warm_evals} vs cold {cold_evals} amplitude evaluations");
+        // evaluations than cold, not the same answer by never leaving the cold path; with
+        // the extrapolated amplitude 0.641 of the cold count on these coarse grids (0.674
+        // from the bound alone)
+        assert!(warm_evals * 100 < cold_evals * 66, "sweep {warm_evals} vs cold {cold_evals} amplitude evaluations");
     }
 
     /// Review cases (stop 14) where the cold descent of a softening or stiffening stator
