@@ -512,7 +512,9 @@ pub fn calibrate(
     // budget/(n + 1)² kept the total near the budget. The linearised Jacobian costs about two
     // passes now; the patience is kept so that fits stop where they did.
     // Tolerances: the sum of squares stops when a step removes less than FIT_CHI2_TOL of
-    // it in absolute terms (the crate's ftol is relative: FIT_CHI2_TOL/χ², at least 1e-12),
+    // it in absolute terms at the start of each pass (the crate's ftol is relative:
+    // FIT_CHI2_TOL/χ² of the pass's start, at least 1e-12; as χ² falls within a pass the
+    // absolute tolerance only tightens),
     // far below anything a verdict compares, yet 200× looser than a relative 1e-12 on
     // 1000-row data (χ² ~ 5e5), where the last 20 % of the passes removed < 0.01 in all.
     // Not looser: a step can remove less than 1e-3 in the middle of a long crawl along a
