@@ -762,9 +762,9 @@ pub(crate) fn finite_or_unconverged(mut s: Solution) -> Solution {
 /// differ from the cold solve by whole branches and make maps depend on their chunking (found in review: generic60 with a strong softening,
 /// 394 rpm in the sweep, 70 rpm cold). A sweep gives the cold answer.
 ///
-/// `history` = the points solved before this one, oldest first, each with its solution
-/// and the slope of its amplitude residual at the root (a sweep keeps the last
-/// [`SWEEP_HISTORY`]). The newest is the warm start's bound. Where earlier ones lie on
+/// `last` = the solution of the point solved just before (it warm-starts the inner angle
+/// solves); `history` = the points solved before this one, oldest first, the newest being
+/// `last`'s (a sweep keeps the last [`SWEEP_HISTORY`]). The newest is the warm start's bound. Where earlier ones lie on
 /// this point's torque line too, the amplitude extrapolated through them (Lagrange, up to
 /// quadratic) is tried first, with the residual's slope extrapolated linearly for the
 /// first Newton step: within about 1e-6 of the root, where the bound is a whole torque
@@ -775,15 +775,14 @@ pub(crate) fn solve_in_sweep(
     p: &Prepared,
     motor: &Motor,
     op: &OperatingPoint,
-    history: &[(OperatingPoint, Solution, Option<f64>)],
+    last: Option<&Solution>,
+    history: &[SweepPoint],
 ) -> (Solution, Option<f64>) {
-    let prev = history.last();
-    let guess = prev.map(|x| &x.1).filter(|g| g.status.is_valid());
-    let top = prev.filter(|(o, g, _)| {
-        matches!(g.status, Status::Ok | Status::Stall)
-            && g.amplitude_m > 0.0
-            && OperatingPoint { torque_nm: op.torque_nm, ..*o } == *op
-            && o.torque_nm <= op.torque_nm
+    let guess = last.filter(|g| g.status.is_valid());
+    let on_line = |h: &SweepPoint| h.running && OperatingPoint { torque_nm: op.torque_nm, ..h.op } == *op;
+    let top = history.last().filter(|h| {
+        on_line(h)
+            && h.op.torque_nm <= op.torque_nm
             && p.law.radial_ratio == 0.0
             && p.compliance == 0.0
             && p.stiffening == 0.0
@@ -792,32 +791,54 @@ pub(crate) fn solve_in_sweep(
             && iterated(p, op) == (false, false)
             && op.invalid_reason().is_none()
     });
-    let Some((_, g, slope)) = top else {
+    let Some(top) = top else {
         return (solve_prepared(p, motor, op, guess), None);
     };
-    // the newest points on this torque line, strictly rising in torque, running or stalled
-    let mut line: Vec<&(OperatingPoint, Solution, Option<f64>)> = Vec::with_capacity(SWEEP_HISTORY);
+    // (torque, amplitude) and (torque, slope) of the newest points on this torque line,
+    // newest first, strictly falling in torque (fixed arrays: this runs once a point)
+    let (mut ws, mut nw) = ([(0.0, 0.0); SWEEP_HISTORY], 0);
+    let (mut ks, mut nk) = ([(0.0, 0.0); 2], 0);
     for h in history.iter().rev() {
-        let (o, s, _) = h;
-        let rising = line.last().map_or(o.torque_nm <= op.torque_nm, |l| o.torque_nm < l.0.torque_nm);
-        if !(rising
-            && matches!(s.status, Status::Ok | Status::Stall)
-            && s.amplitude_m > 0.0
-            && OperatingPoint { torque_nm: op.torque_nm, ..*o } == *op)
-        {
+        if !(on_line(h) && (nw == 0 || h.op.torque_nm < ws[nw - 1].0)) {
             break;
         }
-        line.push(h);
+        ws[nw] = (h.op.torque_nm, h.amplitude_m);
+        nw += 1;
+        match h.slope {
+            Some(k) if nk == nw - 1 && nk < 2 => {
+                ks[nk] = (h.op.torque_nm, k);
+                nk += 1;
+            }
+            _ => {}
+        }
     }
-    let at = |x: &[(f64, f64)]| lagrange_at(x, op.torque_nm);
-    let ws: Vec<(f64, f64)> = line.iter().map(|(o, s, _)| (o.torque_nm, s.amplitude_m)).collect();
-    let predicted = (ws.len() >= 2 && ws[0].0 < op.torque_nm).then(|| at(&ws));
-    let ks: Vec<(f64, f64)> = line.iter().map_while(|(o, _, k)| k.map(|k| (o.torque_nm, k))).take(2).collect();
-    let slope =
-        if ks.len() == 2 && ks[0].0 < op.torque_nm { Some(at(&ks)).filter(|k| *k > 0.0).or(*slope) } else { *slope };
-    let warm = WarmTop { bound: g.amplitude_m, slope, predicted };
+    let ahead = top.op.torque_nm < op.torque_nm;
+    let predicted = (ahead && nw >= 2).then(|| lagrange_at(&ws[..nw], op.torque_nm));
+    let slope = match ahead && nk == 2 {
+        true => Some(lagrange_at(&ks, op.torque_nm)).filter(|k| *k > 0.0).or(top.slope),
+        false => top.slope,
+    };
+    let warm = WarmTop { bound: top.amplitude_m, slope, predicted };
     let (s, slope) = solve_drive_below(p, &Drive::at(p, op), op, guess, Some(warm));
     (finite_or_unconverged(s), slope)
+}
+
+/// What a sweep keeps of a solved point for the warm start of the next ones.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SweepPoint {
+    op: OperatingPoint,
+    amplitude_m: f64,
+    /// Ok or Stall with a positive amplitude: a bound for the next point on its line.
+    running: bool,
+    /// Slope of the amplitude residual r(W) at the root (from the descent's last secant).
+    slope: Option<f64>,
+}
+
+impl SweepPoint {
+    pub(crate) fn new(op: &OperatingPoint, s: &Solution, slope: Option<f64>) -> Self {
+        let running = matches!(s.status, Status::Ok | Status::Stall) && s.amplitude_m > 0.0;
+        SweepPoint { op: *op, amplitude_m: s.amplitude_m, running, slope }
+    }
 }
 
 /// Points a sweep keeps for [`solve_in_sweep`]'s extrapolation (quadratic through three).

@@ -4,7 +4,7 @@
 
 use crate::error::TrumError;
 use crate::params::Motor;
-use crate::solve::{OperatingPoint, Prepared, Solution, SWEEP_HISTORY};
+use crate::solve::{OperatingPoint, Prepared, Solution, SweepPoint, SWEEP_HISTORY};
 
 /// The swept input axes, in nesting order (the last varies fastest).
 pub const AXES: [&str; 4] = ["preload_n", "voltage_v", "frequency_hz", "torque_nm"];
@@ -125,16 +125,19 @@ pub fn solve_range<F>(motor: &Motor, prepared: &Prepared, grid: &Grid, range: st
 where
     F: FnMut(u64, &OperatingPoint, &Solution),
 {
-    // the last points solved, oldest first (solve_in_sweep extrapolates through them)
-    let mut history: Vec<(OperatingPoint, Solution, Option<f64>)> = Vec::with_capacity(SWEEP_HISTORY + 1);
+    // the last points solved, oldest first (solve_in_sweep extrapolates through them), and
+    // the last solution (its angles start the next point's inner solves)
+    let mut history: Vec<SweepPoint> = Vec::with_capacity(SWEEP_HISTORY + 1);
+    let mut last: Option<Solution> = None;
     for i in range {
         let op = grid.point(i);
-        let (s, slope) = crate::solve::solve_in_sweep(prepared, motor, &op, &history);
+        let (s, slope) = crate::solve::solve_in_sweep(prepared, motor, &op, last.as_ref(), &history);
         sink(i, &op, &s);
         if history.len() == SWEEP_HISTORY {
             history.remove(0);
         }
-        history.push((op, s, slope));
+        history.push(SweepPoint::new(&op, &s, slope));
+        last = Some(s);
     }
 }
 
