@@ -1277,13 +1277,15 @@ fn solve_drive_below(
     // go up (Newton, then secants, below the bound), the first with r ≥ 0 is the top and
     // the last below it the bracket's lower end; failing that the bound is the top.
     let converged_at = |t: &Trial| (t.w - t.w_next).abs() <= rtol * t.w;
+    // r ≥ 0, or no number at all
+    let not_below = |t: &Trial| !matches!(t.w.partial_cmp(&t.w_next), Some(std::cmp::Ordering::Less));
     let mut below: Option<Trial> = None;
     let warm_trial = top.map(|wt| match wt.predicted.filter(|&w| w > 0.0 && w < wt.bound) {
         Some(w) => {
             let t = eval(w, &mut ts_guess);
             // (a NaN residual is no bracket: it fails the warm filter below and the
             // point descends from the cold bound)
-            if !(t.w < t.w_next) || converged_at(&t) {
+            if not_below(&t) || converged_at(&t) {
                 return t;
             }
             // Up to three steps up from below: Newton with the slope, then secants,
@@ -1300,7 +1302,7 @@ fn solve_drive_below(
                     break;
                 }
                 let u = eval(x, &mut ts_guess);
-                if !(u.w < u.w_next) || converged_at(&u) {
+                if not_below(&u) || converged_at(&u) {
                     below = Some(b);
                     return u;
                 }
