@@ -842,7 +842,8 @@ pub(crate) struct SweepPoint {
     /// Ok or Stall with a positive amplitude: a bound for the next point on its line.
     running: bool,
     stalled: bool,
-    /// Slope of the amplitude residual r(W) at the root (from the descent's last secant).
+    /// Slope of the amplitude residual r(W) at the root: from the descent's last secant,
+    /// or the extrapolated one where the prediction converged at once.
     slope: Option<f64>,
 }
 
