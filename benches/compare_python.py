@@ -302,6 +302,9 @@ def main():
     # axis are warm-started sweeps; the grid's order is the meshgrid's above.
     t_map, res_map = best_of(5, lambda: trum.map(motor, preload_n=(100.0, 500.0, nf), torque_nm=(0.0, 1.2, nt),
                                                  voltage_v=V, frequency_hz=f, parallel=False))
+    # ... and on every core (the default): the same numbers, rows start cold whatever the threads
+    t_par, res_par = best_of(5, lambda: trum.map(motor, preload_n=(100.0, 500.0, nf), torque_nm=(0.0, 1.2, nt),
+                                                 voltage_v=V, frequency_hz=f, parallel=True))
     t_np, (st_np, out_np) = best_of(3, lambda: numpy_points(P, F, T, V, f))
     # SciPy: an evenly spread subset of the same points (the whole grid would take minutes).
     idx = np.linspace(0, n - 1, min(a.scipy_points, n)).round().astype(int)
@@ -316,6 +319,9 @@ def main():
             or not np.allclose(res_map["torque_nm"], T, rtol=1e-15, atol=1e-15):
         ok = False
         print("trum.map differs from motor.solve in its points or statuses")
+    if any(not np.array_equal(np.asarray(res_par[q]), np.asarray(res_map[q])) for q in ("status", *COMPARED)):
+        ok = False
+        print("trum.map on every core differs from trum.map on one thread")
     if not (st_np == st_trum).all():
         ok = False
         print(f"numpy status differs at {(st_np != st_trum).sum()} points")
@@ -349,6 +355,9 @@ def main():
     print(f"{'implementation':34} {'points':>8} {'us/point':>10} {'trum is x faster':>17} {'trum.map is x faster':>21}")
     print(f"{'trum (Rust, motor.solve, 1 thread)':34} {n:8d} {tp:10.3f} {1.0:17.1f} {tp / tm:21.1f}")
     print(f"{'trum.map (grid sweep, 1 thread)':34} {n:8d} {tm:10.3f} {tm / tp:17.1f} {1.0:21.1f}")
+    tpar = per(t_par, n)
+    cores = f"{os.cpu_count()} cores"
+    print(f"{'trum.map (grid sweep, ' + cores + ')':34} {n:8d} {tpar:10.3f} {tpar / tp:17.1f} {tpar / tm:21.1f}")
     for name, k, t in (("NumPy, vectorised", n, t_np), ("SciPy brentq, per point", len(idx), t_sp)):
         print(f"{name:34} {k:8d} {per(t, k):10.3f} {per(t, k) / tp:17.1f} {per(t, k) / tm:21.1f}")
     print("largest relative difference to trum motor.solve (numpy, scipy, trum.map):")
