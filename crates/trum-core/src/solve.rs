@@ -1352,19 +1352,18 @@ fn solve_drive_below(
     // middle one of several fixed points and fall onto another branch (found by
     // tests/reliability_known_bugs.rs). The guess still warm-starts the inner stick-angle
     // solves.
-    let start = match (warm, top.and_then(|t| t.slope)) {
-        // the predicted amplitude below the root and the bound above it: their secant
-        (Some(h), _) if below.is_some() => {
-            let b = below.map_or(h.w, |b| b.w);
-            let (rb, rh) = (b - below.map_or(0.0, |b| b.w_next), h.w - h.w_next);
-            let x = b - rb * (h.w - b) / (rh - rb);
-            if x > b && x < h.w {
+    let start = match (warm, top.and_then(|t| t.slope), below) {
+        // a trial below the root and the top above it: their secant
+        (Some(h), _, Some(l)) => {
+            let (rl, rh) = (l.w - l.w_next, h.w - h.w_next);
+            let x = l.w - rl * (h.w - l.w) / (rh - rl);
+            if x > l.w && x < h.w {
                 x
             } else {
-                0.5 * (b + h.w)
+                0.5 * (l.w + h.w)
             }
         }
-        (Some(h), Some(k)) if k > 0.0 => {
+        (Some(h), Some(k), None) if k > 0.0 => {
             let x = h.w - (h.w - h.w_next) / k;
             if x > 0.0 && x <= h.w {
                 x
