@@ -25,8 +25,8 @@ pub mod json;
 mod signature;
 
 use crate::calibrate::{
-    baseline_params, calibrate, effect_params, residuals, Calibration, FitOptions, FitParam, FittedParam, Observable,
-    ObservedRow,
+    baseline_params, calibrate, calibrate_adding, effect_params, residuals, Calibration, FitOptions, FitParam,
+    FittedParam, Observable, ObservedRow,
 };
 use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
@@ -534,9 +534,14 @@ pub fn diagnose(
         _ => None,
     };
     // `from`: the start of the fit (the calibrated baseline; for a pair, the lead effect's
-    // own fit, so the pair starts where the single ended).
+    // own fit, so the pair starts where the single ended). `nested`: the χ² and held-out
+    // predictions of the fitted model this one nests (the lead effect's fit for a pair; the
+    // baseline when None), which stand in when the fit ends worse than it.
     type Scored = (RankEntry, Vec<Vec<f64>>, Option<Calibration>);
-    let score = |effects: &[Effect], from: &Motor| -> Scored {
+    type Nested = Option<(f64, Vec<Vec<f64>>, Vec<FittedParam>)>;
+    let score = |effects: &[Effect], from: &Motor, nested: &Nested| -> Scored {
+        let (nested_chi2, nested_preds, nested_params) =
+            nested.as_ref().map(|(c, p, q)| (*c, p, &q[..])).unwrap_or((base_cal.chi2, &base_cv.preds, &[]));
         // Two starts: the calibrated baseline with the effect weak, and the nominal motor
         // with the effect at its typical strength. The baseline calibration may have bent
         // its parameters to mimic part of the effect, a valley the first start can stay in.
@@ -558,7 +563,9 @@ pub fn diagnose(
             };
             return (entry, base_cv.preds.clone(), None);
         }
-        let mut cal = calibrate(&s0, rows, &params, &opts.fit);
+        // the effects this fit adds to the model it nests
+        let added = if nested.is_some() { &effects[1..] } else { effects };
+        let mut cal = calibrate_adding(&s0, rows, &params, &opts.fit, added);
         // The second start is needed only when the first did not reach the noise level and
         // found no clear evidence (a supported effect is not rejected for a shallower valley).
         let first_ev = cal.as_ref().map(|c| 0.5 * (base_bic - bic(c.chi2, kpar))).unwrap_or(f64::NEG_INFINITY);
@@ -569,8 +576,8 @@ pub fn diagnose(
                 let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
                 s1.effects.set(e, &typical);
             }
-            if let Ok(c1) = calibrate(&s1, rows, &params, &opts.fit) {
-                if cal.as_ref().is_err() || cal.as_ref().is_ok_and(|c| c1.chi2 < c.chi2) {
+            if let Ok(c1) = calibrate_adding(&s1, rows, &params, &opts.fit, added) {
+                if !c1.abandoned && !cal.as_ref().is_ok_and(|c| !c.abandoned && c1.chi2 >= c.chi2) {
                     cal = Ok(c1);
                 }
             }
@@ -578,7 +585,11 @@ pub fn diagnose(
         let (evidence, fitted, preds, fitted_motor) = match cal {
             // Nested models: the effect at zero strength is the baseline, so a fit that ends
             // worse than the baseline's χ² is a local minimum; the baseline stands in for it.
-            Ok(c) if c.chi2 <= base_cal.chi2 || opts.exact_cv => {
+            // (Not the lead's χ² for a pair: the two are Huber-reweighted fits, and a pair can
+            // end a little above its lead in unweighted χ² and still predict held-out data
+            // better.) A fit abandoned as collapsing onto its nested model (for a pair, the
+            // lead's fit) is that model.
+            Ok(c) if !c.abandoned && (c.chi2 <= base_cal.chi2 || opts.exact_cv) => {
                 let preds = if opts.exact_cv {
                     cross_validate(motor, &start, rows, &folds, k, effects, opts, reduced).preds
                 } else {
@@ -586,9 +597,19 @@ pub fn diagnose(
                 };
                 (0.5 * (base_bic - bic(c.chi2.min(base_cal.chi2), kpar)), c.params.clone(), preds, Some(c))
             }
-            Ok(c) => {
+            Ok(c) if !c.abandoned => {
                 let zero = c.params.into_iter().map(|p| FittedParam { value: 0.0, ..p }).collect();
                 (0.5 * (base_bic - bic(base_cal.chi2, kpar)), zero, base_cv.preds.clone(), None)
+            }
+            Ok(c) => {
+                // the nested model's values: zero for the added effect, the lead's own for a pair
+                let nested_value = |name: &str| nested_params.iter().find(|q| q.name == name).map(|q| q.value);
+                let zero = c
+                    .params
+                    .into_iter()
+                    .map(|p| FittedParam { value: nested_value(&p.name).unwrap_or(0.0), ..p })
+                    .collect();
+                (0.5 * (base_bic - bic(nested_chi2, kpar)), zero, nested_preds.clone(), None)
             }
             Err(_) => (f64::NEG_INFINITY, Vec::new(), base_cv.preds.clone(), None),
         };
@@ -627,7 +648,7 @@ pub fn diagnose(
             .collect()
     };
     let mut ranking: Vec<RankEntry> =
-        collect(&mut cv_preds, &mut fits, opts.candidates.par_iter().map(|&e| score(&[e], &start)).collect());
+        collect(&mut cv_preds, &mut fits, opts.candidates.par_iter().map(|&e| score(&[e], &start, &None)).collect());
     sort_ranking(&mut ranking);
 
     // A candidate is supported when the full-data evidence is very strong (½ΔBIC > 5)
@@ -651,12 +672,13 @@ pub fn diagnose(
     if gap {
         let best_single = ranking.iter().find(|r| supported(r)).cloned();
         let single_closes = best_single.as_ref().is_some_and(closes);
-        let n_supported = ranking.iter().filter(|r| supported(r)).count();
-        // Pairs are tried when no single effect closes the gap, and also when a second
-        // effect is supported on its own: the best single may close the gap on average yet
-        // leave another effect's signature in one quantity or corner of the data.
+        // Pairs are tried when no single effect closes the gap, and also when one does: it
+        // may close the gap on average yet leave another effect's signature in one quantity
+        // or corner of the data, and that second effect need not be supported on its own
+        // (the first one's gap dominates its single fit). Which second effects are worth a
+        // pair fit is screened below by their score test at the lead's fit.
         let mut best_pair: Option<RankEntry> = None;
-        if opts.try_pairs && ranking.len() >= 2 && (!single_closes || n_supported >= 2) {
+        if opts.try_pairs && ranking.len() >= 2 {
             // Forward selection: the best single joined with every other candidate (a
             // second effect can have no evidence on its own while the first one's gap
             // dominates the fit), plus pairs of the three strongest when no single closes.
@@ -726,8 +748,20 @@ pub fn diagnose(
             }
             // a pair led by a lead starts from that lead's own fit
             let from = |p: &[Effect; 2]| lead_starts.iter().find(|(l, _)| *l == p[0]).map(|x| &x.1).unwrap_or(&start);
-            let mut pr: Vec<RankEntry> =
-                collect(&mut cv_preds, &mut fits, pairs.par_iter().map(|p| score(p, from(p))).collect());
+            // the model a pair nests: its lead's own fit, when the pair starts there
+            let nested: Vec<Nested> = pairs
+                .iter()
+                .map(|p| {
+                    let lead = p[0].name();
+                    let led = lead_starts.iter().any(|(l, _)| *l == p[0]);
+                    fits.get(lead)
+                        .filter(|_| led)
+                        .zip(cv_preds.get(lead))
+                        .map(|(c, preds)| (c.chi2, preds.clone(), c.params.clone()))
+                })
+                .collect();
+            let scored: Vec<Scored> = pairs.par_iter().zip(&nested).map(|(p, n)| score(p, from(p), n)).collect();
+            let mut pr: Vec<RankEntry> = collect(&mut cv_preds, &mut fits, scored);
             sort_ranking(&mut pr);
             best_pair = pr.first().cloned();
             ranking.extend(pr);
