@@ -233,7 +233,7 @@ const FIT_CHI2_TOL: f64 = 1e-4;
 /// A fit also stops when a full Gauss–Newton step could remove less than this from the
 /// (weighted) sum of squared normalised residuals (`gauss_newton_decrement`). The diagnosis
 /// compares sums of squares only in differences of 10 and more (½ΔBIC > 5); on 1000-row
-/// data the last 5-25 % of a fit's passes each removed less than this (the flat tail of a
+/// data the last 5-50 % of a fit's passes each removed less than this (the flat tail of a
 /// converged fit, which FIT_CHI2_TOL alone lets run on), and a crawl along a shallow
 /// valley keeps a large decrement.
 const FIT_DECREMENT_TOL: f64 = 1e-2;
@@ -312,7 +312,7 @@ impl Linearisation {
     }
 }
 
-/// One Levenberg–Marquardt run of `problem` at its current weights (see `calibrate_nested`
+/// One Levenberg–Marquardt run of `problem` at its current weights (see `calibrate`
 /// for the budget and the tolerances).
 fn lm_pass<'a>(problem: Problem<'a>, opts: &FitOptions) -> (Problem<'a>, levenberg_marquardt::MinimizationReport<f64>) {
     let np1 = problem.params.len() + 1;
@@ -576,6 +576,11 @@ fn remaining_gain(j: &DMatrix<f64>, r: &DVector<f64>, u: &DVector<f64>) -> f64 {
 /// of a converged fit, large along a slow crawl down a shallow valley (where the steps are
 /// short but the model still sees far to go). Infinite when it cannot be computed.
 fn gauss_newton_decrement(j: &DMatrix<f64>, r: &DVector<f64>) -> f64 {
+    // no free parameter (all pressed against bounds): no step (nalgebra's SVD asserts on
+    // an empty matrix)
+    if j.ncols() == 0 {
+        return 0.0;
+    }
     let g = j.transpose() * r;
     let h = j.transpose() * j;
     if !g.iter().chain(h.iter()).all(|x| x.is_finite()) {
@@ -920,6 +925,20 @@ pub(crate) mod tests {
         // pushed inwards instead: free, the plain decrement
         assert_eq!(pressed(u0, -g[0]), None);
         assert_eq!(pressed(-u0, -1.0), Some(Bound::Upper));
+        // The edge term by another route: in the parameter's own coordinate p (a bounded
+        // FitParam, J_p = J_u/(dp/du)), moving p onto its lower bound changes χ² by
+        // 2·(J_pᵀr)·(lo − p) to first order.
+        let fp = FitParam { param: ParamRef::Motor("x".into()), lo: 2.0, hi: 7.0, log: false };
+        let p = fp.from_u(u0);
+        let gp = j.column(0).dot(&r) / fp.dp_du(u0);
+        let first_order = -2.0 * gp * (fp.lo - p);
+        let edge = remaining_gain(&j, &r, &low) - gauss_newton_decrement(&j.columns(1, 1).into_owned(), &r);
+        assert!((edge - first_order).abs() < 1e-9 * first_order.abs(), "{edge} vs {first_order}");
+        // every parameter pressed: no free column, no panic, the edge gains alone
+        let both = DVector::from_vec(vec![u0, -u0]);
+        let gain = remaining_gain(&j, &r, &both);
+        assert!(gain.is_finite() && gain > 0.0, "{gain}");
+        assert_eq!(gauss_newton_decrement(&DMatrix::zeros(4, 0), &r), 0.0);
     }
 
     /// The linearised Jacobian (crate::sensitivity) against central differences of whole

@@ -567,7 +567,10 @@ pub fn diagnose(
             };
             return (entry, base_cv.preds.clone(), None);
         }
-        // the effects this fit adds to the model it nests
+        // the effects this fit adds to the model it nests (a pair not led by a fitted single,
+        // one of the three strongest when none closes the gap, nests the baseline: both its
+        // effects count as added, and a collapse of either lets the baseline stand in, not the
+        // other single; such a pair cannot win over that single anyway)
         let added = if nested.is_some() { &effects[1..] } else { effects };
         let mut cal = calibrate_adding(&s0, rows, &params, &opts.fit, added);
         // The second start is needed only when the first did not reach the noise level and
