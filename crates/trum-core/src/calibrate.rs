@@ -947,7 +947,7 @@ pub(crate) mod tests {
     /// thermal motors) time-dependent states.
     #[test]
     fn linearised_jacobian_matches_central_differences_of_whole_solves() {
-        let (mut worst, mut stalled_rows): (f64, usize) = (0.0, 0);
+        let (mut worst, mut stalled_rows, mut clamped_rows): (f64, usize, usize) = (0.0, 0, 0);
         for e in std::iter::once(None).chain(crate::effects::ALL.iter().copied().map(Some)) {
             let mut m = preset("trum60a").unwrap();
             let mut params = Vec::new();
@@ -971,6 +971,20 @@ pub(crate) mod tests {
                     rows.push(ObservedRow { op, readings, ambient_c: 25.0 });
                 }
             }
+            // two rows where friction clamps the stator (W = 0), carried over as clamped
+            for &t in &[0.0, 0.3] {
+                let mut op = OperatingPoint::new(900.0, t, 200.0, 43e3);
+                op.elapsed_s = 600.0;
+                let s = crate::solve(&m, &op);
+                let readings = Observable::ALL
+                    .iter()
+                    .map(|&o| {
+                        let v = o.predict(&s, 25.0);
+                        (o, v * 1.01 + 0.01, o.default_sigma(v))
+                    })
+                    .collect();
+                rows.push(ObservedRow { op, readings, ambient_c: 25.0 });
+            }
             params.extend(baseline_params(&m, &rows));
             if let Some(e) = e {
                 params.extend(effect_params(e));
@@ -991,12 +1005,17 @@ pub(crate) mod tests {
                 let kept = solve_kept(&pb, &base, &r.op);
                 // the kept solve is the residuals' solve, bit for bit
                 assert_eq!(kept.solution, solve_prepared(&pb, &base, &r.op, None));
-                linear += usize::from(crate::sensitivity::linearise(&pb, &kept).is_some());
+                let carried = crate::sensitivity::linearise(&pb, &kept).is_some();
+                linear += usize::from(carried);
+                if kept.solution.status == Status::Clamped {
+                    clamped_rows += 1;
+                    assert!(carried, "{e:?}: a clamped row solved from scratch");
+                }
             }
             let stalled = rows.iter().filter(|r| crate::solve(&base, &r.op).status == Status::Stall).count();
-            // (12 rows; the eccentric motor's stalled row stops in a sector and is solved from
+            // (14 rows; the eccentric motor's stalled row stops in a sector and is solved from
             // scratch)
-            assert!(linear >= 11, "{e:?}: {linear} of {} rows linearised", rows.len());
+            assert!(linear >= 13, "{e:?}: {linear} of {} rows linearised", rows.len());
             stalled_rows += stalled;
             let j = residual_jacobian(&base, &moved, &steps, &rows, None);
             for k in 0..u.len() {
@@ -1014,8 +1033,11 @@ pub(crate) mod tests {
                 );
             }
         }
-        // stalled points are among those compared (4 stall in these 96 rows)
+        // stalled points are among those compared (4 stall in the 96 rows below 900 N), and
+        // clamped ones (two per motor, except where the effect lets the stator run at 900 N)
         assert!(stalled_rows >= 3, "{stalled_rows} stalled rows");
+        assert!(clamped_rows >= 12, "{clamped_rows} clamped rows");
+        eprintln!("{clamped_rows} clamped rows");
         eprintln!("worst relative column error {worst:.2e}");
     }
 

@@ -16,15 +16,19 @@
 //! O(h²) (the neglected curvature in z) plus the inner solves' tolerances; the test below
 //! checks whole Jacobian columns against central differences of from-scratch solves.
 //!
-//! Where the base point has no smooth steady state to linearise (clamped, no
-//! convergence, the rotor sticking in a sector of an eccentric revolution, I − Φ_z
-//! singular), or the change switches an iterated effect on or off, [`solve_near`] returns
-//! None and the caller solves from scratch.
+//! A clamped base point (W = 0) stays clamped for the changed motor, whose clamped state
+//! is a closed form: the descent that finds a stator clamped is not repeated per column
+//! (it was 30 % of a 1000-row diagnosis, docs/PERFORMANCE.md).
+//!
+//! Where the base point has no steady state to carry over (no convergence, the rotor
+//! sticking in a sector of an eccentric revolution, I − Φ_z singular), or the change
+//! switches an iterated effect on or off, [`solve_near`] returns None and the caller
+//! solves from scratch.
 
 use crate::params::Motor;
 use crate::solve::{
-    eccentric_average_with, finite_or_unconverged, iterated, map_solution, solve_effects, solve_prepared_with,
-    state_map, OperatingPoint, Prepared, Solution, Status, Trial,
+    eccentric_average_with, finite_or_unconverged, iterated, map_solution, solve_clamped, solve_effects,
+    solve_prepared_with, state_map, OperatingPoint, Prepared, Solution, Status, Trial,
 };
 use nalgebra::{Matrix3, Vector3};
 
@@ -116,9 +120,39 @@ impl Linear {
     }
 }
 
+/// One steady-state solve of a base point, carried over to nearby motors.
+enum Part {
+    /// A running or stalled state, linearised at its fixed point.
+    Smooth(Linear),
+    /// A clamped stator (W = 0, the only fixed point of the amplitude map): a slightly
+    /// changed motor is clamped too, and its clamped state is a closed form (with the
+    /// effects' fixed point on it, [`solve_clamped`]). Within a forward-difference step of
+    /// the clamping edge the changed motor would run instead; the whole solve then jumps
+    /// and has no derivative to give, and the clamped one-sided answer is kept. `active`:
+    /// the components the base iterates on (thermal, sag), as for [`Linear`].
+    Clamped { active: (bool, bool) },
+}
+
+impl Part {
+    fn at(p: &Prepared, op: &OperatingPoint, s: &Solution) -> Option<Part> {
+        if s.status == Status::Clamped {
+            Some(Part::Clamped { active: iterated(p, op) })
+        } else {
+            Linear::at(p, op, s).map(Part::Smooth)
+        }
+    }
+
+    fn eval(&self, p: &Prepared, op: &OperatingPoint) -> Option<Solution> {
+        match self {
+            Part::Smooth(l) => l.eval(p, op),
+            Part::Clamped { active } => (iterated(p, op) == *active).then(|| solve_clamped(p, op)),
+        }
+    }
+}
+
 /// A row's base steady state, linearised for nearby motors (see the module docs).
 pub(crate) struct Base {
-    parts: Vec<Linear>,
+    parts: Vec<Part>,
     eccentric: bool,
 }
 
@@ -147,11 +181,16 @@ pub(crate) fn solve_kept(p: &Prepared, motor: &Motor, op: &OperatingPoint) -> So
 /// sector.
 pub(crate) fn linearise(p: &Prepared, solved: &Solved) -> Option<Base> {
     let eccentric = p.runout_m > 0.0;
-    let ok = if eccentric { Status::Ok == solved.solution.status } else { solved.solution.status.is_valid() };
+    // an eccentric motor clamped at the nominal preload is that one solve (no ripple samples)
+    let ok = if eccentric {
+        solved.solution.status == Status::Ok || (solved.solution.status == Status::Clamped && solved.calls.len() == 1)
+    } else {
+        solved.solution.status.is_valid()
+    };
     if !ok || solved.calls.is_empty() {
         return None;
     }
-    let parts = solved.calls.iter().map(|(o, s)| Linear::at(p, o, s)).collect::<Option<Vec<_>>>()?;
+    let parts = solved.calls.iter().map(|(o, s)| Part::at(p, o, s)).collect::<Option<Vec<_>>>()?;
     Some(Base { parts, eccentric })
 }
 

@@ -883,13 +883,32 @@ fn lagrange_at(xy: &[(f64, f64)], x: f64) -> f64 {
 /// clamped …); the one consistent state lies between V and G(V) (210.1 V, moving). An
 /// unbounded secant on every pass (tried: 1.6× faster) left that interval.
 pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
+    solve_effects_with(p, op, guess, |d, g| solve_drive(p, d, op, g))
+}
+
+/// The clamped state of `p` at `op` (W = 0) with the effects' fixed point solved on it,
+/// without the amplitude descent that finds a stator clamped: what [`solve_effects`] returns
+/// where the stator clamps. For crate::sensitivity, which carries a clamped base state over
+/// to slightly changed motors (the descent to W = 0 is the costliest solve there is: 10-80
+/// trials).
+pub(crate) fn solve_clamped(p: &Prepared, op: &OperatingPoint) -> Solution {
+    solve_effects_with(p, op, None, |d, _| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0))
+}
+
+/// [`solve_effects`] with `drive(d, guess)` solving the amplitude under drive `d`.
+fn solve_effects_with(
+    p: &Prepared,
+    op: &OperatingPoint,
+    guess: Option<&Solution>,
+    drive: impl Fn(&Drive, Option<&Solution>) -> Solution,
+) -> Solution {
     let mut d = Drive::at(p, op);
     let (thermal, sag) = iterated(p, op);
     if !thermal && !sag {
-        return solve_drive(p, &d, op, guess);
+        return drive(&d, guess);
     }
     let mut rise = 0.0;
-    let mut s = solve_drive(p, &d, op, guess);
+    let mut s = drive(&d, guess);
     let mut settled = false;
     // (x, G(x)) of the previous pass, for the temperature rise and the electrode voltage
     let mut last_pass: Option<((f64, f64), (f64, f64))> = None;
@@ -936,7 +955,7 @@ pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&So
             d.warm(p, rise);
         }
         let prev = s.clone();
-        s = solve_drive(p, &d, op, Some(&prev).filter(|g| g.status.is_valid()));
+        s = drive(&d, Some(&prev).filter(|g| g.status.is_valid()));
         if done {
             settled = true;
             break;
@@ -1767,6 +1786,41 @@ mod tests {
             }
         }
         assert!(stalled > 500 && moving > 500, "{stalled} stalled, {moving} moving trials");
+    }
+
+    /// Where the descent finds the stator clamped, the clamped state's closed form (with the
+    /// effects' fixed point on it) is that solution: crate::sensitivity carries clamped rows
+    /// over with it. Every effect at its typical strength, preloads from the clamping edge
+    /// up, elapsed time on (thermal drift iterates).
+    #[test]
+    fn clamped_closed_form_is_the_clamped_solve() {
+        let mut clamped = 0;
+        for e in std::iter::once(None).chain(crate::effects::ALL.iter().copied().map(Some)) {
+            let mut m = crate::presets::preset("trum60a").expect("preset");
+            if let Some(e) = e {
+                let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
+                m.effects.set(e, &typical);
+            }
+            let p = Prepared::new(&m);
+            for &f in &[700.0, 800.0, 1200.0] {
+                for &t in &[0.0, 0.4] {
+                    let mut op = OperatingPoint::new(f, t, 200.0, 43e3);
+                    op.elapsed_s = 600.0;
+                    let s = solve_effects(&p, &op, None);
+                    if s.status != Status::Clamped {
+                        continue;
+                    }
+                    clamped += 1;
+                    let c = solve_clamped(&p, &op);
+                    assert_eq!(c.status, Status::Clamped);
+                    for q in crate::quantities::QUANTITIES {
+                        let (a, b) = ((q.get)(&c), (q.get)(&s));
+                        assert!((a - b).abs() <= 1e-10 * b.abs().max(1e-12), "{e:?} {op:?} {}: {a} vs {b}", q.name);
+                    }
+                }
+            }
+        }
+        assert!(clamped >= 30, "{clamped} clamped points");
     }
 
     /// The motor `name` with the effect assignments `fx` ("a=1;b:x=2,y=3") in candidate or
