@@ -337,7 +337,7 @@ fn motor_at(base: &Motor, params: &[FitParam], u: &DVector<f64>) -> Motor {
 /// Normalised residuals (prediction − measurement)/σ of every reading of `rows`, in
 /// order; a point the model cannot solve contributes a large residual (50 σ).
 pub fn residuals(motor: &Motor, rows: &[ObservedRow]) -> Vec<f64> {
-    let p = Prepared::new(motor);
+    let p = Prepared::new(motor).without_stall_torque();
     // cold starts, as in `Problem::pass_at`
     per_row(rows, |r| row_residuals(r, &solve_prepared(&p, motor, &r.op, None)))
 }
@@ -380,8 +380,9 @@ pub(crate) fn residual_jacobian(
     solved: Option<&[Solved]>,
 ) -> DMatrix<f64> {
     let n = moved.len();
-    let pb = Prepared::new(base);
-    let pm: Vec<Prepared> = moved.iter().map(Prepared::new).collect();
+    // (residuals read only the observables: no stall-torque integral)
+    let pb = Prepared::new(base).without_stall_torque();
+    let pm: Vec<Prepared> = moved.iter().map(|m| Prepared::new(m).without_stall_torque()).collect();
     // (row, its base solves when the caller has them)
     let one = |&(r, known): &(&ObservedRow, Option<&Solved>)| -> Vec<f64> {
         let kept;
@@ -470,7 +471,7 @@ impl<'a> Problem<'a> {
         if self.last.borrow().as_ref().is_none_or(|p| &p.u != u) {
             self.evals.set(self.evals.get() + 1);
             let m = self.motor_at(u);
-            let p = Prepared::new(&m);
+            let p = Prepared::new(&m).without_stall_torque();
             // Cold starts: a warm start from a neighbouring row could settle on another fixed
             // point where the amplitude map has several, and the fit must see one model.
             let solved = per_row(self.rows, |r| vec![solve_kept(&p, &m, &r.op)]);
@@ -999,12 +1000,12 @@ pub(crate) mod tests {
             let moved: Vec<Motor> = (0..u.len()).map(|k| at(k, steps[k])).collect();
             let base = motor_at(&m, &params, &u);
             // the linearised route, not the from-scratch fallback, is what is compared
-            let pb = Prepared::new(&base);
+            let pb = Prepared::new(&base).without_stall_torque();
             let mut linear = 0;
             for r in &rows {
                 let kept = solve_kept(&pb, &base, &r.op);
-                // the kept solve is the residuals' solve, bit for bit
-                assert_eq!(kept.solution, solve_prepared(&pb, &base, &r.op, None));
+                // the kept solve is the residuals' solve, bit for bit (Debug: NaN stall torque)
+                assert_eq!(format!("{:?}", kept.solution), format!("{:?}", solve_prepared(&pb, &base, &r.op, None)));
                 let carried = crate::sensitivity::linearise(&pb, &kept).is_some();
                 linear += usize::from(carried);
                 if kept.solution.status == Status::Clamped {

@@ -191,7 +191,7 @@ fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
 
 /// Predictions of `motor` for `rows` (NaN where the model has no solution).
 fn predict(motor: &Motor, rows: &[&ObservedRow]) -> Vec<Vec<f64>> {
-    let p = Prepared::new(motor);
+    let p = Prepared::new(motor).without_stall_torque();
     rows.iter()
         .map(|r| {
             let s = solve_prepared(&p, motor, &r.op, None);

@@ -219,5 +219,5 @@ pub(crate) fn solve_near(base: &Base, p: &Prepared, motor: &Motor, op: &Operatin
     } else {
         base.parts[0].eval(p, op)?
     };
-    Some(finite_or_unconverged(s))
+    Some(finite_or_unconverged(p, s))
 }
