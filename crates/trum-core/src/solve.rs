@@ -313,12 +313,8 @@ impl Prepared {
     /// True when every quantity `s` reports is a number (the stall torque excepted where
     /// it is not computed).
     fn all_finite(&self, s: &Solution) -> bool {
-        let finite = |s: &Solution| crate::quantities::QUANTITIES.iter().all(|q| (q.get)(s).is_finite());
-        if self.stall_torque || !s.stall_torque_nm.is_nan() {
-            finite(s)
-        } else {
-            finite(&Solution { stall_torque_nm: 0.0, ..s.clone() })
-        }
+        let skip = !self.stall_torque && s.stall_torque_nm.is_nan();
+        crate::quantities::QUANTITIES.iter().all(|q| (skip && q.name == "stall_torque_nm") || (q.get)(s).is_finite())
     }
 }
 
