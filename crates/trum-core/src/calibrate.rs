@@ -956,26 +956,8 @@ pub(crate) mod tests {
                 let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
                 m.effects.set(e, &typical);
             }
-            let mut rows = Vec::new();
-            for (i, &f) in [120.0, 250.0, 380.0].iter().enumerate() {
-                for &t in &[0.0, 0.3, 0.6, 0.9] {
-                    let mut op = OperatingPoint::new(f, t, 200.0, 43e3 - 250.0 * i as f64);
-                    op.elapsed_s = 300.0 * (1 + i) as f64;
-                    let s = crate::solve(&m, &op);
-                    let readings = Observable::ALL
-                        .iter()
-                        .map(|&o| {
-                            let v = o.predict(&s, 25.0);
-                            (o, v * 1.01 + 0.01, o.default_sigma(v))
-                        })
-                        .collect();
-                    rows.push(ObservedRow { op, readings, ambient_c: 25.0 });
-                }
-            }
-            // two rows where friction clamps the stator (W = 0), carried over as clamped
-            for &t in &[0.0, 0.3] {
-                let mut op = OperatingPoint::new(900.0, t, 200.0, 43e3);
-                op.elapsed_s = 600.0;
+            // every observable read at `op`, 1 % and 0.01 off the model
+            let observed = |op: OperatingPoint| {
                 let s = crate::solve(&m, &op);
                 let readings = Observable::ALL
                     .iter()
@@ -984,7 +966,21 @@ pub(crate) mod tests {
                         (o, v * 1.01 + 0.01, o.default_sigma(v))
                     })
                     .collect();
-                rows.push(ObservedRow { op, readings, ambient_c: 25.0 });
+                ObservedRow { op, readings, ambient_c: 25.0 }
+            };
+            let mut rows = Vec::new();
+            for (i, &f) in [120.0, 250.0, 380.0].iter().enumerate() {
+                for &t in &[0.0, 0.3, 0.6, 0.9] {
+                    let mut op = OperatingPoint::new(f, t, 200.0, 43e3 - 250.0 * i as f64);
+                    op.elapsed_s = 300.0 * (1 + i) as f64;
+                    rows.push(observed(op));
+                }
+            }
+            // two rows where friction clamps the stator (W = 0), carried over as clamped
+            for &t in &[0.0, 0.3] {
+                let mut op = OperatingPoint::new(900.0, t, 200.0, 43e3);
+                op.elapsed_s = 600.0;
+                rows.push(observed(op));
             }
             params.extend(baseline_params(&m, &rows));
             if let Some(e) = e {
