@@ -655,6 +655,31 @@ pub(crate) fn calibrate_adding(
     opts: &FitOptions,
     added: &[Effect],
 ) -> Result<Calibration, TrumError> {
+    fit(motor, rows, params, opts, added, None)
+}
+
+/// [`calibrate`] with the Huber weights fixed at `weights` (one per reading, in row order):
+/// one least-squares pass, no reweighting. A leave-block-out refit of a weighted fit
+/// (the diagnosis's approximate cross-validation, where its first-order step moved far)
+/// keeps the full-data fit's weights on its training readings, as the step does.
+pub(crate) fn calibrate_weighted(
+    motor: &Motor,
+    rows: &[ObservedRow],
+    params: &[FitParam],
+    opts: &FitOptions,
+    weights: Vec<f64>,
+) -> Result<Calibration, TrumError> {
+    fit(motor, rows, params, opts, &[], Some(weights))
+}
+
+fn fit(
+    motor: &Motor,
+    rows: &[ObservedRow],
+    params: &[FitParam],
+    opts: &FitOptions,
+    added: &[Effect],
+    fixed_weights: Option<Vec<f64>>,
+) -> Result<Calibration, TrumError> {
     let n_read: usize = rows.iter().map(|r| r.readings.len()).sum();
     if params.is_empty() {
         return Err(TrumError::input("no parameters to fit: name at least one"));
@@ -679,6 +704,16 @@ pub(crate) fn calibrate_adding(
         .map(|(k, _)| k)
         .collect();
     let mut problem = Problem::new(motor, rows, params, u0, off.clone());
+    let irls_passes = match fixed_weights {
+        Some(w) if w.len() == n_read => {
+            problem.set_weights(w);
+            0
+        }
+        Some(w) => {
+            return Err(TrumError::input(format!("{} weights for {n_read} readings", w.len())));
+        }
+        None => opts.irls_passes,
+    };
     // The crate's patience bounds its own residual evaluations at patience·(n + 1); with
     // forward-difference Jacobians of n + 1 whole passes per accepted step, patience =
     // budget/(n + 1)² kept the total near the budget. The linearised Jacobian costs about two
@@ -695,7 +730,7 @@ pub(crate) fn calibrate_adding(
     let mut warnings = Vec::new();
     let mut last = None;
     let mut abandoned = false;
-    for pass in 0..=opts.irls_passes {
+    for pass in 0..=irls_passes {
         let (p, report) = lm_pass(problem, opts);
         problem = p;
         // a stop on the Gauss–Newton decrement is convergence (the crate calls it a user stop)
@@ -709,7 +744,7 @@ pub(crate) fn calibrate_adding(
             abandoned = true;
             break;
         }
-        if pass < opts.irls_passes {
+        if pass < irls_passes {
             // Huber weights from the current unweighted residuals.
             let r = problem.pass_at(&problem.u).raw.clone();
             let w: Vec<f64> =
@@ -857,6 +892,39 @@ pub(crate) mod tests {
         // χ² itself, and the fit stops once that is below the decrement tolerance
         assert!(cal.chi2 < FIT_DECREMENT_TOL, "{}", cal.chi2);
         assert!(cal.warnings.is_empty(), "{:?}", cal.warnings);
+    }
+
+    /// A fixed-weight fit keeps the weights it was given (no reweighting pass), refits to
+    /// the weighted optimum from a perturbed start, and is the unweighted fit when the
+    /// weights are all one; a weight vector of the wrong length is an input error.
+    #[test]
+    fn a_fixed_weight_fit_keeps_its_weights() {
+        let truth = preset("trum60a").unwrap();
+        let mut rows = rows_from(&truth);
+        // one gross outlier: the reweighted fit downweights it, a fixed-weight fit cannot
+        rows[5].readings[0].1 *= 1.5;
+        let mut start = truth.clone();
+        start.friction_layer.friction_coefficient *= 1.3;
+        let params = vec![
+            fit_rel(&start, "friction_layer.friction_coefficient", 0.3, 3.0),
+            fit_rel(&start, "stator.modal_damping_ns_per_m", 0.2, 5.0),
+        ];
+        let opts = FitOptions::default();
+        let n: usize = rows.iter().map(|r| r.readings.len()).sum();
+        let huber = calibrate(&start, &rows, &params, &opts).unwrap();
+        assert!(huber.lin.weights.iter().any(|&w| w < 0.5), "the outlier was not downweighted");
+        let fixed = calibrate_weighted(&start, &rows, &params, &opts, huber.lin.weights.clone()).unwrap();
+        assert_eq!(fixed.lin.weights, huber.lin.weights);
+        // the same weighted problem: the same optimum
+        let mu = |c: &Calibration| c.motor.friction_layer.friction_coefficient;
+        assert!((mu(&fixed) / mu(&huber) - 1.0).abs() < 1e-4, "{} vs {}", mu(&fixed), mu(&huber));
+        // unit weights: the plain least-squares fit, which the outlier pulls further
+        let ones = calibrate_weighted(&start, &rows, &params, &opts, vec![1.0; n]).unwrap();
+        let plain = calibrate(&start, &rows, &params, &FitOptions { irls_passes: 0, ..opts.clone() }).unwrap();
+        assert!((ones.chi2 / plain.chi2 - 1.0).abs() < 1e-9, "{} vs {}", ones.chi2, plain.chi2);
+        assert!(ones.chi2 < fixed.chi2, "unweighted χ²: {} (fit to it) vs {}", ones.chi2, fixed.chi2);
+        let short = calibrate_weighted(&start, &rows, &params, &opts, vec![1.0; n - 1]);
+        assert!(short.is_err_and(|e| e.to_string().contains("weights")));
     }
 
     /// An added effect the data do not contain collapses onto the nested model (abandoned,

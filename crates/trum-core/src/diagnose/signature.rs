@@ -9,7 +9,9 @@
 //! switched on at a tenth of its typical strength, then each further parameter doubled), the
 //! signature is S̃ = (I − J J⁺) S, the part of S orthogonal to what refitting the other
 //! parameters already does. Linearised, adding the effect lowers χ² by ‖P_S̃ r‖², the
-//! projection of r onto the span of S̃ (Rao's score statistic for a least-squares model).
+//! projection of r onto the span of S̃ (Rao's score statistic for a least-squares model),
+//! one-sided for an effect whose strength is bounded below by off: a residual that only a
+//! negative strength would remove is no evidence for the effect.
 
 use super::pseudo_inverse;
 use crate::calibrate::{residuals, Calibration, ObservedRow};
@@ -24,7 +26,8 @@ const PROBE: f64 = 0.1;
 pub(crate) struct Signature {
     /// S̃: one column per effect parameter, rows in reading order (weighted σ units).
     pub(crate) columns: DMatrix<f64>,
-    /// ‖P_S̃ r‖²: the χ² the effect removes to first order.
+    /// ‖P_S̃ r‖²: the χ² the effect removes to first order, at a strength no lower than
+    /// off (one-sided: zero for a one-parameter effect the residual would need negative).
     pub(crate) linear_chi2_drop: f64,
     /// cos(r, −S̃₀): +1 when the residual is exactly what the effect's primary parameter
     /// (raised from the fit's value) removes, −1 when it would need the opposite sign.
@@ -65,12 +68,35 @@ pub(crate) fn signature(cal: &Calibration, rows: &[ObservedRow], e: Effect) -> O
     }
     let j = &cal.lin.jacobian;
     let st = &s - j * (pseudo_inverse(&(j.transpose() * j)) * (j.transpose() * &s));
-    let g = st.transpose() * r;
-    let linear_chi2_drop = (g.transpose() * pseudo_inverse(&(st.transpose() * &st)) * &g)[(0, 0)].max(0.0);
+    let linear_chi2_drop = one_sided_drop(&st, r, info.params[0].min >= 0.0);
     let s0 = st.column(0);
     let denom = s0.norm() * r.norm();
     let matched = if denom > 0.0 { -s0.dot(r) / denom } else { 0.0 };
     Some(Signature { columns: st, linear_chi2_drop, matched })
+}
+
+/// min over a of ‖r + S̃a‖² subtracted from ‖r‖²: the χ² the columns remove to first order.
+/// With `bounded` the primary coefficient a₀ must be ≥ 0 (an effect whose strength cannot
+/// go below off): when the unconstrained a₀ is negative the constrained minimum lies on
+/// a₀ = 0 (one inequality on a convex quadratic), and only the other columns remove
+/// anything (nothing for a one-parameter effect). Without the bound a fit would be screened
+/// in on a residual only a negative strength removes, and collapse onto the model it nests.
+fn one_sided_drop(st: &DMatrix<f64>, r: &DVector<f64>, bounded: bool) -> f64 {
+    let drop = |s: &DMatrix<f64>| -> (f64, f64) {
+        if s.ncols() == 0 {
+            return (0.0, 0.0);
+        }
+        let g = s.transpose() * r;
+        let h = pseudo_inverse(&(s.transpose() * s));
+        let a0 = -(h.row(0) * &g)[(0, 0)];
+        ((g.transpose() * h * &g)[(0, 0)].max(0.0), a0)
+    };
+    let (full, a0) = drop(st);
+    if bounded && a0 < 0.0 {
+        drop(&st.columns(1, st.ncols() - 1).into_owned()).0
+    } else {
+        full
+    }
 }
 
 /// |cos| of the angle between two signatures' primary columns: 1 when the data see the two
@@ -136,5 +162,77 @@ mod tests {
         assert!((overlap(&sig, &sig) - 1.0).abs() < 1e-12);
         let (ab, ba) = (overlap(&sig, &other), overlap(&other, &sig));
         assert!((ab - ba).abs() < 1e-12 && (0.0..=1.0).contains(&ab), "{ab}");
+    }
+
+    /// The one-sided drop against a scan: min over a₀ ≥ 0 (a grid) of the residual with the
+    /// other coefficient at its least-squares value for that a₀. Equal to the two-sided
+    /// projection when the free optimum has a₀ ≥ 0, smaller otherwise, zero for one column.
+    #[test]
+    fn the_one_sided_drop_is_the_constrained_minimum() {
+        let n = 30;
+        let col = |f: &dyn Fn(f64) -> f64| DVector::from_iterator(n, (0..n).map(|i| f(i as f64 / n as f64)));
+        let st = DMatrix::from_columns(&[col(&|x| x * x - 0.3), col(&|x| (3.0 * x).sin())]);
+        let scan = |r: &DVector<f64>| -> f64 {
+            let (s0, s1) = (st.column(0), st.column(1));
+            let best = (0..=20000)
+                .map(|i| {
+                    let a0 = i as f64 * 1e-3;
+                    let rr = r + s0 * a0;
+                    let a1 = -s1.dot(&rr) / s1.dot(&s1);
+                    (rr + s1 * a1).norm_squared()
+                })
+                .fold(f64::INFINITY, f64::min);
+            r.norm_squared() - best
+        };
+        let noise = col(&|x| 0.05 * (17.0 * x).cos());
+        for sign in [1.0, -1.0] {
+            // a residual that a₀ = ∓4 (with some a₁) removes, plus a part neither column has
+            let r = (st.column(0) * (-4.0 * sign) + st.column(1) * 0.7) + &noise;
+            let bounded = one_sided_drop(&st, &r, true);
+            let free = one_sided_drop(&st, &r, false);
+            assert!((bounded - scan(&r)).abs() < 1e-6 * free, "{sign}: {bounded} vs scan {}", scan(&r));
+            if sign > 0.0 {
+                assert!((bounded - free).abs() < 1e-9 * free, "{bounded} vs {free}");
+            } else {
+                assert!(bounded < 0.5 * free, "{bounded} vs {free}");
+            }
+            let one = st.columns(0, 1).into_owned();
+            let single = one_sided_drop(&one, &r, true);
+            assert!(if sign > 0.0 { single > 0.5 * free } else { single == 0.0 }, "{sign}: {single}");
+        }
+    }
+
+    /// Data the calibrated baseline misses the opposite way from voltage sag (readings
+    /// mirrored about the baseline model: sag would have to be a negative resistance) carry
+    /// no evidence for it, while sag's own data do.
+    #[test]
+    fn a_residual_only_a_negative_strength_removes_is_no_evidence() {
+        let nominal = preset("trum60a").unwrap();
+        let mut sag = nominal.clone();
+        sag.effects.set(Effect::VoltageSag, &[300.0]);
+        let with = rows_of(&sag);
+        let base_rows = rows_of(&nominal);
+        let mirrored: Vec<ObservedRow> = base_rows
+            .iter()
+            .zip(&with)
+            .map(|(b, s)| {
+                let mut r = b.clone();
+                for (x, y) in r.readings.iter_mut().zip(&s.readings) {
+                    x.1 = 2.0 * x.1 - y.1;
+                }
+                r
+            })
+            .collect();
+        let fit = FitOptions::default();
+        let score = |rows: &[ObservedRow]| {
+            let base = calibrate(&nominal, rows, &baseline_params(&nominal, rows), &fit).unwrap();
+            let s = signature(&base, rows, Effect::VoltageSag).unwrap();
+            (s.linear_chi2_drop, s.matched, base.chi2)
+        };
+        let (drop, matched, chi2) = score(&with);
+        assert!(matched > 0.5 && drop > 0.5 * chi2, "sag data: drop {drop} of χ² {chi2}, match {matched}");
+        let (drop, matched, chi2) = score(&mirrored);
+        assert!(chi2 > 100.0, "the mirrored data are missed: χ² {chi2}");
+        assert!(matched < -0.5 && drop == 0.0, "mirrored: drop {drop}, match {matched}");
     }
 }
