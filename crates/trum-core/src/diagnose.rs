@@ -248,16 +248,28 @@ fn approx_cv(cal: &Calibration, rows: &[ObservedRow], folds: &[usize], k: usize,
             DVector::from_iterator(r.len(), r.iter().zip(&w).map(|(x, w)| x * w))
         };
         let mut r = DVector::from_iterator(idx.len(), idx.iter().map(|&j| lin.residuals[j]));
-        let (mut u, mut best) = (lin.u.clone(), (lin.u.clone(), r.norm_squared()));
+        let mut best = (lin.u.clone(), r.norm_squared());
         for _ in 0..2 {
             let step = &hinv * (jt.transpose() * &r);
             // a step that leaves the region where the linearisation holds is cut back
             let big = step.amax();
-            u -= if big > 2.0 { step * (2.0 / big) } else { step };
-            r = weighted(&u);
-            if r.norm_squared() < best.1 {
-                best = (u.clone(), r.norm_squared());
-            }
+            let full = if big > 2.0 { step * (2.0 / big) } else { step };
+            // Damped: a step whose actual gain on the training χ² is below a quarter of what
+            // the linear model predicts for it (it overshoots, or crosses a row's change of
+            // status, moving to clamped) is halved, up to twice (the trust-region
+            // acceptance ratio ρ ≥ ¼). Undamped, a failed step left the fold with the
+            // full-data fit, and its held-out block was predicted in-sample.
+            let taken = (0..3).find_map(|h| {
+                let du = &full * 0.5f64.powi(h);
+                let ut = &best.0 - &du;
+                let rt = weighted(&ut);
+                let predicted = best.1 - (&r - &jt * &du).norm_squared();
+                let actual = best.1 - rt.norm_squared();
+                (actual > 0.0 && actual >= 0.25 * predicted).then_some((ut, rt))
+            });
+            let Some((ut, rt)) = taken else { break };
+            best = (ut, rt.norm_squared());
+            r = rt;
         }
         let moved = (&best.0 - &lin.u).amax();
         let fitted = if moved > 0.3 {
@@ -1052,12 +1064,51 @@ mod tests {
         }
     }
 
-    #[test]
-    fn approximate_and_exact_block_cross_validation_agree() {
+    /// The nominal trum60a and seeded preload-torque data of it with voltage sag (300 Ω).
+    fn sag_data() -> (Motor, Vec<ObservedRow>, Vec<String>) {
         let mut m = preset("trum60a").expect("preset");
         m.effects.set_strength(Effect::VoltageSag, 300.0);
         let (rows, groups) = data(&m, 1.0, 11);
-        let nominal = preset("trum60a").expect("preset");
+        (preset("trum60a").expect("preset"), rows, groups)
+    }
+
+    /// A fold step that overshoots is halved until the training fit improves, not dropped:
+    /// with the Jacobian four times too small the full step is four times too long, and the
+    /// damped route still removes the held-out block's influence (predictions as with the
+    /// right Jacobian), where dropping the step left the full-data fit, predicting the
+    /// held-out block in-sample.
+    #[test]
+    fn an_overshooting_fold_step_is_damped_not_dropped() {
+        let (nominal, rows, _) = sag_data();
+        let fit = FitOptions::default();
+        let (s0, params) = fit_params(&nominal, &nominal, &rows, &[], false);
+        let cal = calibrate(&s0, &rows, &params, &fit).expect("baseline");
+        // folds by preload, so each held-out block moves the parameters
+        let mut loads: Vec<f64> = rows.iter().map(|r| r.op.preload_n).collect();
+        loads.sort_by(f64::total_cmp);
+        loads.dedup();
+        let folds: Vec<usize> =
+            rows.iter().map(|r| loads.iter().position(|&l| l == r.op.preload_n).unwrap_or(0) % 4).collect();
+        let right = approx_cv(&cal, &rows, &folds, 4, &fit).preds;
+        let mut short = cal.clone();
+        short.lin.jacobian *= 0.25;
+        let damped = approx_cv(&short, &rows, &folds, 4, &fit).preds;
+        let all: Vec<&ObservedRow> = rows.iter().collect();
+        let in_sample = predict(&cal.motor, &all);
+        // largest difference in units of the readings' σ
+        let sigmas: Vec<f64> = rows.iter().flat_map(|r| r.readings.iter().map(|x| x.2)).collect();
+        let gap = |a: &[Vec<f64>], b: &[Vec<f64>]| {
+            let d = a.iter().flatten().zip(b.iter().flatten()).zip(&sigmas).map(|((x, y), s)| ((x - y) / s).abs());
+            d.fold(0.0, f64::max)
+        };
+        let moved = gap(&right, &in_sample);
+        assert!(moved > 0.3, "the held-out blocks do not move the fit: {moved} σ");
+        assert!(gap(&damped, &right) < 0.2 * moved, "damped {} vs held-out shift {moved}", gap(&damped, &right));
+    }
+
+    #[test]
+    fn approximate_and_exact_block_cross_validation_agree() {
+        let (nominal, rows, groups) = sag_data();
         let a = diagnose(&nominal, &rows, &groups, &quick(false)).expect("approximate");
         let e = diagnose(&nominal, &rows, &groups, &quick(true)).expect("exact");
         // the refit step is first-order: held-out errors within 10 %, same verdict
