@@ -236,7 +236,7 @@ const FIT_CHI2_TOL: f64 = 1e-4;
 /// data the last 5-50 % of a fit's passes each removed less than this (the flat tail of a
 /// converged fit, which FIT_CHI2_TOL alone lets run on), and a crawl along a shallow
 /// valley keeps a large decrement.
-const FIT_DECREMENT_TOL: f64 = 1e-2;
+pub(crate) const FIT_DECREMENT_TOL: f64 = 1e-2;
 
 /// Options of a fit.
 #[derive(Clone, Debug, PartialEq)]

@@ -110,6 +110,10 @@ pub struct RankEntry {
     pub linear_chi2_drop: Option<f64>,
     /// |cos| between this effect's signature and the verdict's (1: the data see one shape).
     pub signature_overlap: Option<f64>,
+    /// Cross-validation folds whose refit could not be moved off this fit's full-data
+    /// optimum, so their held-out blocks were predicted in-sample (the held-out figures are
+    /// then optimistic; 0 with exact CV, and for an entry its nested model stands in for).
+    pub heldout_in_sample_folds: usize,
 }
 
 /// The diagnosis.
@@ -207,6 +211,10 @@ fn predict(motor: &Motor, rows: &[&ObservedRow]) -> Vec<Vec<f64>> {
 struct CvResult {
     /// held-out predictions aligned with rows/readings
     preds: Vec<Vec<f64>>,
+    /// folds whose fit could not be moved off the full-data fit (approximate CV: even the
+    /// damped first step raised the training χ²), so their held-out blocks were predicted
+    /// in-sample
+    in_sample: usize,
 }
 
 /// Approximate leave-block-out refits. From the full-data optimum û (where the gradient
@@ -232,6 +240,7 @@ fn approx_cv(cal: &Calibration, rows: &[ObservedRow], folds: &[usize], k: usize,
         offset.push(offset.last().copied().unwrap_or(0) + r.readings.len());
     }
     let mut preds: Vec<Vec<f64>> = rows.iter().map(|r| vec![f64::NAN; r.readings.len()]).collect();
+    let mut in_sample = 0;
     for f in 0..k {
         let test: Vec<usize> = (0..rows.len()).filter(|&i| folds[i] == f).collect();
         if test.is_empty() {
@@ -249,7 +258,7 @@ fn approx_cv(cal: &Calibration, rows: &[ObservedRow], folds: &[usize], k: usize,
         };
         let mut r = DVector::from_iterator(idx.len(), idx.iter().map(|&j| lin.residuals[j]));
         let mut best = (lin.u.clone(), r.norm_squared());
-        for _ in 0..2 {
+        for iteration in 0..2 {
             let step = &hinv * (jt.transpose() * &r);
             // a step that leaves the region where the linearisation holds is cut back
             let big = step.amax();
@@ -267,7 +276,15 @@ fn approx_cv(cal: &Calibration, rows: &[ObservedRow], folds: &[usize], k: usize,
                 let actual = best.1 - rt.norm_squared();
                 (actual > 0.0 && actual >= 0.25 * predicted).then_some((ut, rt))
             });
-            let Some((ut, rt)) = taken else { break };
+            let Some((ut, rt)) = taken else {
+                // stuck at the full-data fit, though the held-out block moves the training
+                // optimum (the first step promised a gain a fit would not stop short of)
+                let promised = best.1 - (&r - &jt * &full).norm_squared();
+                if iteration == 0 && promised >= crate::calibrate::FIT_DECREMENT_TOL {
+                    in_sample += 1;
+                }
+                break;
+            };
             best = (ut, rt.norm_squared());
             r = rt;
         }
@@ -283,7 +300,7 @@ fn approx_cv(cal: &Calibration, rows: &[ObservedRow], folds: &[usize], k: usize,
             preds[*i] = p;
         }
     }
-    CvResult { preds }
+    CvResult { preds, in_sample }
 }
 
 /// Moore–Penrose inverse of a small symmetric normal matrix; directions the training data
@@ -380,7 +397,7 @@ fn cross_validate(
             preds[*i] = p;
         }
     }
-    CvResult { preds }
+    CvResult { preds, in_sample: 0 }
 }
 
 /// Normalised held-out errors: (NRMSE with the quantity scales, mean squared residual in σ,
@@ -580,6 +597,7 @@ pub fn diagnose(
                 signature_match: None,
                 linear_chi2_drop: None,
                 signature_overlap: None,
+                heldout_in_sample_folds: 0,
             };
             return (entry, base_cv.preds.clone(), None);
         }
@@ -609,6 +627,7 @@ pub fn diagnose(
                 }
             }
         }
+        let mut in_sample = 0;
         let (evidence, fitted, preds, fitted_motor) = match cal {
             // Nested models: the effect at zero strength is the baseline, so a fit that ends
             // worse than the baseline's χ² is a local minimum; the baseline stands in for it.
@@ -617,12 +636,13 @@ pub fn diagnose(
             // better.) A fit abandoned as collapsing onto its nested model (for a pair, the
             // lead's fit) is that model.
             Ok(c) if !c.abandoned && (c.chi2 <= base_cal.chi2 || opts.exact_cv) => {
-                let preds = if opts.exact_cv {
-                    cross_validate(motor, &start, rows, &folds, k, effects, opts, reduced).preds
+                let cv = if opts.exact_cv {
+                    cross_validate(motor, &start, rows, &folds, k, effects, opts, reduced)
                 } else {
-                    approx_cv(&c, rows, &folds, k, &opts.fit).preds
+                    approx_cv(&c, rows, &folds, k, &opts.fit)
                 };
-                (0.5 * (base_bic - bic(c.chi2.min(base_cal.chi2), kpar)), c.params.clone(), preds, Some(c))
+                in_sample = cv.in_sample;
+                (0.5 * (base_bic - bic(c.chi2.min(base_cal.chi2), kpar)), c.params.clone(), cv.preds, Some(c))
             }
             Ok(c) if !c.abandoned => {
                 let zero = c.params.into_iter().map(|p| FittedParam { value: 0.0, ..p }).collect();
@@ -654,6 +674,7 @@ pub fn diagnose(
             signature_match: single_sig(effects).map(|s| s.matched),
             linear_chi2_drop: single_sig(effects).map(|s| s.linear_chi2_drop),
             signature_overlap: None,
+            heldout_in_sample_folds: in_sample,
         };
         (entry, preds, fitted_motor)
     };
@@ -876,6 +897,18 @@ pub fn diagnose(
         ));
     }
     notes.extend(screened_note);
+    // held-out figures that rest partly on in-sample predictions
+    let stuck: Vec<String> = std::iter::once(("the calibrated baseline".to_string(), base_cv.in_sample))
+        .chain(ranking.iter().map(|r| (r.effect.clone(), r.heldout_in_sample_folds)))
+        .filter(|(_, n)| *n > 0)
+        .map(|(name, n)| format!("{name} in {n} of {k}"))
+        .collect();
+    if !stuck.is_empty() {
+        notes.push(format!(
+            "held-out blocks predicted in-sample, so these held-out figures are optimistic: {} folds (the fold's fit could not be moved off the full-data fit: even a quarter of the first-order step raised the training χ², as where a row changes between moving and clamped)",
+            stuck.join(", ")
+        ));
+    }
     if reduced && verdict != "none" {
         notes.push(format!("with so few readings the verdict '{verdict}' is tentative; measure more operating points"));
     }
@@ -1089,10 +1122,14 @@ mod tests {
         loads.dedup();
         let folds: Vec<usize> =
             rows.iter().map(|r| loads.iter().position(|&l| l == r.op.preload_n).unwrap_or(0) % 4).collect();
-        let right = approx_cv(&cal, &rows, &folds, 4, &fit).preds;
+        let right = approx_cv(&cal, &rows, &folds, 4, &fit);
+        assert_eq!(right.in_sample, 0);
+        let right = right.preds;
         let mut short = cal.clone();
         short.lin.jacobian *= 0.25;
-        let damped = approx_cv(&short, &rows, &folds, 4, &fit).preds;
+        let damped = approx_cv(&short, &rows, &folds, 4, &fit);
+        assert_eq!(damped.in_sample, 0);
+        let damped = damped.preds;
         let all: Vec<&ObservedRow> = rows.iter().collect();
         let in_sample = predict(&cal.motor, &all);
         // largest difference in units of the readings' σ
@@ -1104,6 +1141,12 @@ mod tests {
         let moved = gap(&right, &in_sample);
         assert!(moved > 0.3, "the held-out blocks do not move the fit: {moved} σ");
         assert!(gap(&damped, &right) < 0.2 * moved, "damped {} vs held-out shift {moved}", gap(&damped, &right));
+        // 64 times too long: even a quarter of it overshoots, the folds keep the full-data
+        // fit and say so
+        short.lin.jacobian *= 1.0 / 16.0;
+        let stuck = approx_cv(&short, &rows, &folds, 4, &fit);
+        assert_eq!(stuck.in_sample, 4);
+        assert!(gap(&stuck.preds, &in_sample) < 1e-9, "{}", gap(&stuck.preds, &in_sample));
     }
 
     #[test]

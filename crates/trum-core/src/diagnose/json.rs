@@ -68,6 +68,7 @@ pub fn to_json(d: &Diagnosis, src: &Provenance<'_>) -> Value {
             "signature_match": r.signature_match.map(num),
             "linear_chi2_drop": r.linear_chi2_drop.map(num),
             "signature_overlap": r.signature_overlap.map(num),
+            "heldout_in_sample_folds": r.heldout_in_sample_folds,
         })).collect::<Vec<_>>(),
         "evidence_scale": EVIDENCE_SCALE,
         "notes": d.notes,
