@@ -29,6 +29,9 @@ pub(crate) struct Signature {
     /// ‖P_S̃ r‖²: the χ² the effect removes to first order, at a strength no lower than
     /// off (one-sided: zero for a one-parameter effect the residual would need negative).
     pub(crate) linear_chi2_drop: f64,
+    /// S̃a at that minimum: the first-order change of the fit's weighted residuals when the
+    /// effect is added and everything refitted (r + S̃a is the refit's residual).
+    pub(crate) linear_change: DVector<f64>,
     /// cos(r, −S̃₀): +1 when the residual is exactly what the effect's primary parameter
     /// (raised from the fit's value) removes, −1 when it would need the opposite sign.
     pub(crate) matched: f64,
@@ -68,34 +71,37 @@ pub(crate) fn signature(cal: &Calibration, rows: &[ObservedRow], e: Effect) -> O
     }
     let j = &cal.lin.jacobian;
     let st = &s - j * (pseudo_inverse(&(j.transpose() * j)) * (j.transpose() * &s));
-    let linear_chi2_drop = one_sided_drop(&st, r, info.params[0].min >= 0.0);
+    let (linear_chi2_drop, linear_change) = one_sided_drop(&st, r, info.params[0].min >= 0.0);
     let s0 = st.column(0);
     let denom = s0.norm() * r.norm();
     let matched = if denom > 0.0 { -s0.dot(r) / denom } else { 0.0 };
-    Some(Signature { columns: st, linear_chi2_drop, matched })
+    Some(Signature { columns: st, linear_chi2_drop, linear_change, matched })
 }
 
-/// min over a of ‖r + S̃a‖² subtracted from ‖r‖²: the χ² the columns remove to first order.
-/// With `bounded` the primary coefficient a₀ must be ≥ 0 (an effect whose strength cannot
-/// go below off): when the unconstrained a₀ is negative the constrained minimum lies on
-/// a₀ = 0 (one inequality on a convex quadratic), and only the other columns remove
-/// anything (nothing for a one-parameter effect). Without the bound a fit would be screened
-/// in on a residual only a negative strength removes, and collapse onto the model it nests.
-fn one_sided_drop(st: &DMatrix<f64>, r: &DVector<f64>, bounded: bool) -> f64 {
-    let drop = |s: &DMatrix<f64>| -> (f64, f64) {
+/// min over a of ‖r + S̃a‖² subtracted from ‖r‖²: the χ² the columns remove to first order,
+/// with the change S̃a at the minimum. With `bounded` the primary coefficient a₀ must be ≥ 0
+/// (an effect whose strength cannot go below off): when the unconstrained a₀ is negative
+/// the constrained minimum lies on a₀ = 0 (one inequality on a convex quadratic), and only
+/// the other columns remove anything (nothing for a one-parameter effect). Without the
+/// bound a fit would be screened in on a residual only a negative strength removes, and
+/// collapse onto the model it nests.
+fn one_sided_drop(st: &DMatrix<f64>, r: &DVector<f64>, bounded: bool) -> (f64, DVector<f64>) {
+    // (drop, change, a₀) of the least-squares a over the columns `s`
+    let drop = |s: &DMatrix<f64>| -> (f64, DVector<f64>, f64) {
         if s.ncols() == 0 {
-            return (0.0, 0.0);
+            return (0.0, DVector::zeros(r.len()), 0.0);
         }
-        let g = s.transpose() * r;
-        let h = pseudo_inverse(&(s.transpose() * s));
-        let a0 = -(h.row(0) * &g)[(0, 0)];
-        ((g.transpose() * h * &g)[(0, 0)].max(0.0), a0)
+        let a = -(pseudo_inverse(&(s.transpose() * s)) * (s.transpose() * r));
+        let change = s * &a;
+        // ‖r‖² − ‖r + S̃a‖² = −rᵀS̃a at the least-squares a
+        ((-r.dot(&change)).max(0.0), change, a[0])
     };
-    let (full, a0) = drop(st);
+    let (full, change, a0) = drop(st);
     if bounded && a0 < 0.0 {
-        drop(&st.columns(1, st.ncols() - 1).into_owned()).0
+        let (d, c, _) = drop(&st.columns(1, st.ncols() - 1).into_owned());
+        (d, c)
     } else {
-        full
+        (full, change)
     }
 }
 
@@ -188,8 +194,8 @@ mod tests {
         for sign in [1.0, -1.0] {
             // a residual that a₀ = ∓4 (with some a₁) removes, plus a part neither column has
             let r = (st.column(0) * (-4.0 * sign) + st.column(1) * 0.7) + &noise;
-            let bounded = one_sided_drop(&st, &r, true);
-            let free = one_sided_drop(&st, &r, false);
+            let bounded = one_sided_drop(&st, &r, true).0;
+            let free = one_sided_drop(&st, &r, false).0;
             assert!((bounded - scan(&r)).abs() < 1e-6 * free, "{sign}: {bounded} vs scan {}", scan(&r));
             if sign > 0.0 {
                 assert!((bounded - free).abs() < 1e-9 * free, "{bounded} vs {free}");
@@ -197,7 +203,7 @@ mod tests {
                 assert!(bounded < 0.5 * free, "{bounded} vs {free}");
             }
             let one = st.columns(0, 1).into_owned();
-            let single = one_sided_drop(&one, &r, true);
+            let single = one_sided_drop(&one, &r, true).0;
             assert!(if sign > 0.0 { single > 0.5 * free } else { single == 0.0 }, "{sign}: {single}");
         }
     }
