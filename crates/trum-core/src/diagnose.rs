@@ -591,28 +591,18 @@ pub fn diagnose(
     // An effect that moves no prediction of these rows (thermal_drift without a time
     // series) cannot be tested: it is ranked with the baseline's fit and its parameter
     // penalty, not fitted, and joins no pair.
-    let base_res = residuals(&start, rows);
-    let untestable: Vec<Effect> = opts
-        .candidates
+    // Score tests at the calibrated baseline: each candidate's signature against the
+    // baseline's residual (one model pass per effect parameter). Its probe is also the test
+    // of whether the effect moves any prediction at all: all columns exactly zero.
+    let probed: Vec<(Effect, Option<signature::Signature>)> =
+        opts.candidates.par_iter().map(|&e| (e, signature::signature(&base_cal, rows, e))).collect();
+    let untestable: Vec<Effect> = probed
         .iter()
-        .copied()
-        .filter(|&e| {
-            let mut probe = start.clone();
-            let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
-            probe.effects.set(e, &typical);
-            residuals(&probe, rows) == base_res
-        })
+        .filter(|(_, s)| s.as_ref().is_some_and(|s| s.columns.iter().all(|&x| x == 0.0)))
+        .map(|(e, _)| *e)
         .collect();
-    // Score tests at the calibrated baseline: each testable candidate's signature against
-    // the baseline's residual (one model pass per effect parameter).
-    let base_sigs: BTreeMap<Effect, signature::Signature> = opts
-        .candidates
-        .par_iter()
-        .filter(|e| !untestable.contains(e))
-        .filter_map(|&e| signature::signature(&base_cal, rows, e).map(|s| (e, s)))
-        .collect::<Vec<_>>()
-        .into_iter()
-        .collect();
+    let base_sigs: BTreeMap<Effect, signature::Signature> =
+        probed.into_iter().filter(|(e, _)| !untestable.contains(e)).filter_map(|(e, s)| s.map(|s| (e, s))).collect();
     let single_sig = |effects: &[Effect]| match effects {
         [e] => base_sigs.get(e),
         _ => None,
@@ -1287,6 +1277,25 @@ mod tests {
         assert!(!worth(Some((0.0, 0.0))));
         // the evidence bar still holds on its own
         assert!(!worth_pair_fit(Some(&base), &rows, Effect::RadialFriction, 4.1 * sig.linear_chi2_drop, None, &sc));
+    }
+
+    /// An effect that moves no prediction of the rows (thermal drift without a time series)
+    /// is ranked with the baseline's fit and its parameter penalty, not fitted; the other
+    /// candidate is.
+    #[test]
+    fn an_effect_the_data_cannot_see_is_not_fitted() {
+        let (nominal, rows, groups) = sag_data();
+        let opts = DiagnoseOptions { candidates: vec![Effect::VoltageSag, Effect::ThermalDrift], ..quick(false) };
+        let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+        let entry = |name: &str| d.ranking.iter().find(|r| r.effect == name).expect("ranked");
+        let thermal = entry("thermal_drift");
+        let penalty = 0.5 * Effect::ThermalDrift.info().params.len() as f64 * (d.n_readings as f64).ln();
+        assert!(thermal.params.is_empty() && thermal.shrink == 0.0, "{thermal:?}");
+        assert!((thermal.evidence + penalty).abs() < 1e-9 * penalty, "{} vs −{penalty}", thermal.evidence);
+        assert!(thermal.signature_match.is_none());
+        let sag = entry("voltage_sag");
+        assert!(!sag.params.is_empty() && sag.evidence > 5.0 && sag.signature_match.is_some(), "{sag:?}");
+        assert!(d.notes.iter().any(|n| n.contains("thermal_drift cannot act")));
     }
 
     #[test]
