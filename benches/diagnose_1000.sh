@@ -4,6 +4,7 @@
 # trum60a (radial_friction injected, nominal noise) at drive voltages 165-235 V, joins
 # them into one file (run ids prefixed with the voltage) and times `trum diagnose`.
 #   bash benches/diagnose_1000.sh            # release build, then the timed run
+#   SEED_OFFSET=10 bash benches/diagnose_1000.sh   # the same campaigns with seeds 11-18
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -q -p trum-cli
@@ -12,9 +13,10 @@ dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 out="$dir/bench1000.csv"
 i=0
+off=${SEED_OFFSET:-0}
 for v in 165 175 185 195 205 215 225 235; do
     i=$((i + 1))
-    "$T" synth --motor trum60a --effect radial_friction=1 --campaign combined --noise 1 --seed "$i" \
+    "$T" synth --motor trum60a --effect radial_friction=1 --campaign combined --noise 1 --seed "$((i + off))" \
         --voltage-v "$v" -o "$dir/c$i.csv" > /dev/null
     if [ "$i" = 1 ]; then head -n 1 "$dir/c$i.csv" > "$out"; fi
     # prefix every run id (the last column) with the voltage so runs stay distinct
