@@ -194,8 +194,12 @@ mod tests {
         for sign in [1.0, -1.0] {
             // a residual that a₀ = ∓4 (with some a₁) removes, plus a part neither column has
             let r = (st.column(0) * (-4.0 * sign) + st.column(1) * 0.7) + &noise;
-            let bounded = one_sided_drop(&st, &r, true).0;
-            let free = one_sided_drop(&st, &r, false).0;
+            let (bounded, change) = one_sided_drop(&st, &r, true);
+            let (free, free_change) = one_sided_drop(&st, &r, false);
+            // the change is the one at the minimum: r + change is what is left
+            for (d, c) in [(bounded, &change), (free, &free_change)] {
+                assert!((d - (r.norm_squared() - (&r + c).norm_squared())).abs() < 1e-9 * free, "{sign}: {d}");
+            }
             assert!((bounded - scan(&r)).abs() < 1e-6 * free, "{sign}: {bounded} vs scan {}", scan(&r));
             if sign > 0.0 {
                 assert!((bounded - free).abs() < 1e-9 * free, "{bounded} vs {free}");
