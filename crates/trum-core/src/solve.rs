@@ -1265,6 +1265,10 @@ fn add_solution(a: &Solution, b: &Solution) -> Solution {
 /// bracketed (see `solve_drive_below`).
 const MULTI_BRANCH_STEP: f64 = 0.8;
 
+/// Fall of the amplitude per fixed-point step of a multi-branch descent below 1e-3 of its
+/// top before a root is bracketed (see `solve_drive_below`).
+const DEEP_CLAMPED_STEP: f64 = 0.1;
+
 fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
     solve_drive_below(p, d, op, guess, None).0
 }
@@ -1518,7 +1522,15 @@ fn solve_drive_below(
                 // W falls and plain steps of r ≈ 10⁻³·W took the whole budget (points near
                 // stall and clamping of the dense preset maps, tests/solver_convergence.rs).
                 // The step is at most a tenth of W so that a root is not stepped over
-                // lightly; a step into r < 0 brackets one.
+                // lightly; a step into r < 0 brackets one. Not so below 1e-3 of a
+                // multi-branch descent's top, where the cap above is released as a clamped
+                // stator's descent to zero: there G ≈ κ·W with κ just below 1 (full
+                // contact, the friction set by the preload, not by W), so the secant points
+                // at W ≤ 0 and tenths took about 130 trials a clamped row down to the
+                // clamping threshold (0.3 of the trials of a 1000-row diagnosis, docs/
+                // PERFORMANCE.md). A decade a step there (or the fixed-point step when it
+                // goes further): no bolder than the secant steps the release allows.
+                let deep = cap && cur.w < 1e-3 * w_top;
                 let secant = prev.map(|pv| {
                     let rp = pv.w - pv.w_next;
                     cur.w - r * (cur.w - pv.w) / (r - rp)
@@ -1528,6 +1540,7 @@ fn solve_drive_below(
                         stretch = 1.0;
                         x
                     }
+                    _ if deep => cur.w_next.min(DEEP_CLAMPED_STEP * cur.w),
                     _ => {
                         let x = cur.w - (r * stretch).min(0.1 * cur.w).max(r);
                         stretch *= 2.0;
@@ -2037,6 +2050,23 @@ mod tests {
             assert!((s.amplitude_m / expected - 1.0).abs() < 2e-3, "{name}: {:e} m", s.amplitude_m);
             let top = amplitude_branches(&m, &op).last().map(|b| b.amplitude_m);
             assert_eq!(top.map(|w| (w / s.amplitude_m - 1.0).abs() < 1e-6), Some(true), "{top:?}");
+        }
+    }
+
+    /// A stator clamped under weak preload stiffening (the strength a 1000-row diagnosis
+    /// fits): below 1e-3 of the top the map is G ≈ κ·W with κ just below 1, where steps of a
+    /// tenth of W took about 130 trials to reach the clamping threshold (about 180 in all;
+    /// 0.3 of a diagnosis's trials). A decade a step there: the same clamped answer, which
+    /// the dense branch scan confirms, in under 100.
+    #[test]
+    fn a_clamped_multi_branch_descent_takes_decade_steps_near_zero() {
+        let m = motor_with("trum60a", "preload_stiffening=0.06", false);
+        for (preload, freq) in [(400.0, 43e3), (400.0, 44e3), (500.0, 41.5e3), (500.0, 43e3), (500.0, 44e3)] {
+            let op = OperatingPoint::new(preload, 0.0, 120.0, freq);
+            let (problem, s, _) = largest_fixed_point_problem(&m, &op);
+            assert!(problem.is_none(), "{op:?}: {problem:?}");
+            assert_eq!(s.status, Status::Clamped, "{op:?}");
+            assert!(s.iterations < 100, "{op:?}: {} amplitude evaluations", s.iterations);
         }
     }
 
