@@ -315,11 +315,21 @@ fn held_out_need(b: &RankEntry, n_read: usize, noise_nrmse: f64) -> (f64, f64) {
     )
 }
 
+/// `x` to about three significant digits, for notes.
+fn rounded(x: f64) -> String {
+    match x.abs() {
+        a if a >= 100.0 => format!("{x:.0}"),
+        a if a >= 10.0 => format!("{x:.1}"),
+        _ => format!("{x:.2}"),
+    }
+}
+
 /// Whether `e` is worth a pair fit as a second effect to the lead fitted in `lead_fit`: its
 /// score test there removes at least a quarter of `chi2_needed` (what the pair needs in
 /// evidence), and, when the lead closes the gap (`held_needed`: the Σ z² and Σ e² a pair
 /// must remove on held-out data to beat it), its first-order gain reaches a quarter of
 /// either. Without a lead fit or a signature there is nothing to screen on: worth it.
+/// When not worth it, the second value says which bar failed, with its numbers.
 fn worth_pair_fit(
     lead_fit: Option<&Calibration>,
     rows: &[ObservedRow],
@@ -327,15 +337,29 @@ fn worth_pair_fit(
     chi2_needed: f64,
     held_needed: Option<(f64, f64)>,
     sc: &BTreeMap<Observable, f64>,
-) -> bool {
+) -> (bool, String) {
     let Some((c, s)) = lead_fit.and_then(|c| signature::signature(c, rows, e).map(|s| (c, s))) else {
-        return true;
+        return (true, String::new());
     };
-    let held = held_needed.is_none_or(|(chi2, e2)| {
-        let (d_chi2, d_e2) = first_order_gains(c, rows, &s, sc);
-        (chi2 > 0.0 && d_chi2 >= 0.25 * chi2) || (e2 > 0.0 && d_e2 >= 0.25 * e2)
-    });
-    s.linear_chi2_drop >= 0.25 * chi2_needed && held
+    if s.linear_chi2_drop < 0.25 * chi2_needed {
+        let why = format!("score Δχ² {} < {}", rounded(s.linear_chi2_drop), rounded(0.25 * chi2_needed));
+        return (false, why);
+    }
+    match held_needed {
+        Some((chi2, e2)) => {
+            let (d_chi2, d_e2) = first_order_gains(c, rows, &s, sc);
+            let worth = (chi2 > 0.0 && d_chi2 >= 0.25 * chi2) || (e2 > 0.0 && d_e2 >= 0.25 * e2);
+            let why = format!(
+                "Σz² {} < {} and Σe² {} < {}",
+                rounded(d_chi2),
+                rounded(0.25 * chi2),
+                rounded(d_e2),
+                rounded(0.25 * e2)
+            );
+            (worth, if worth { String::new() } else { why })
+        }
+        None => (true, String::new()),
+    }
 }
 
 /// Whether a pair of two candidates that lead nothing may beat the best single effect
@@ -862,22 +886,26 @@ pub fn diagnose(
             for &lead in &leads {
                 let lead_fit = fits.get(lead.name());
                 let need = held_need(lead);
-                let second: Vec<(Effect, bool)> = names
+                let second: Vec<(Effect, (bool, String))> = names
                     .par_iter()
                     .filter(|&&e| e != lead)
                     .map(|&e| (e, worth_pair_fit(lead_fit, rows, e, needed(e), need, &sc)))
                     .collect();
-                for &(e, worth) in &second {
-                    if worth {
-                        push(lead, e);
+                for (e, (worth, _)) in &second {
+                    if *worth {
+                        push(lead, *e);
                     }
                 }
-                let skipped: Vec<&str> = second.iter().filter(|x| !x.1).map(|x| x.0.name()).collect();
+                let skipped: Vec<String> =
+                    second.iter().filter(|x| !x.1 .0).map(|(e, (_, why))| format!("{e} ({why})")).collect();
                 if !skipped.is_empty() {
-                    let held =
-                        if need.is_some() { ", or a third of the held-out gap it leaves beyond the noise" } else { "" };
+                    let held = if need.is_some() {
+                        ", or a third of the held-out gap it leaves beyond the noise (Σz², Σe²)"
+                    } else {
+                        ""
+                    };
                     skipped_notes.push(format!(
-                        "not fitted as a second effect to {lead} (first-order gain at its fit below a quarter of what a pair needs: ½ΔBIC > 5{held}): {}",
+                        "not fitted as a second effect to {lead} (first-order gain at its fit below a quarter of what a pair needs: ½ΔBIC > 5 (score Δχ²){held}): {}",
                         skipped.join(", ")
                     ));
                 }
@@ -1335,14 +1363,20 @@ mod tests {
         assert!((0.8..=1.05).contains(&r_e2), "Σe²: first order {d_e2} vs refit {}", b.1 - a.1);
 
         // the screen on these gains: a quarter of what is needed in either held-out measure
-        let worth = |held| worth_pair_fit(Some(&base), &rows, Effect::RadialFriction, 10.0, held, &sc);
+        let worth = |held| worth_pair_fit(Some(&base), &rows, Effect::RadialFriction, 10.0, held, &sc).0;
         assert!(worth(None));
         assert!(worth(Some((3.9 * d_chi2, f64::INFINITY))) && worth(Some((0.0, 3.9 * d_e2))));
         assert!(!worth(Some((4.1 * d_chi2, 4.1 * d_e2))));
         // nothing to remove beyond the noise: no pair can beat the lead
         assert!(!worth(Some((0.0, 0.0))));
         // the evidence bar still holds on its own
-        assert!(!worth_pair_fit(Some(&base), &rows, Effect::RadialFriction, 4.1 * sig.linear_chi2_drop, None, &sc));
+        let (worth_it, why) =
+            worth_pair_fit(Some(&base), &rows, Effect::RadialFriction, 4.1 * sig.linear_chi2_drop, None, &sc);
+        assert!(!worth_it && why.starts_with("score Δχ²"), "{why}");
+        // a failed held-out bar says so, with its numbers
+        let (worth_it, why) =
+            worth_pair_fit(Some(&base), &rows, Effect::RadialFriction, 10.0, Some((4.1 * d_chi2, 4.1 * d_e2)), &sc);
+        assert!(!worth_it && why.starts_with("Σz² ") && why.contains(" and Σe² "), "{why}");
 
         // the screen of pairs that lead nothing, with the baseline as the first effect's fit
         // (evidence 0): the pair must remove 2·best + ln n + 10 to beat a best single of
