@@ -284,6 +284,35 @@ fn coulomb_sums(nodes: &Nodes, c: f64, u: f64, rho: f64, weight: f64) -> Factors
     }
 }
 
+/// The node sums of the candidate saturating law without radial slip (ρ = 0, S = tanh):
+/// the traction per unit μp is g_t = tanh(dt/σ) (odd in the slip, so its sign needs no
+/// branch) and ∂g_t/∂u = −(1 − g_t²)/σ, with power = ∫q·g_t·cos θ: one exp and one
+/// division a node (the general route, [`accumulate`], takes D = |dt|, g = S(D/σ)/D and
+/// dg/dD: a square root and two more divisions). The two agree to rounding (test below).
+fn compliance_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64, weight: f64) -> Factors {
+    let inv_s = 1.0 / slip_scale;
+    let (mut t, mut t_u, mut p, mut p_u) = (0.0, 0.0, 0.0, 0.0);
+    for k in 0..nodes.len {
+        let (co, w) = (nodes.cos[k], nodes.weight[k]);
+        let wq = w * (co - c).max(0.0);
+        let x = (co - u) * inv_s;
+        let g = tanh_nonneg(x.abs()).copysign(x);
+        let dg = -(1.0 - g * g) * inv_s;
+        t += wq * g;
+        t_u += wq * dg;
+        p += wq * g * co;
+        p_u += wq * dg * co;
+    }
+    Factors {
+        torque: weight * t,
+        power: weight * p,
+        radial: 0.0,
+        torque_du: weight * t_u,
+        power_du: weight * p_u,
+        radial_du: 0.0,
+    }
+}
+
 /// Interface factors for contact `ct`, rotor speed ratio u = v_r/v0 ∈ [0, 1] and `law`.
 /// The integration splits at the stick point θs = acos u where the tangential slip
 /// changes sign.
@@ -302,7 +331,9 @@ pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
     }
     let mut f = Factors::default();
     for (rho, weight) in radii(law) {
-        let part = if law.slip_scale > 0.0 {
+        let part = if law.slip_scale > 0.0 && rho == 0.0 && !law.truth {
+            compliance_sums(&nodes, c, u, law.slip_scale, weight)
+        } else if law.slip_scale > 0.0 {
             let mut g = Factors::default();
             for k in 0..nodes.len {
                 accumulate(&mut g, nodes.sin[k], nodes.cos[k], weight * nodes.weight[k], c, u, rho, law);
