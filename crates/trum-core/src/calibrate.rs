@@ -238,6 +238,10 @@ const FIT_CHI2_TOL: f64 = 1e-4;
 /// valley keeps a large decrement.
 pub(crate) const FIT_DECREMENT_TOL: f64 = 1e-2;
 
+/// A fit's unweighted first run, which only places the first Huber weights, stops once an
+/// accepted step removed less than this fraction of the sum of squares (see `fit`).
+const IRLS_START_RTOL: f64 = 1e-3;
+
 /// Options of a fit.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FitOptions {
@@ -436,6 +440,13 @@ struct Problem<'a> {
     off: Vec<usize>,
     /// Set when one of them was pressed against zero (also a user stop for the crate).
     collapsed: std::cell::Cell<bool>,
+    /// Set for the unweighted first run of a fit from a converged nested fit, which only
+    /// places the Huber weights (`calibrate_extending`): the run also stops once an
+    /// accepted step removed less than this fraction of the sum of squares. `last_sum`
+    /// keeps the sum at the latest Jacobian; `stopped_early` records such a stop.
+    early_rtol: Option<f64>,
+    last_sum: std::cell::Cell<Option<f64>>,
+    stopped_early: std::cell::Cell<bool>,
 }
 
 /// One model pass over the rows at transformed parameters `u`.
@@ -459,6 +470,9 @@ impl<'a> Problem<'a> {
             last: std::cell::RefCell::new(None),
             jac: std::cell::RefCell::new(None),
             settled: std::cell::Cell::new(false),
+            early_rtol: None,
+            last_sum: std::cell::Cell::new(None),
+            stopped_early: std::cell::Cell::new(false),
             off,
             collapsed: std::cell::Cell::new(false),
         }
@@ -626,6 +640,13 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
             self.settled.set(true);
             return None;
         }
+        // a weights-only run whose last accepted step removed little: the weights are placed
+        let sum = r.norm_squared();
+        if self.early_rtol.is_some_and(|t| self.last_sum.replace(Some(sum)).is_some_and(|s| s - sum < t * s)) {
+            self.stopped_early.set(true);
+            self.settled.set(true);
+            return None;
+        }
         Some(j)
     }
 }
@@ -655,7 +676,20 @@ pub(crate) fn calibrate_adding(
     opts: &FitOptions,
     added: &[Effect],
 ) -> Result<Calibration, TrumError> {
-    fit(motor, rows, params, opts, added, None)
+    fit(motor, rows, params, opts, added, None, None)
+}
+
+/// [`calibrate_adding`] from a converged fit of the nested model (a pair from its lead's
+/// fit): the unweighted first run, which only places the Huber weights, stops once an
+/// accepted step removes less than IRLS_START_RTOL of the sum of squares.
+pub(crate) fn calibrate_extending(
+    motor: &Motor,
+    rows: &[ObservedRow],
+    params: &[FitParam],
+    opts: &FitOptions,
+    added: &[Effect],
+) -> Result<Calibration, TrumError> {
+    fit(motor, rows, params, opts, added, None, Some(IRLS_START_RTOL))
 }
 
 /// [`calibrate`] with the Huber weights fixed at `weights` (one per reading, in row order):
@@ -669,7 +703,7 @@ pub(crate) fn calibrate_weighted(
     opts: &FitOptions,
     weights: Vec<f64>,
 ) -> Result<Calibration, TrumError> {
-    fit(motor, rows, params, opts, &[], Some(weights))
+    fit(motor, rows, params, opts, &[], Some(weights), None)
 }
 
 fn fit(
@@ -679,6 +713,7 @@ fn fit(
     opts: &FitOptions,
     added: &[Effect],
     fixed_weights: Option<Vec<f64>>,
+    early_weights: Option<f64>,
 ) -> Result<Calibration, TrumError> {
     let n_read: usize = rows.iter().map(|r| r.readings.len()).sum();
     if params.is_empty() {
@@ -728,9 +763,14 @@ fn fit(
     // shallow valley (seed 001 Table 2: at 1e-3, or a relative 1e-9, preload_stiffening
     // stopped with evidence −1 instead of 176).
     let mut warnings = Vec::new();
-    let mut last = None;
+    let mut last;
     let mut abandoned = false;
-    for pass in 0..=irls_passes {
+    let mut pass = 0;
+    loop {
+        // The unweighted first run only places the Huber weights, unless they come out all
+        // ones: then it is finished as a full run (`stopped_early` below).
+        problem.early_rtol = early_weights.filter(|_| pass == 0 && irls_passes > 0 && !problem.stopped_early.get());
+        problem.last_sum.set(None);
         let (p, report) = lm_pass(problem, opts);
         problem = p;
         // a stop on the Gauss–Newton decrement is convergence (the crate calls it a user stop)
@@ -744,17 +784,23 @@ fn fit(
             abandoned = true;
             break;
         }
-        if pass < irls_passes {
-            // Huber weights from the current unweighted residuals.
-            let r = problem.pass_at(&problem.u).raw.clone();
-            let w: Vec<f64> =
-                r.iter().map(|x| if x.abs() <= opts.huber_k { 1.0 } else { (opts.huber_k / x.abs()).sqrt() }).collect();
-            // unchanged weights: another pass would end where this one did
-            if w.iter().zip(&problem.weights).all(|(a, b)| (a - b).abs() <= 1e-3 * b) {
-                break;
-            }
-            problem.set_weights(w);
+        if pass == irls_passes {
+            break;
         }
+        // Huber weights from the current unweighted residuals.
+        let r = problem.pass_at(&problem.u).raw.clone();
+        let w: Vec<f64> =
+            r.iter().map(|x| if x.abs() <= opts.huber_k { 1.0 } else { (opts.huber_k / x.abs()).sqrt() }).collect();
+        // unchanged weights: another pass would end where this one did (a run stopped
+        // early for the weights' sake is finished first: its point is then the answer)
+        if w.iter().zip(&problem.weights).all(|(a, b)| (a - b).abs() <= 1e-3 * b) {
+            if problem.early_rtol.is_some() && problem.stopped_early.get() {
+                continue;
+            }
+            break;
+        }
+        problem.set_weights(w);
+        pass += 1;
     }
     if let Some(t) = last.filter(|t| !t.was_successful() && !abandoned) {
         warnings.push(format!("the fit stopped before converging ({t:?})"));
@@ -932,6 +978,46 @@ pub(crate) mod tests {
     /// contain is fitted, not abandoned. Voltage sag acts linearly in its resistance near
     /// zero, so the plain fit crawls (an effect of second order there, like radial
     /// friction's, settles on the decrement instead).
+    #[test]
+    fn an_early_stopped_weights_run_ends_where_the_full_one_does() {
+        // An early stop of the unweighted first run, forced harder than the diagnosis's
+        // (which stops where a step removes less than 1e-3 of χ²): the weighted runs end
+        // where the plain fit's do.
+        let nominal = preset("trum60a").unwrap();
+        let sag = Effect::VoltageSag;
+        let mut params = vec![
+            fit_rel(&nominal, "friction_layer.friction_coefficient", 0.3, 3.0),
+            fit_rel(&nominal, "stator.modal_damping_ns_per_m", 0.2, 5.0),
+            fit_rel(&nominal, "stator.force_factor_n_per_v", 0.3, 3.0),
+        ];
+        params.extend(effect_params(sag));
+        let mut start = nominal.clone();
+        start.effects.set(sag, &[75.0]);
+        let mut truth = nominal.clone();
+        truth.effects.set(sag, &[300.0]);
+        let clean = rows_from(&truth);
+        // the same data with three readings 20 σ off: Huber weights below one there
+        let mut outliers = clean.clone();
+        for r in outliers.iter_mut().step_by(7).take(3) {
+            r.readings[0].1 += 20.0 * r.readings[0].2;
+        }
+        let opts = FitOptions::default();
+        // (clean data stopped at the second Jacobian, after one step; data with outliers
+        // where a step removes less than half of χ²: the weighted runs start from there.
+        // Within 1e-3: the plain fit's own stopping tolerances leave 1.6e-4 of the source
+        // resistance on the clean data.)
+        for (rows, rtol) in [(&clean, 1.0), (&outliers, 0.5)] {
+            let full = fit(&start, rows, &params, &opts, &[sag], None, None).unwrap();
+            let early = fit(&start, rows, &params, &opts, &[sag], None, Some(rtol)).unwrap();
+            assert!(!full.abandoned && !early.abandoned);
+            assert!(early.evaluations != full.evaluations, "the early stop did not act");
+            for (a, b) in full.params.iter().zip(&early.params) {
+                assert!((a.value - b.value).abs() <= 1e-3 * a.value.abs(), "{}: {} vs {}", a.name, a.value, b.value);
+            }
+            assert!((early.chi2 - full.chi2).abs() <= 1e-3 * full.chi2.max(1.0), "{} vs {}", early.chi2, full.chi2);
+        }
+    }
+
     #[test]
     fn an_added_effect_collapses_only_when_the_data_lack_it() {
         let nominal = preset("trum60a").unwrap();

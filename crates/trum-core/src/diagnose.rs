@@ -25,8 +25,8 @@ pub mod json;
 mod signature;
 
 use crate::calibrate::{
-    baseline_params, calibrate, calibrate_adding, calibrate_weighted, effect_params, residuals, Calibration,
-    FitOptions, FitParam, FittedParam, Observable, ObservedRow,
+    baseline_params, calibrate, calibrate_adding, calibrate_extending, calibrate_weighted, effect_params, residuals,
+    Calibration, FitOptions, FitParam, FittedParam, Observable, ObservedRow,
 };
 use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
@@ -708,7 +708,12 @@ pub fn diagnose(
         // effects count as added, and a collapse of either lets the baseline stand in, not the
         // other single; such a pair cannot win over that single anyway)
         let added = if nested.is_some() { &effects[1..] } else { effects };
-        let mut cal = calibrate_adding(&s0, rows, &params, &opts.fit, added);
+        // a pair led by a fitted single starts at that fit's optimum
+        let mut cal = if nested.is_some() {
+            calibrate_extending(&s0, rows, &params, &opts.fit, added)
+        } else {
+            calibrate_adding(&s0, rows, &params, &opts.fit, added)
+        };
         // The second start is needed only when the first did not reach the noise level and
         // found no clear evidence (a supported effect is not rejected for a shallower valley).
         // A first fit that collapsed onto the nested model has its answer: from the calibrated
