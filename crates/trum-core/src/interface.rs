@@ -172,28 +172,47 @@ impl Nodes {
         Nodes { sin: [0.0; 4 * NODES], cos: [0.0; 4 * NODES], weight: [0.0; 4 * NODES], len: 0 }
     }
 
-    /// Adds [a, b] (width at most π) as two equal sub-panels, given (sin, cos) of its
-    /// centre. The nodes are symmetric about each sub-panel's centre m = centre ∓ r, so
-    /// sin(m ± y) and cos(m ± y) follow by angle addition from the series of r and of
-    /// y = r·x (|y| < π/4), which both sub-panels share.
-    fn panel(&mut self, a: f64, b: f64, (sc, cc): (f64, f64)) {
+    /// Adds each [a, b] of `panels` (width at most π, at most two of them) as two equal
+    /// sub-panels, given (sin, cos) of its centre. The nodes are symmetric about each
+    /// sub-panel's centre m = centre ∓ r, so sin(m ± y) and cos(m ± y) follow by angle
+    /// addition from the series of r and of y = r·x (|y| < π/4), which both sub-panels share.
+    fn panels(&mut self, panels: &[(f64, f64, (f64, f64))]) {
+        const HALF: usize = NODES / 2;
         let gl = gauss_legendre();
-        let r = 0.25 * (b - a);
-        let mut offsets = [(0.0, 0.0, 0.0); NODES / 2];
-        // gauss_legendre() lists the positive nodes first, their mirror images after
-        for (o, &(x, w)) in offsets.iter_mut().zip(&gl[..NODES / 2]) {
-            let (sy, cy) = sin_cos_small(r * x);
-            *o = (sy, cy, w * r);
+        // The series of all panels at once, lane by lane over fixed-size arrays (per panel:
+        // the six offsets y = r·x of the positive nodes, which gauss_legendre() lists first,
+        // then r). The compiler evaluates them two lanes at a time in vector registers, each
+        // lane with the operations of a scalar call, so the nodes are the same to the bit;
+        // the Horner chains of both panels overlap instead of running one after the other.
+        debug_assert!(panels.len() <= 2);
+        let mut y = [0.0; 16];
+        for (p, &(a, b, _)) in panels.iter().enumerate() {
+            let r = 0.25 * (b - a);
+            for (yi, &(x, _)) in y[8 * p..].iter_mut().zip(&gl[..HALF]) {
+                *yi = r * x;
+            }
+            y[8 * p + HALF] = r;
         }
-        let (sr, cr) = sin_cos_small(r);
-        for (sm, cm) in [(sc * cr - cc * sr, cc * cr + sc * sr), (sc * cr + cc * sr, cc * cr - sc * sr)] {
-            for &(sy, cy, w) in &offsets {
-                for (sign, k) in [(1.0, self.len), (-1.0, self.len + 1)] {
-                    self.sin[k] = sm * cy + sign * cm * sy;
-                    self.cos[k] = cm * cy - sign * sm * sy;
+        let (mut sy, mut cy) = ([0.0; 16], [0.0; 16]);
+        for i in 0..16 {
+            (sy[i], cy[i]) = sin_cos_small(y[i]);
+        }
+        for (p, &(_, _, (sc, cc))) in panels.iter().enumerate() {
+            let (sy, cy) = (&sy[8 * p..8 * p + 8], &cy[8 * p..8 * p + 8]);
+            let r = y[8 * p + HALF];
+            let (sr, cr) = (sy[HALF], cy[HALF]);
+            for (sm, cm) in [(sc * cr - cc * sr, cc * cr + sc * sr), (sc * cr + cc * sr, cc * cr - sc * sr)] {
+                for i in 0..HALF {
+                    let k = self.len + 2 * i;
+                    let w = gl[i].1 * r;
+                    self.sin[k] = sm * cy[i] + cm * sy[i];
+                    self.cos[k] = cm * cy[i] - sm * sy[i];
                     self.weight[k] = w;
+                    self.sin[k + 1] = sm * cy[i] - cm * sy[i];
+                    self.cos[k + 1] = cm * cy[i] + sm * sy[i];
+                    self.weight[k + 1] = w;
                 }
-                self.len += 2;
+                self.len += NODES;
             }
         }
     }
@@ -324,10 +343,12 @@ pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
     let mut nodes = Nodes::new();
     if ts > 0.0 && ts < phi0 {
         // the centre of [0, θs] by the half-angle formulas of cos θs = u (no sin_cos call)
-        nodes.panel(0.0, ts, ((0.5 * (1.0 - uc)).sqrt(), (0.5 * (1.0 + uc)).sqrt()));
-        nodes.panel(ts, phi0, (0.5 * (ts + phi0)).sin_cos());
+        nodes.panels(&[
+            (0.0, ts, ((0.5 * (1.0 - uc)).sqrt(), (0.5 * (1.0 + uc)).sqrt())),
+            (ts, phi0, (0.5 * (ts + phi0)).sin_cos()),
+        ]);
     } else {
-        nodes.panel(0.0, phi0, (0.5 * phi0).sin_cos());
+        nodes.panels(&[(0.0, phi0, (0.5 * phi0).sin_cos())]);
     }
     let mut f = Factors::default();
     for (rho, weight) in radii(law) {
