@@ -1050,6 +1050,43 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn an_early_stop_with_unit_weights_is_finished_as_a_full_run() {
+        // Noise-free data and a start close enough that no residual reaches the Huber
+        // threshold after the first step: the weights-only run, stopped there (rtol 1: any
+        // step), leaves all-one weights, so its point would be the answer; the run is
+        // finished as a full one and ends where the plain fit does.
+        let nominal = preset("trum60a").unwrap();
+        let sag = Effect::VoltageSag;
+        let mut params = vec![
+            fit_rel(&nominal, "friction_layer.friction_coefficient", 0.3, 3.0),
+            fit_rel(&nominal, "stator.modal_damping_ns_per_m", 0.2, 5.0),
+            fit_rel(&nominal, "stator.force_factor_n_per_v", 0.3, 3.0),
+        ];
+        params.extend(effect_params(sag));
+        let mut truth = nominal.clone();
+        truth.effects.set(sag, &[300.0]);
+        let rows = rows_from(&truth);
+        let opts = FitOptions::default();
+        for s0 in [200.0, 250.0] {
+            let mut start = nominal.clone();
+            start.effects.set(sag, &[s0]);
+            let full = fit(&start, &rows, &params, &opts, &[sag], None, None).unwrap();
+            let early = fit(&start, &rows, &params, &opts, &[sag], None, Some(1.0)).unwrap();
+            assert!(early.lin.weights.iter().all(|&w| w == 1.0));
+            for (a, b) in full.params.iter().zip(&early.params) {
+                assert!(
+                    (a.value - b.value).abs() <= 1e-9 * a.value.abs(),
+                    "{s0}: {}: {} vs {}",
+                    a.name,
+                    a.value,
+                    b.value
+                );
+            }
+            assert!(early.chi2 <= full.chi2 + 1e-9, "{s0}: {} vs {}", early.chi2, full.chi2);
+        }
+    }
+
+    #[test]
     fn an_added_effect_collapses_only_when_the_data_lack_it() {
         let nominal = preset("trum60a").unwrap();
         let rf = Effect::VoltageSag;

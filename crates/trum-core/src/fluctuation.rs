@@ -85,9 +85,8 @@ pub(crate) fn fluctuation_about(
         let mut o = *op;
         o.preload_n = op.preload_n + ripple * phi.cos();
         let s = solve_prepared(p, motor, &o, prev.as_ref());
-        if !s.status.is_valid() {
-            status = s.status;
-        } else if s.status != Status::Ok && status == Status::Ok {
+        // an invalid sample decides the status; a valid one with a warning only while none is set
+        if !s.status.is_valid() || (s.status != Status::Ok && status == Status::Ok) {
             status = s.status;
         }
         xc = (xc.0.min(s.contact_angle_deg), xc.1.max(s.contact_angle_deg));
