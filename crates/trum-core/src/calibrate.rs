@@ -348,10 +348,14 @@ pub fn residuals(motor: &Motor, rows: &[ObservedRow]) -> Vec<f64> {
 
 /// The normalised residuals of one row's readings for the solution `s` of its point.
 fn row_residuals(r: &ObservedRow, s: &Solution) -> Vec<f64> {
+    row_residuals_iter(r, s).collect()
+}
+
+/// [`row_residuals`] without collecting them (the Jacobian writes each into its matrix).
+fn row_residuals_iter<'a>(r: &'a ObservedRow, s: &'a Solution) -> impl Iterator<Item = f64> + 'a {
     r.readings
         .iter()
         .map(|&(o, v, sigma)| if s.status.is_valid() { (o.predict(s, r.ambient_c) - v) / sigma } else { 50.0 })
-        .collect()
 }
 
 /// `one` of every row, concatenated in row order. Large data sets in parallel chunks: a
@@ -401,16 +405,18 @@ pub(crate) fn residual_jacobian(
         let near = |p: &Prepared, m: &Motor| lin.as_ref().and_then(|b| crate::sensitivity::solve_near(b, p, m, &r.op));
         let r_near = near(&pb, base).map(|s| row_residuals(r, &s));
         let r_cold = row_residuals(r, &known.solution);
-        let mut cols: Vec<Vec<f64>> = Vec::with_capacity(n);
-        for k in 0..n {
-            let (rk, r0) = match (near(&pm[k], &moved[k]), &r_near) {
-                (Some(s), Some(r0)) => (row_residuals(r, &s), r0),
-                _ => (row_residuals(r, &solve_prepared(&pm[k], &moved[k], &r.op, None)), &r_cold),
-            };
-            cols.push(rk.iter().zip(r0).map(|(a, b)| (a - b) / steps[k]).collect());
-        }
         // row-major: reading i, then column k
-        (0..r.readings.len()).flat_map(|i| cols.iter().map(move |c| c[i])).collect()
+        let mut out = vec![0.0; r.readings.len() * n];
+        for k in 0..n {
+            let (sk, r0) = match (near(&pm[k], &moved[k]), &r_near) {
+                (Some(s), Some(r0)) => (s, r0),
+                _ => (solve_prepared(&pm[k], &moved[k], &r.op, None), &r_cold),
+            };
+            for (i, (a, b)) in row_residuals_iter(r, &sk).zip(r0).enumerate() {
+                out[i * n + k] = (a - b) / steps[k];
+            }
+        }
+        out
     };
     let items: Vec<(&ObservedRow, Option<&Solved>)> =
         rows.iter().enumerate().map(|(i, r)| (r, solved.map(|s| &s[i]))).collect();
