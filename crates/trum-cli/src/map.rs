@@ -107,23 +107,55 @@ pub fn header(cols: &[&Quantity]) -> String {
 fn chunk_csv(motor: &Motor, prep: &Prepared, grid: &Grid, cols: &[&Quantity], range: std::ops::Range<u64>) -> Vec<u8> {
     let mut buf = Vec::with_capacity((range.end - range.start) as usize * (24 * cols.len() + 64));
     let mut fmt = NumberFormatter::new();
+    let mut last = ColumnMemo::new(INPUT_COLUMNS.len() + cols.len());
     solve_range(motor, prep, grid, range, |_, op, s| {
-        for v in [op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz] {
-            fmt.push(&mut buf, v);
+        for (c, v) in [op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz].into_iter().enumerate() {
+            last.push(&mut fmt, &mut buf, c, v);
             buf.push(b',');
         }
         buf.extend_from_slice(s.status.as_str().as_bytes());
         let valid = s.status.is_valid();
-        for q in cols {
+        for (c, q) in cols.iter().enumerate() {
             buf.push(b',');
             // Invalid points: empty cells (never "NaN"); the status column says why.
             if valid {
-                fmt.push(&mut buf, (q.get)(s));
+                last.push(&mut fmt, &mut buf, INPUT_COLUMNS.len() + c, (q.get)(s));
             }
         }
         buf.push(b'\n');
     });
     buf
+}
+
+/// Where each column's latest number was written, reused while the column repeats it: in
+/// a map the drive voltage and frequency, the preload along a torque line, and quantities
+/// that are constant or zero for a motor (the electrode voltage without sag, the modal
+/// stiffness, an effect's zero loss) repeat row after row, and copying their bytes from
+/// the row above is several times cheaper than formatting them again. The text stays in
+/// the chunk's own buffer (`out` only grows), so a new value is written once.
+struct ColumnMemo {
+    /// Per column: the value's bits (NaN's, never produced by a finite value, when empty)
+    /// and the range of `out` holding its text.
+    last: Vec<(u64, std::ops::Range<usize>)>,
+}
+
+impl ColumnMemo {
+    fn new(columns: usize) -> Self {
+        ColumnMemo { last: vec![(f64::NAN.to_bits(), 0..0); columns] }
+    }
+
+    /// Appends `v` to `out` as `fmt.push` does, for column `c`; `out` must be the buffer
+    /// of every earlier call.
+    fn push(&mut self, fmt: &mut NumberFormatter, out: &mut Vec<u8>, c: usize, v: f64) {
+        let (bits, text) = &mut self.last[c];
+        if *bits == v.to_bits() {
+            out.extend_from_within(text.clone());
+        } else {
+            let start = out.len();
+            fmt.push(out, v);
+            (*bits, *text) = (v.to_bits(), start..out.len());
+        }
+    }
 }
 
 /// Writes numbers as `format!("{v}")` (and so [`crate::args::csv_number`]) does —
@@ -252,6 +284,25 @@ mod tests {
         f.push(&mut out, f64::NAN);
         f.push(&mut out, f64::INFINITY);
         assert!(out.is_empty());
+    }
+
+    #[test]
+    fn column_memo_writes_what_the_formatter_writes() {
+        // Two columns, values repeated, changed, signed zeros (equal as f64, not as text),
+        // non-finite values (no text) and a repeat right after one.
+        let seq = [1.5, 1.5, 2.0, 0.0, -0.0, -0.0, f64::NAN, f64::NAN, 3.25, 3.25, f64::INFINITY, 7e-9];
+        let (mut memo, mut f) = (ColumnMemo::new(2), NumberFormatter::new());
+        let (mut got, mut want) = (Vec::new(), Vec::new());
+        for (i, &v) in seq.iter().enumerate() {
+            let w = if i % 3 == 0 { 4.0 } else { v };
+            for (c, x) in [v, w].into_iter().enumerate() {
+                memo.push(&mut f, &mut got, c, x);
+                f.push(&mut want, x);
+                got.push(b',');
+                want.push(b',');
+            }
+        }
+        assert_eq!(String::from_utf8(got).unwrap(), String::from_utf8(want).unwrap());
     }
 }
 
