@@ -535,10 +535,12 @@ mod tests {
     /// full and rotor speeds up to just below the crest speed. The rule's error is largest
     /// where the law is closest to Coulomb (small ρ or σ): the traction then turns from
     /// driving to braking over |θ − θs| of order ρ or σ/sin θs, steep on the scale of the
-    /// Gauss–Legendre sub-panels next to θs. Measured worst relative errors (of the larger
-    /// of torque and power): ρ = 0.05: 7.2e-5, ρ = 0.3: 1.3e-5, ρ = 1: 3.3e-5, σ = 0.02:
-    /// 3.5e-4, σ = 0.2: 6.2e-8; truth forms ρ = 0.5: 8.8e-6, σ = 0.05: 3.7e-5. Each law's
-    /// bound below is about 1.5× its measured worst, so a rule that got worse fails here.
+    /// Gauss–Legendre sub-panels next to θs; and as u → 1 (the slip nearly vanishes at the
+    /// crest). Measured worst relative errors (of the larger of torque and power): ρ = 0.05:
+    /// 7.2e-5, ρ = 0.3: 1.3e-5 and ρ = 1: 3.3e-5 (both at u = 0.9999 only), σ = 0.02:
+    /// 3.5e-4, σ = 0.2: 6.2e-8; truth forms ρ = 0.5: 8.8e-6, σ = 0.05: 3.7e-5 (docs/EFFECTS.md).
+    /// Each law's bound below is about 1.5× its measured worst, so a rule that got worse
+    /// fails here.
     #[test]
     fn factors_agree_with_adaptive_quadrature_of_their_integrals() {
         use crate::quad::integrate;
