@@ -736,13 +736,17 @@ fn fit(
             return Err(TrumError::input(format!("invalid bounds [{}, {}] for {}", fp.lo, fp.hi, fp.param.name())));
         }
     }
-    // A start on a bound (a nested fit that pressed the parameter there) is placed BOUND_T
-    // inside it. At the transform's saturated end dp/du ≈ 1e-9: the column is ~0, the
-    // trust region, scaled by column norms, lets a step move u by 1e8, and it shrinks by
+    // A start within BOUND_T of a bound (in t; a nested fit that pressed the parameter
+    // there, a pair from its lead's optimum, a fold refit from its stepped point) is placed
+    // at BOUND_T from it. At the transform's saturated end dp/du ≈ 1e-9: the column is ~0,
+    // the trust region, scaled by column norms, lets a step move u by 1e8, and it shrinks by
     // ten a rejection until that step is harmless, then doubles back over dozens of passes
     // (1000-row benchmark, seeds 21-28: 34 of the 61 passes of the `voltage_sag` fit, the
-    // damping starting on its upper bound). Where the data press it back, `pressed` takes
-    // over within BOUND_T of the bound.
+    // damping starting on its upper bound). The start sits on the edge of the zone where
+    // `pressed` counts a parameter as on its bound (inside it by rounding at the lower
+    // bound, just outside at the upper); one step outwards it is inside. A parameter the
+    // data press only weakly can therefore end up to BOUND_T of its range short of the
+    // bound, where the bound term's gain is below FIT_DECREMENT_TOL.
     let u_edge = ((1.0 - BOUND_T) / BOUND_T).ln();
     let u0 = DVector::from_iterator(
         params.len(),

@@ -708,7 +708,8 @@ pub fn diagnose(
         // effects count as added, and a collapse of either lets the baseline stand in, not the
         // other single; such a pair cannot win over that single anyway)
         let added = if nested.is_some() { &effects[1..] } else { effects };
-        // a pair led by a fitted single starts at that fit's optimum
+        // a pair led by a fitted single starts at that fit's optimum (a parameter within
+        // 1e-3 of a bound moved to 1e-3 from it, `calibrate::fit`)
         let mut cal = if nested.is_some() {
             calibrate_extending(&s0, rows, &params, &opts.fit, added)
         } else {
