@@ -993,11 +993,18 @@ pub(crate) mod tests {
         assert!(short.is_err_and(|e| e.to_string().contains("weights")));
     }
 
-    /// An added effect the data do not contain collapses onto the nested model (abandoned,
-    /// in fewer passes than the fit that crawls its strength towards zero); one they do
-    /// contain is fitted, not abandoned. Voltage sag acts linearly in its resistance near
-    /// zero, so the plain fit crawls (an effect of second order there, like radial
-    /// friction's, settles on the decrement instead).
+    /// Friction coefficient, damping and force factor (the parameters `rows_from`'s grid
+    /// determines) and the voltage sag's source resistance, for the early-stop tests.
+    fn sag_fit_params(nominal: &Motor) -> Vec<FitParam> {
+        let mut params = vec![
+            fit_rel(nominal, "friction_layer.friction_coefficient", 0.3, 3.0),
+            fit_rel(nominal, "stator.modal_damping_ns_per_m", 0.2, 5.0),
+            fit_rel(nominal, "stator.force_factor_n_per_v", 0.3, 3.0),
+        ];
+        params.extend(effect_params(Effect::VoltageSag));
+        params
+    }
+
     #[test]
     fn an_early_stopped_weights_run_ends_where_the_full_one_does() {
         // An early stop of the unweighted first run, forced harder than the diagnosis's
@@ -1005,12 +1012,7 @@ pub(crate) mod tests {
         // where the plain fit's do.
         let nominal = preset("trum60a").unwrap();
         let sag = Effect::VoltageSag;
-        let mut params = vec![
-            fit_rel(&nominal, "friction_layer.friction_coefficient", 0.3, 3.0),
-            fit_rel(&nominal, "stator.modal_damping_ns_per_m", 0.2, 5.0),
-            fit_rel(&nominal, "stator.force_factor_n_per_v", 0.3, 3.0),
-        ];
-        params.extend(effect_params(sag));
+        let params = sag_fit_params(&nominal);
         let mut start = nominal.clone();
         start.effects.set(sag, &[75.0]);
         let mut truth = nominal.clone();
@@ -1067,12 +1069,7 @@ pub(crate) mod tests {
         // finished as a full one and ends where the plain fit does.
         let nominal = preset("trum60a").unwrap();
         let sag = Effect::VoltageSag;
-        let mut params = vec![
-            fit_rel(&nominal, "friction_layer.friction_coefficient", 0.3, 3.0),
-            fit_rel(&nominal, "stator.modal_damping_ns_per_m", 0.2, 5.0),
-            fit_rel(&nominal, "stator.force_factor_n_per_v", 0.3, 3.0),
-        ];
-        params.extend(effect_params(sag));
+        let params = sag_fit_params(&nominal);
         let mut truth = nominal.clone();
         truth.effects.set(sag, &[300.0]);
         let rows = rows_from(&truth);
@@ -1096,6 +1093,11 @@ pub(crate) mod tests {
         }
     }
 
+    /// An added effect the data do not contain collapses onto the nested model (abandoned,
+    /// in fewer passes than the fit that crawls its strength towards zero); one they do
+    /// contain is fitted, not abandoned. Voltage sag acts linearly in its resistance near
+    /// zero, so the plain fit crawls (an effect of second order there, like radial
+    /// friction's, settles on the decrement instead).
     #[test]
     fn an_added_effect_collapses_only_when_the_data_lack_it() {
         let nominal = preset("trum60a").unwrap();
