@@ -1785,7 +1785,7 @@ pub struct AmplitudeBranch {
 /// the frequency is swept down onto the resonance). Effects that iterate on the solution
 /// (thermal state, voltage sag) are not applied here: the drive is the set voltage.
 /// Found by a scan of 400 logarithmically spaced amplitudes from 10⁻⁶ of the bound
-/// Θ·V/(ω·c) to the bound, plus 4000 linearly spaced ones from 0.8 to 1.02 of the
+/// Θ·V/(ω·c) to the bound, plus 9000 linearly spaced ones from 0.8 to 1.3 of the
 /// amplitude where a W-dependent stiffness cancels the detuning (narrow folds), each sign
 /// change refined by bisection to 1e-12 relative.
 pub fn amplitude_branches(motor: &Motor, op: &OperatingPoint) -> Vec<AmplitudeBranch> {
@@ -1808,11 +1808,12 @@ pub fn amplitude_branches(motor: &Motor, op: &OperatingPoint) -> Vec<AmplitudeBr
     }
     const N: usize = 400;
     let mut ws: Vec<f64> = (0..=N).map(|i| w_hi * 1e-6f64.powf(1.0 - i as f64 / N as f64)).collect();
-    // Near a fold the window of r < 0 below the stiffness crossing is far narrower than the
-    // log grid's 3.5 % steps (0.3 % at trum60-qut, β = 1.089e18): scan 20 % below the
-    // crossing to 2 % above it in steps of 0.0055 % as well.
+    // Near the crossing a window of r < 0 can be far narrower than the log grid's 3.5 %
+    // steps: below it near a fold (0.3 % at trum60-qut, β = 1.089e18), above it where
+    // friction damping keeps |Z| falling (0.65 % at trum60a with both effects, 1.2 % above
+    // the crossing): scan 20 % below the crossing to 30 % above it in steps of 0.0055 %.
     if let Some(c) = stiffness_crossing(&p, &d, w_hi) {
-        ws.extend((0..=4000).map(|i| c * (0.8 + 0.22 * i as f64 / 4000.0)).filter(|&w| w < w_hi));
+        ws.extend((0..=9000).map(|i| c * (0.8 + 0.5 * i as f64 / 9000.0)).filter(|&w| w < w_hi));
         ws.sort_by(f64::total_cmp);
     }
     let rs: Vec<f64> = ws.iter().map(|&w| r(w)).collect();
@@ -2220,8 +2221,8 @@ mod tests {
     /// Where G(W) is not monotonic (preload stiffening, Hertz softening, candidate and
     /// truth forms, alone and together) the cold solve still reports the largest fixed
     /// point, the state reached from above; 1000 random points per configuration, each
-    /// with its own seed (≈ 5 s in release; `-- --nocapture` prints the census with the
-    /// mean amplitude evaluations). Before the capped descent and the softening spike
+    /// with its own seed (≈ 15 s in release, mostly the reference's dense scan;
+    /// `-- --nocapture` prints the census with the mean amplitude evaluations). Before the capped descent and the softening spike
     /// probe, 118 of 600 candidate-form points were on a lower branch or clamped; before
     /// the truth-form crossing and the fold search, a stop-15 review found 26 of 4000
     /// truth-form points so, and about 8 % with both effects on.
