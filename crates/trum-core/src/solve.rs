@@ -752,11 +752,23 @@ fn fold_window(p: &Prepared, d: &Drive, spike: &Trial, eval: &mut dyn FnMut(f64)
 /// - below the crossing (Re Z ≥ 0) |Z(W)| ≥ |Z(z2)|, G(W) ≤ G(z2): none where z1 ≥ G(z2);
 /// - above it (Re Z ≤ 0) |Z(W)| ≥ hypot(Re Z(z1), Im Z(z2)): none where z1 ≥ Θ·V over that.
 ///
-/// The highest interval not ruled out is halved, top down, until a probe has r < 0 or
-/// every interval above the lowest probe with r < 0 is ruled out (or narrower than 1e-7
-/// relative, as `fold_window`); after `budget` new probes, the highest r < 0 found so far.
-/// Both falls held without exception on fine scans (4000 amplitudes from 1e-3 of the
-/// crossing to the top) at 1740 random points of the multi-branch test configurations.
+/// The highest interval not ruled out is halved, top down, until every interval above a
+/// probe with r < 0 is ruled out or narrower than 1e-7 relative (as `fold_window`), or
+/// `budget` new probes are spent (then the highest r < 0 found so far). The bound never
+/// rules out the interval just above a probe with r < 0 (there G(z2) > z1), so a search
+/// that finds a window halves that interval to 1e-7 or to the budget: the budget exit is
+/// the usual one then. (Returning as soon as an interval's lower end has r < 0 was tried by
+/// a review: it missed a higher window inside that interval, generic60 softening 3e17 at
+/// 409 N, 1.47 N·m.) A search that finds none costs nothing where the descent kept clear
+/// of the crossing.
+///
+/// Both falls held without exception for the Coulomb interface on fine scans (4000
+/// amplitudes from 1e-3 of the crossing to the top, 1740 random points of the
+/// multi-branch test configurations; a review: 10 000 points × 6 000 amplitudes, torque up
+/// to 5 N·m). Under `tangential_compliance` Im Z can jump up where the speed ratio drops
+/// (generic60, stiffening 3.3 and compliance 1 in truth form: 7× over 0.2 % of W), so the
+/// bound above the crossing is not proven there; a review's soundness check (18
+/// configurations, dense grids) found no interval it ruled out that held r < 0.
 fn highest_window(
     p: &Prepared,
     d: &Drive,
@@ -1522,9 +1534,12 @@ fn solve_drive_below(
         }
     };
     // G peaks in a spike where the W-dependent stiffness cancels the detuning k − mω²,
-    // narrower than any step cap (10 % wide in W at generic60, β = 3e17). Above that
-    // amplitude |Re Z| only grows with W, so where the spike reaches r < 0 the largest
-    // root is the one root between it and the top: bracket it at once. Where r ≥ 0 at the
+    // narrower than any step cap (10 % wide in W at generic60, β = 3e17). Where the spike
+    // reaches r < 0 the root between it and the top is bracketed at once. That is the
+    // largest root only if r has one sign change above the spike, which the falling
+    // friction damping can break (a review: 2 of 300 000 random points, trum60a with
+    // candidate-form softening 1e18, where a lower root was reported; searching that
+    // bracket with `highest_window` cost 1.5-12 more evaluations a point). Where r ≥ 0 at the
     // spike a window of r < 0 can still open next to it, because friction damping falls
     // with W and moves G's peak off the crossing:
     // - below it, near a fold (trum60-qut truth form, β = 1.089e18 at 211.8 N, 252.6 V,
@@ -2166,6 +2181,9 @@ mod tests {
             ("trum60a", "hertz_softening=1e18", false, OperatingPoint::new(492.619, 0.701395, 162.961, 40361.9), true),
             ("trum60a", "hertz_softening=1e18", false, OperatingPoint::new(598.512, 0.555832, 170.570, 38155.7), true),
             ("trum60a", BOTH, true, OperatingPoint::new(596.554, 0.228730, 168.347, 42206.1), true),
+            // a window 0.4 % wide at 1.047 of the crossing (a review; the reference scan
+            // went only to 1.02 of the crossing then and passed the clamped-like 1.98e-8 m)
+            ("trum60a", BOTH, true, OperatingPoint::new(488.149312, 0.6318092, 154.291230, 43570.8501), true),
             ("trum60a", "preload_stiffening=1", true, OperatingPoint::new(194.551, 1.386416, 80.8638, 44049.04), false),
             (
                 "trum60-qut",
