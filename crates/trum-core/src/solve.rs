@@ -757,10 +757,12 @@ fn fold_window(p: &Prepared, d: &Drive, spike: &Trial, eval: &mut dyn FnMut(f64)
 /// `budget` new probes are spent (then the highest r < 0 found so far). The bound never
 /// rules out the interval just above a probe with r < 0 (there G(z2) > z1), so a search
 /// that finds a window halves that interval to 1e-7 or to the budget: the budget exit is
-/// the usual one then. (Returning as soon as an interval's lower end has r < 0 was tried by
-/// a review: it missed a higher window inside that interval, generic60 softening 3e17 at
-/// 409 N, 1.47 N·m.) A search that finds none costs nothing where the descent kept clear
-/// of the crossing.
+/// the usual one then. An interval with r < 0 at its lower end that is narrower than
+/// `resolved` (relative) is taken as the answer at once: 1 − MULTI_BRANCH_STEP, the step
+/// the capped descent trusts, from a crossing with r < 0; 0 after the descent. (Returning
+/// at any width was tried by a review: it missed a higher window inside that interval,
+/// generic60 softening 3e17 at 409 N, 1.47 N·m.) A search that finds none costs nothing
+/// where the descent kept clear of the crossing.
 ///
 /// Both falls held without exception for the Coulomb interface on fine scans (4000
 /// amplitudes from 1e-3 of the crossing to the top, 1740 random points of the
@@ -775,6 +777,7 @@ fn highest_window(
     ws: f64,
     mut probes: Vec<Trial>,
     budget: usize,
+    resolved: f64,
     eval: &mut dyn FnMut(f64) -> Trial,
 ) -> Option<(Trial, Trial)> {
     let theta_v = p.theta * d.v;
@@ -793,6 +796,9 @@ fn highest_window(
             }
             if j == 0 || clear(&probes[j - 1], &probes[j]) {
                 continue;
+            }
+            if below(&probes[j - 1]) && probes[j].w - probes[j - 1].w <= resolved * probes[j].w {
+                return Some((probes[j - 1], probes[j]));
             }
             if spent == budget {
                 // out of budget: the highest r < 0 found, if any
@@ -1535,11 +1541,12 @@ fn solve_drive_below(
     };
     // G peaks in a spike where the W-dependent stiffness cancels the detuning k − mω²,
     // narrower than any step cap (10 % wide in W at generic60, β = 3e17). Where the spike
-    // reaches r < 0 the root between it and the top is bracketed at once. That is the
-    // largest root only if r has one sign change above the spike, which the falling
-    // friction damping can break (a review: 2 of 300 000 random points, trum60a with
-    // candidate-form softening 1e18, where a lower root was reported; searching that
-    // bracket with `highest_window` cost 1.5-12 more evaluations a point). Where r ≥ 0 at the
+    // reaches r < 0 a root lies between it and the top, but not necessarily the largest:
+    // the falling friction damping can give r more than one sign change up there (a
+    // review: 2 of 300 000 random points, trum60a with candidate-form softening 1e18, a
+    // lower root reported). `highest_window` brackets the highest window, to the width of
+    // a capped descent step (the rigour of the descent itself; 0.5-3.8 more evaluations a
+    // point in the census, 5-12 % of a diagnosis). Where r ≥ 0 at the
     // spike a window of r < 0 can still open next to it, because friction damping falls
     // with W and moves G's peak off the crossing:
     // - below it, near a fold (trum60-qut truth form, β = 1.089e18 at 211.8 N, 252.6 V,
@@ -1556,7 +1563,10 @@ fn solve_drive_below(
     if let Some(ws) = if multi_branch { stiffness_crossing(p, d, hi.w) } else { None } {
         let t = eval(ws, &mut ts_guess);
         if t.w < t.w_next {
-            cur = Some(t);
+            let found =
+                highest_window(p, d, ws, vec![hi, t], 40, 1.0 - MULTI_BRANCH_STEP, &mut |w| eval(w, &mut ts_guess));
+            let (tl, top) = found.unwrap_or((t, hi));
+            (hi, cur) = (top, Some(tl));
         } else {
             spike = Some(t);
             above.push(hi);
@@ -1641,7 +1651,7 @@ fn solve_drive_below(
             spike = None;
             let mut seen = std::mem::take(&mut above);
             seen.push(sp);
-            let found = highest_window(p, d, sp.w, seen, 40, &mut |w| eval(w, &mut ts_guess)).or_else(|| {
+            let found = highest_window(p, d, sp.w, seen, 40, 0.0, &mut |w| eval(w, &mut ts_guess)).or_else(|| {
                 // the fold window's trials, to rule out a window above the one it found
                 let mut seen = vec![sp];
                 let tm = fold_window(p, d, &sp, &mut |w| {
@@ -1650,7 +1660,7 @@ fn solve_drive_below(
                     t
                 })?;
                 seen.retain(|t| t.w >= tm.w);
-                highest_window(p, d, sp.w, seen, 40, &mut |w| eval(w, &mut ts_guess))
+                highest_window(p, d, sp.w, seen, 40, 0.0, &mut |w| eval(w, &mut ts_guess))
             });
             if let Some((t, top)) = found {
                 bracket.record(top.w, top.w - top.w_next, true);
@@ -2184,6 +2194,22 @@ mod tests {
             // a window 0.4 % wide at 1.047 of the crossing (a review; the reference scan
             // went only to 1.02 of the crossing then and passed the clamped-like 1.98e-8 m)
             ("trum60a", BOTH, true, OperatingPoint::new(488.149312, 0.6318092, 154.291230, 43570.8501), true),
+            // r < 0 at the crossing itself, and a higher window above it than the one the
+            // bracket [crossing, top] converged in (a review; the second 12-25× the crossing)
+            (
+                "trum60a",
+                "hertz_softening=1e18",
+                false,
+                OperatingPoint::new(488.145028, 0.54623495, 160.640349, 40590.465),
+                true,
+            ),
+            (
+                "trum60a",
+                "hertz_softening=1e18",
+                false,
+                OperatingPoint::new(310.906458, 0.28872648, 100.388775, 40749.024),
+                true,
+            ),
             ("trum60a", "preload_stiffening=1", true, OperatingPoint::new(194.551, 1.386416, 80.8638, 44049.04), false),
             (
                 "trum60-qut",
