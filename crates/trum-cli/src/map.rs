@@ -7,7 +7,7 @@
 //! byte-identical whatever the parallelism. At most three waves exist at once (one being
 //! solved, one queued, one being written): memory is constant for any grid size.
 
-use crate::args::{check_grid, default_grid, GridArgs, MotorArgs, OutputTarget, Progress};
+use crate::args::{check_grid, default_grid, GridArgs, MotorArgs, OutputTarget, Progress, WritebackFile};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use rayon::prelude::*;
@@ -21,6 +21,10 @@ use trum_core::Motor;
 /// Points per chunk: large enough that warm starts pay off and scheduling is cheap,
 /// small enough that a wave of chunks stays a few megabytes.
 const CHUNK: u64 = 4096;
+
+/// Bytes between the early disk flushes of a map written to a file (4-32 MB measured the
+/// same; docs/PERFORMANCE.md "CSV maps").
+const WRITEBACK_STEP: u64 = 32 << 20;
 
 /// Input columns, in the order they are written.
 pub const INPUT_COLUMNS: [&str; 4] = ["preload_n", "torque_nm", "voltage_v", "frequency_hz"];
@@ -83,7 +87,7 @@ pub fn run(a: &MapArgs, out: &mut dyn Write, _err: &mut dyn Write) -> Result<i32
     let result = match target.open()? {
         None => write_map(&motor, &grid, &cols, a.chunk_points, &pool, out, &mut progress),
         Some(file) => {
-            let mut w = BufWriter::with_capacity(1 << 20, file);
+            let mut w = BufWriter::with_capacity(1 << 20, WritebackFile::new(file, WRITEBACK_STEP));
             write_map(&motor, &grid, &cols, a.chunk_points, &pool, &mut w, &mut progress)
                 .and_then(|()| w.flush().map_err(Into::into))
                 .with_context(|| format!("writing '{}'", a.output.display()))
@@ -183,9 +187,19 @@ impl NumberFormatter {
         if !v.is_finite() {
             return;
         }
+        let a = v.abs();
         let s = self.digits.format_finite(v).as_bytes();
+        if (1e-5..1e16).contains(&a) {
+            // zmij writes these magnitudes in decimal form (decimal exponent -5..=15: the
+            // shortest digits of a double below 1e16, or at or above the double nearest
+            // 1e-5, stay on the same side of the bound), an integer as "N.0", which
+            // Display writes without ".0". Deciding by magnitude instead of reading the
+            // text back (looking for `e`, then for ".0") was ~17 % of a map's CPU.
+            let n = if v.fract() == 0.0 { s.len() - 2 } else { s.len() };
+            out.extend_from_slice(&s[..n]);
+            return;
+        }
         let Some(e) = s.iter().position(|&b| b == b'e') else {
-            // Decimal form: the same digits as Display, which omits a trailing ".0".
             out.extend_from_slice(s.strip_suffix(b".0").unwrap_or(s));
             return;
         };
@@ -266,6 +280,18 @@ mod tests {
         for v in [0.0, -0.0, 1.0, -1.0, 0.1, 1e-7, 1.5e20, 1e21, 123.456, 5e-324, f64::MAX, f64::MIN_POSITIVE, 43000.0]
         {
             check(v);
+        }
+        // Both sides of the magnitudes where the notation changes, and integers near them.
+        for b in [1e-5, 1e16, 1e15, 1e-4] {
+            for k in -3i64..=3 {
+                let v = f64::from_bits((b as f64).to_bits().wrapping_add_signed(k));
+                check(v);
+                check(-v);
+            }
+        }
+        for v in [9_999_999_999_999_998.0, 999_999_999_999_999.9, 4_503_599_627_370_496.5, 0.5, 2.0f64.powi(52)] {
+            check(v);
+            check(-v);
         }
         // Random bit patterns over the whole finite range, and values of map magnitudes.
         let mut x = 0x9E37_79B9_7F4A_7C15u64;
