@@ -266,16 +266,18 @@ fn stress_baseline_always_converges() {
     assert_eq!(c.get("invalid_input"), None, "{c:?}");
 }
 
-/// With strong `voltage_sag` or `thermal_drift`, every valid state is its own fixed point;
-/// `no_convergence` stays rare (no steady state at the clamping edge, or a thermal
-/// runaway past the resonance far beyond typical strength: docs/EFFECTS.md).
+/// With strong `voltage_sag` or `thermal_drift`, alone or together, every valid state is
+/// its own fixed point; `no_convergence` stays rare (no steady state at the clamping edge,
+/// or a thermal runaway past the resonance far beyond typical strength: docs/EFFECTS.md).
+/// Together: 155 of 20 000 since the nested fallback of stop 27 (468 before, where the
+/// joint passes cycled; the bound of 1 in 50 fails without it at the default size too).
 #[test]
 fn stress_self_consistent_effects() {
-    for (sag, thermal) in [(true, false), (false, true)] {
+    for (sag, thermal, one_in) in [(true, false, 25), (false, true, 25), (true, true, 50)] {
         let n = stress_n(2_000);
         let c = stress(n, 0x2545_f491_4f6c_dd1d, sag, thermal);
         assert_eq!(c.get("inconsistent"), None, "{c:?}");
         let nc = c.get("no_convergence").copied().unwrap_or(0);
-        assert!(nc * 25 <= n, "{nc} of {n} points without a steady state: {c:?}");
+        assert!(nc * one_in <= n, "{nc} of {n} points without a steady state: {c:?}");
     }
 }
