@@ -255,83 +255,6 @@ fn parse_exponent(s: &[u8]) -> i64 {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn number_formatter_writes_what_display_writes() {
-        let mut f = NumberFormatter::new();
-        let (mut exact, mut total) = (0usize, 0usize);
-        let mut check = |v: f64| {
-            let mut out = Vec::new();
-            f.push(&mut out, v);
-            let got = String::from_utf8(out).expect("ascii");
-            let want = format!("{v}");
-            // Same shortest round trip in the same notation. (Where two 17-digit strings
-            // are equally short, zmij and std may pick different last digits: 1658206780088562.2
-            // vs .3 for 1.6582067800885623e15; both parse back to v.)
-            assert_eq!(got.parse::<f64>().map(f64::to_bits), Ok(v.to_bits()), "{v:e}: {got}");
-            assert_eq!(got.len(), want.len(), "{v:e}: {got} vs {want}");
-            assert!(!got.contains('e'));
-            exact += usize::from(got == want);
-            total += 1;
-        };
-        for v in [0.0, -0.0, 1.0, -1.0, 0.1, 1e-7, 1.5e20, 1e21, 123.456, 5e-324, f64::MAX, f64::MIN_POSITIVE, 43000.0]
-        {
-            check(v);
-        }
-        // Both sides of the magnitudes where the notation changes, and integers near them.
-        for b in [1e-5, 1e16, 1e15, 1e-4] {
-            for k in -3i64..=3 {
-                let v = f64::from_bits((b as f64).to_bits().wrapping_add_signed(k));
-                check(v);
-                check(-v);
-            }
-        }
-        for v in [9_999_999_999_999_998.0, 999_999_999_999_999.9, 4_503_599_627_370_496.5, 0.5, 2.0f64.powi(52)] {
-            check(v);
-            check(-v);
-        }
-        // Random bit patterns over the whole finite range, and values of map magnitudes.
-        let mut x = 0x9E37_79B9_7F4A_7C15u64;
-        for _ in 0..200_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            let v = f64::from_bits(x);
-            if v.is_finite() {
-                check(v);
-                check(v.abs().log2().fract() * 1e3);
-            }
-        }
-        assert!(exact as f64 >= 0.999 * total as f64, "{exact} of {total} identical to Display");
-        let mut out = Vec::new();
-        f.push(&mut out, f64::NAN);
-        f.push(&mut out, f64::INFINITY);
-        assert!(out.is_empty());
-    }
-
-    #[test]
-    fn column_memo_writes_what_the_formatter_writes() {
-        // Two columns, values repeated, changed, signed zeros (equal as f64, not as text),
-        // non-finite values (no text) and a repeat right after one.
-        let seq = [1.5, 1.5, 2.0, 0.0, -0.0, -0.0, f64::NAN, f64::NAN, 3.25, 3.25, f64::INFINITY, 7e-9];
-        let (mut memo, mut f) = (ColumnMemo::new(2), NumberFormatter::new());
-        let (mut got, mut want) = (Vec::new(), Vec::new());
-        for (i, &v) in seq.iter().enumerate() {
-            let w = if i % 3 == 0 { 4.0 } else { v };
-            for (c, x) in [v, w].into_iter().enumerate() {
-                memo.push(&mut f, &mut got, c, x);
-                f.push(&mut want, x);
-                got.push(b',');
-                want.push(b',');
-            }
-        }
-        assert_eq!(String::from_utf8(got).unwrap(), String::from_utf8(want).unwrap());
-    }
-}
-
 fn write_map(
     motor: &Motor,
     grid: &Grid,
@@ -383,4 +306,81 @@ fn write_map(
         }
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn number_formatter_writes_what_display_writes() {
+        let mut f = NumberFormatter::new();
+        let (mut exact, mut total) = (0usize, 0usize);
+        let mut check = |v: f64| {
+            let mut out = Vec::new();
+            f.push(&mut out, v);
+            let got = String::from_utf8(out).expect("ascii");
+            let want = format!("{v}");
+            // Same shortest round trip in the same notation. (Where two 17-digit strings
+            // are equally short, zmij and std may pick different last digits: 1658206780088562.2
+            // vs .3 for 1.6582067800885623e15; both parse back to v.)
+            assert_eq!(got.parse::<f64>().map(f64::to_bits), Ok(v.to_bits()), "{v:e}: {got}");
+            assert_eq!(got.len(), want.len(), "{v:e}: {got} vs {want}");
+            assert!(!got.contains('e'));
+            exact += usize::from(got == want);
+            total += 1;
+        };
+        for v in [0.0, -0.0, 1.0, -1.0, 0.1, 1e-7, 1.5e20, 1e21, 123.456, 5e-324, f64::MAX, f64::MIN_POSITIVE, 43000.0]
+        {
+            check(v);
+        }
+        // Both sides of the magnitudes where the notation changes, and integers near them.
+        for b in [1e-5f64, 1e16, 1e15, 1e-4] {
+            for k in -3i64..=3 {
+                let v = f64::from_bits(b.to_bits().wrapping_add_signed(k));
+                check(v);
+                check(-v);
+            }
+        }
+        for v in [9_999_999_999_999_998.0, 999_999_999_999_999.9, 4_503_599_627_370_496.5, 0.5, 2.0f64.powi(52)] {
+            check(v);
+            check(-v);
+        }
+        // Random bit patterns over the whole finite range, and values of map magnitudes.
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = f64::from_bits(x);
+            if v.is_finite() {
+                check(v);
+                check(v.abs().log2().fract() * 1e3);
+            }
+        }
+        assert!(exact as f64 >= 0.999 * total as f64, "{exact} of {total} identical to Display");
+        let mut out = Vec::new();
+        f.push(&mut out, f64::NAN);
+        f.push(&mut out, f64::INFINITY);
+        assert!(out.is_empty());
+    }
+
+    #[test]
+    fn column_memo_writes_what_the_formatter_writes() {
+        // Two columns, values repeated, changed, signed zeros (equal as f64, not as text),
+        // non-finite values (no text) and a repeat right after one.
+        let seq = [1.5, 1.5, 2.0, 0.0, -0.0, -0.0, f64::NAN, f64::NAN, 3.25, 3.25, f64::INFINITY, 7e-9];
+        let (mut memo, mut f) = (ColumnMemo::new(2), NumberFormatter::new());
+        let (mut got, mut want) = (Vec::new(), Vec::new());
+        for (i, &v) in seq.iter().enumerate() {
+            let w = if i % 3 == 0 { 4.0 } else { v };
+            for (c, x) in [v, w].into_iter().enumerate() {
+                memo.push(&mut f, &mut got, c, x);
+                f.push(&mut want, x);
+                got.push(b',');
+                want.push(b',');
+            }
+        }
+        assert_eq!(String::from_utf8(got).expect("ascii"), String::from_utf8(want).expect("ascii"));
+    }
 }
