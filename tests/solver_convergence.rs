@@ -236,7 +236,8 @@ fn stress(n: usize, seed: u64, sag: bool, thermal: bool) -> std::collections::BT
         if s.status.is_valid() && thermal && op.elapsed_s > 0.0 {
             let hs = m.thermal.heat_transfer_coefficient_w_per_m2k * m.thermal.surface_area_m2;
             let want = s.temperature_rise_k * (1.0 - (-op.elapsed_s * hs / m.thermal.heat_capacity_j_per_k).exp());
-            consistent &= (s.temperature_rise_at_elapsed_k - want).abs() <= 1e-8 * want.max(1e-6);
+            // (the passes stop within 1e-10·(1 + rise) K: absolute for a rise of a few mK)
+            consistent &= (s.temperature_rise_at_elapsed_k - want).abs() <= 1e-8 * want.max(1e-6) + 1e-9;
         }
         if s.status.is_valid() && sag {
             let v_set = (s.electrode_voltage_v + z * s.current_in_phase_a).hypot(z * s.current_quadrature_a);
