@@ -255,7 +255,13 @@ impl OutputTarget {
     /// Moves the finished temporary file to its final name.
     pub fn finish(self) -> Result<()> {
         if let OutputTarget::File(tmp, path) = self {
-            tmp.as_file().sync_all().ok();
+            // An fsync that fails can mean data that never reached the disk: no rename then
+            // (the temporary file is removed). A filesystem without fsync is no failure.
+            if let Err(e) = tmp.as_file().sync_all() {
+                if !matches!(e.kind(), std::io::ErrorKind::InvalidInput | std::io::ErrorKind::Unsupported) {
+                    bail!("cannot write '{}': {e}", path.display());
+                }
+            }
             tmp.persist(&path).map_err(|e| anyhow!("cannot write '{}': {}", path.display(), e.error))?;
         }
         Ok(())
@@ -281,17 +287,21 @@ pub struct WritebackFile {
 
 impl WritebackFile {
     /// Wraps `file`; flushes start every `step` bytes (no helper when the file cannot be
-    /// cloned: then it is a plain file writer).
+    /// cloned or no thread started: then it is a plain file writer).
     pub fn new(file: std::fs::File, step: u64) -> WritebackFile {
         let (kick, helper) = match file.try_clone() {
             Ok(clone) => {
                 let (tx, rx) = std::sync::mpsc::sync_channel::<()>(1);
-                let h = std::thread::spawn(move || {
+                let spawned = std::thread::Builder::new().name("trum-writeback".into()).spawn(move || {
                     for () in rx {
                         clone.sync_data().ok();
                     }
                 });
-                (Some(tx), Some(h))
+                match spawned {
+                    Ok(h) => (Some(tx), Some(h)),
+                    // no thread to spare: a plain writer
+                    Err(_) => (None, None),
+                }
             }
             Err(_) => (None, None),
         };
