@@ -2316,7 +2316,8 @@ mod tests {
                   damping_coefficient_per_k=0.002";
         let m = motor_with("trum60a", &format!("voltage_sag=150;{th}"), false);
         let p = Prepared::new(&m);
-        let mut op = OperatingPoint::new(301.77607641416205, 0.7886468900037416, 227.28717512048937, 40163.644478763854);
+        let mut op =
+            OperatingPoint::new(301.77607641416205, 0.7886468900037416, 227.28717512048937, 40163.644478763854);
         op.elapsed_s = 170.56565919703655;
         let direct = |d: &Drive, _: f64, g: Option<&Solution>| solve_drive(&p, d, &op, g);
         let (_, _, joint) = settle(&p, &op, None, (true, true), 0.0, &direct);
