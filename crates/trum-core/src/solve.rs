@@ -1063,12 +1063,12 @@ fn solve_effects_with(
     s
 }
 
-/// The fixed point of the effects that iterate (`which` = (temperature rise, electrode
-/// voltage)) by passes: each pass solves the state (`state(d, rise, guess)`) at the drive
-/// of the latest temperature rise and electrode voltage and recomputes both from it. A
-/// temperature rise that does not iterate stays at `rise0`. Returns the last state, the
-/// rise and whether the passes settled; an invalid state (clamped, no convergence) ends
-/// them.
+/// The fixed point of the effects that iterate ((`thermal`, `sag`): the temperature rise,
+/// the electrode voltage) by passes: each pass solves the state (`state(d, rise, guess)`)
+/// at the drive of the latest temperature rise and electrode voltage and recomputes both
+/// from it. A temperature rise that does not iterate stays at `rise0`. Returns the last
+/// state, the rise and whether the passes settled; a state without valid numbers (no
+/// convergence) ends them.
 fn settle(
     p: &Prepared,
     op: &OperatingPoint,
