@@ -1629,8 +1629,9 @@ fn solve_drive_below(
         // known, r ≥ 0), so that the loop's next step runs the window searches: landing
         // below the crossing with r < 0 would bracket the first root regula falsi finds
         // between there and the top (a review: 893 of 200 000 census points landed below
-        // the crossing, 6 of them with r < 0, none yet on a lower root).
-        (None, Some(sp)) if lo.is_none() && capped(start, hi.w) <= sp.w => sp,
+        // the crossing, 6 of them with r < 0, none yet on a lower root). Not a crossing
+        // trial without a finite residual: as `cur` it would become `lo`.
+        (None, Some(sp)) if lo.is_none() && sp.w_next.is_finite() && capped(start, hi.w) <= sp.w => sp,
         (None, _) => eval(capped(start, hi.w), &mut ts_guess),
     };
     // From a warm top (within a hair of the root) the first secant already uses it; from
