@@ -2324,16 +2324,22 @@ mod tests {
         }
     }
 
+    /// trum60a with `voltage_sag` 150 Ω and the nominal `thermal_drift` coefficients.
+    fn sag_and_drift_trum60a() -> (Motor, Prepared) {
+        let th = "thermal_drift:stiffness_coefficient_per_k=-0.0004,friction_coefficient_per_k=-0.002,\
+                  damping_coefficient_per_k=0.002";
+        let m = motor_with("trum60a", &format!("voltage_sag=150;{th}"), false);
+        let p = Prepared::new(&m);
+        (m, p)
+    }
+
     /// `voltage_sag` with `thermal_drift`: where the joint passes cycle (here between a
     /// running and a stalled state: they do not settle in 100 passes), the nested fallback
     /// finds the state that is its own fixed point in both: the temperature rise its losses
     /// produce, the electrode voltage its current leaves.
     #[test]
     fn sag_with_thermal_drift_settles_where_the_joint_passes_cycle() {
-        let th = "thermal_drift:stiffness_coefficient_per_k=-0.0004,friction_coefficient_per_k=-0.002,\
-                  damping_coefficient_per_k=0.002";
-        let m = motor_with("trum60a", &format!("voltage_sag=150;{th}"), false);
-        let p = Prepared::new(&m);
+        let (m, p) = sag_and_drift_trum60a();
         let mut op =
             OperatingPoint::new(301.77607641416205, 0.7886468900037416, 227.28717512048937, 40163.644478763854);
         op.elapsed_s = 170.56565919703655;
@@ -2357,10 +2363,7 @@ mod tests {
     /// double from r = 2.6e-18 m).
     #[test]
     fn the_descent_does_not_crawl_just_past_a_fold() {
-        let th = "thermal_drift:stiffness_coefficient_per_k=-0.0004,friction_coefficient_per_k=-0.002,\
-                  damping_coefficient_per_k=0.002";
-        let m = motor_with("trum60a", &format!("voltage_sag=150;{th}"), false);
-        let p = Prepared::new(&m);
+        let (_, p) = sag_and_drift_trum60a();
         let mut op = OperatingPoint::new(400.6711409395973, 0.789261744966443, 173.7, 39935.4);
         op.elapsed_s = 611.0;
         let mut d = Drive::at(&p, &op);
