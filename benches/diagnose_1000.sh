@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # The issue-5 speed benchmark: a diagnosis of about 1000 rows with all seven candidates
 # and block cross-validation (docs/PERFORMANCE.md). Builds eight `combined` campaigns of
-# trum60a (radial_friction injected, nominal noise) at drive voltages 165-235 V, joins
+# one trum60a (radial_friction injected, nominal noise) at drive voltages 165-235 V, joins
 # them into one file (run ids prefixed with the voltage) and times `trum diagnose`.
 #   bash benches/diagnose_1000.sh            # release build, then the timed run
-#   SEED_OFFSET=10 bash benches/diagnose_1000.sh   # the same campaigns with seeds 11-18
+#   SEED_OFFSET=10 bash benches/diagnose_1000.sh   # noise seeds 11-18, motor seed 11
+#   FLEET=1 bash benches/diagnose_1000.sh    # the design before stop 28: each campaign
+#                                            # its own motor (motor seed = noise seed)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -q -p trum-cli
@@ -16,8 +18,11 @@ i=0
 off=${SEED_OFFSET:-0}
 for v in 165 175 185 195 205 215 225 235; do
     i=$((i + 1))
+    # one motor measured in eight runs: the motor seed is shared, the noise seeds differ
+    motor_seed=$((1 + off))
+    if [ -n "${FLEET:-}" ]; then motor_seed=$((i + off)); fi
     "$T" synth --motor trum60a --effect radial_friction=1 --campaign combined --noise 1 --seed "$((i + off))" \
-        --voltage-v "$v" -o "$dir/c$i.csv" > /dev/null
+        --motor-seed "$motor_seed" --voltage-v "$v" -o "$dir/c$i.csv" > /dev/null
     if [ "$i" = 1 ]; then head -n 1 "$dir/c$i.csv" > "$out"; fi
     # prefix every run id (the last column) with the voltage so runs stay distinct
     tail -n +2 "$dir/c$i.csv" | awk -F, -v OFS=, -v p="v$v-" '{ $NF = p $NF; print }' >> "$out"

@@ -46,6 +46,11 @@ pub struct SynthArgs {
     /// Random seed (the same seed gives the same file, byte for byte).
     #[arg(long, value_name = "N")]
     seed: u64,
+    /// Seed of the true motor's parameter perturbation (default: `--seed`). Give several
+    /// campaigns the same motor seed and different seeds to simulate one motor measured
+    /// in several runs; different motor seeds are different motors of one design.
+    #[arg(long, value_name = "N")]
+    motor_seed: Option<u64>,
     /// Relative standard deviation of the perturbation of the uncertain motor parameters
     /// (what calibration must absorb).
     #[arg(long, default_value_t = 0.03, value_name = "REL")]
@@ -100,6 +105,7 @@ pub fn run(a: &SynthArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
         campaign: a.campaign.campaign()?,
         noise: a.noise,
         seed: a.seed,
+        motor_seed: a.motor_seed,
         perturbation: a.perturbation,
         voltage_v: a.voltage_v,
         frequency_hz: a.frequency_hz,
@@ -122,12 +128,13 @@ pub fn run(a: &SynthArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
         };
         writeln!(
             err,
-            "wrote {} rows to '{}': campaign {}, noise {}, seed {}, effects {}{forms}",
+            "wrote {} rows to '{}': campaign {}, noise {}, seed {}{}, effects {}{forms}",
             rows.len(),
             a.output.display(),
             a.campaign.to_possible_value().map(|v| v.get_name().to_string()).unwrap_or_default(),
             a.noise,
             a.seed,
+            a.motor_seed.filter(|&m| m != a.seed).map(|m| format!(" (motor seed {m})")).unwrap_or_default(),
             motor.effects,
         )?;
     }

@@ -723,7 +723,9 @@ pub fn diagnose(
         let first_ev = cal.as_ref().map(|c| 0.5 * (base_bic - bic(c.chi2, kpar))).unwrap_or(f64::NEG_INFINITY);
         let at_noise = cal.as_ref().is_ok_and(|c| c.chi2 <= 1.5 * n_read as f64);
         let collapsed = cal.as_ref().is_ok_and(|c| c.abandoned);
-        if !at_noise && first_ev <= 5.0 && !collapsed {
+        let on_bound =
+            cal.as_ref().is_ok_and(|c| c.params.iter().any(|p| p.at_bound && !p.name.starts_with("effects.")));
+        if !at_noise && (first_ev <= 5.0 || on_bound) && !collapsed {
             let mut s1 = motor.clone();
             for &e in effects {
                 let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
@@ -1422,6 +1424,49 @@ mod tests {
         let d = diagnose(&carrying, &rows, &groups, &opts).expect("diagnosis");
         let thermal = d.ranking.iter().find(|r| r.effect == "thermal_drift").expect("ranked");
         assert!(thermal.params.is_empty() && thermal.shrink == 0.0, "{thermal:?}");
+    }
+
+    /// One motor measured at four drive voltages (preload-torque runs, radial friction in its
+    /// truth form): the baseline fit presses the modal damping onto its upper bound, a valley
+    /// the radial-friction fit started from it stays in (held-out χ² 108 per reading, ρ far
+    /// from the truth). A fit that ends with a baseline parameter on a bound short of the
+    /// noise level gets the second start from the nominal motor, which finds the truth.
+    #[test]
+    fn a_fit_left_on_the_baselines_bound_gets_a_second_start() {
+        let nominal = preset("trum60a").expect("preset");
+        let mut truth = nominal.clone();
+        truth.effects.set_strength(Effect::RadialFriction, 1.0);
+        let (mut rows, mut groups) = (Vec::new(), Vec::new());
+        for (i, v) in [165.0, 185.0, 205.0, 225.0].into_iter().enumerate() {
+            let cfg = SynthConfig {
+                campaign: Campaign::PreloadTorque,
+                seed: 31 + i as u64,
+                motor_seed: Some(31),
+                voltage_v: v,
+                ..SynthConfig::default()
+            };
+            for r in synthesize(&truth, &cfg).expect("synth") {
+                rows.push(r.observed());
+                groups.push(format!("v{v}-{}", r.run_id));
+            }
+        }
+        let opts = DiagnoseOptions {
+            candidates: vec![Effect::RadialFriction],
+            try_pairs: false,
+            bootstrap: 50,
+            ..DiagnoseOptions::default()
+        };
+        let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnose");
+        let damping = d.baseline_params.iter().find(|p| p.0.ends_with("modal_damping_ns_per_m")).expect("damping").1;
+        assert!(
+            damping > 49.9,
+            "the baseline no longer ends on the damping bound ({damping}): the test needs new data"
+        );
+        let rf = d.ranking.iter().find(|r| r.effect == "radial_friction").expect("ranked");
+        assert_eq!(d.verdict, "radial_friction");
+        assert!(rf.heldout_chi2_after < 5.0, "held-out χ² per reading {}", rf.heldout_chi2_after);
+        let rho = rf.params[0].1;
+        assert!((rho - 1.0).abs() < 0.1, "ρ {rho}");
     }
 
     /// The held-out need is the pair that gains exactly PAIR_GAIN of the single's excess in

@@ -57,8 +57,11 @@ pub struct SynthConfig {
     pub campaign: Campaign,
     /// Noise level: 0 = exact, 1 = the nominal bench noise of docs/SYNTH.md.
     pub noise: f64,
-    /// Random seed.
+    /// Random seed of the readings' noise (and of the true motor unless `motor_seed`).
     pub seed: u64,
+    /// Seed of the true motor's perturbation; `None`: `seed`. Campaigns of one motor (a
+    /// bench's several runs) share it while their noise seeds differ.
+    pub motor_seed: Option<u64>,
     /// Relative standard deviation of the perturbation of the uncertain parameters.
     pub perturbation: f64,
     /// Drive voltage amplitude of the fixed-drive campaigns [V].
@@ -77,6 +80,7 @@ impl Default for SynthConfig {
             campaign: Campaign::PreloadTorque,
             noise: 1.0,
             seed: 1,
+            motor_seed: None,
             perturbation: 0.03,
             voltage_v: 200.0,
             frequency_hz: 43_000.0,
@@ -124,7 +128,7 @@ pub const PERTURBED: [&str; 5] = [
 
 /// The true motor: `motor` with its uncertain parameters perturbed.
 pub fn true_motor(motor: &Motor, cfg: &SynthConfig) -> Motor {
-    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed ^ 0x5eed_0f_7e57);
+    let mut rng = ChaCha8Rng::seed_from_u64(cfg.motor_seed.unwrap_or(cfg.seed) ^ 0x5eed_0f_7e57);
     let mut m = motor.clone();
     for key in PERTURBED {
         let rel = if key.ends_with("resonance_frequency_hz") { 0.1 * cfg.perturbation } else { cfg.perturbation };
