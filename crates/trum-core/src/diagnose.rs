@@ -25,8 +25,8 @@ pub mod json;
 mod signature;
 
 use crate::calibrate::{
-    baseline_params, calibrate, calibrate_adding, calibrate_extending, calibrate_weighted, effect_params, residuals,
-    Calibration, FitOptions, FitParam, FittedParam, Observable, ObservedRow,
+    baseline_params, calibrate, calibrate_adding, calibrate_extending, calibrate_restart, calibrate_weighted,
+    effect_params, residuals, Calibration, FitOptions, FitParam, FittedParam, Observable, ObservedRow,
 };
 use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
@@ -731,7 +731,7 @@ pub fn diagnose(
                 let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
                 s1.effects.set(e, &typical);
             }
-            if let Ok(c1) = calibrate_adding(&s1, rows, &params, &opts.fit, added) {
+            if let Ok(c1) = calibrate_restart(&s1, rows, &params, &opts.fit, added) {
                 if !c1.abandoned && !cal.as_ref().is_ok_and(|c| !c.abandoned && c1.chi2 >= c.chi2) {
                     cal = Ok(c1);
                 }
