@@ -1434,6 +1434,26 @@ mod tests {
         assert!(thermal.params.is_empty() && thermal.shrink == 0.0, "{thermal:?}");
     }
 
+    /// One motor (`motor_seed` = `seed`) measured in a run of `campaign` at each drive
+    /// voltage, noise seeds `seed`, `seed` + 1, ...; run ids prefixed with the voltage.
+    fn one_motor(truth: &Motor, campaign: Campaign, seed: u64, voltages: &[f64]) -> (Vec<ObservedRow>, Vec<String>) {
+        let (mut rows, mut groups) = (Vec::new(), Vec::new());
+        for (i, &v) in voltages.iter().enumerate() {
+            let cfg = SynthConfig {
+                campaign,
+                seed: seed + i as u64,
+                motor_seed: Some(seed),
+                voltage_v: v,
+                ..SynthConfig::default()
+            };
+            for r in synthesize(truth, &cfg).expect("synth") {
+                rows.push(r.observed());
+                groups.push(format!("v{v}-{}", r.run_id));
+            }
+        }
+        (rows, groups)
+    }
+
     /// One motor measured at four drive voltages (preload-torque runs, radial friction in its
     /// truth form): the baseline fit presses the modal damping onto its upper bound, a valley
     /// the radial-friction fit started from it stays in (held-out χ² 108 per reading, ρ far
@@ -1444,20 +1464,7 @@ mod tests {
         let nominal = preset("trum60a").expect("preset");
         let mut truth = nominal.clone();
         truth.effects.set_strength(Effect::RadialFriction, 1.0);
-        let (mut rows, mut groups) = (Vec::new(), Vec::new());
-        for (i, v) in [165.0, 185.0, 205.0, 225.0].into_iter().enumerate() {
-            let cfg = SynthConfig {
-                campaign: Campaign::PreloadTorque,
-                seed: 31 + i as u64,
-                motor_seed: Some(31),
-                voltage_v: v,
-                ..SynthConfig::default()
-            };
-            for r in synthesize(&truth, &cfg).expect("synth") {
-                rows.push(r.observed());
-                groups.push(format!("v{v}-{}", r.run_id));
-            }
-        }
+        let (rows, groups) = one_motor(&truth, Campaign::PreloadTorque, 31, &[165.0, 185.0, 205.0, 225.0]);
         let opts = DiagnoseOptions {
             candidates: vec![Effect::RadialFriction],
             try_pairs: false,
@@ -1486,20 +1493,8 @@ mod tests {
     #[test]
     fn the_positive_bias_of_speed_std_readings_is_not_eccentricity() {
         let nominal = preset("trum60a").expect("preset");
-        let (mut rows, mut groups) = (Vec::new(), Vec::new());
-        for (i, v) in [165.0, 175.0, 185.0, 195.0, 205.0, 215.0, 225.0, 235.0].into_iter().enumerate() {
-            let cfg = SynthConfig {
-                campaign: Campaign::Stability,
-                seed: 41 + i as u64,
-                motor_seed: Some(41),
-                voltage_v: v,
-                ..SynthConfig::default()
-            };
-            for r in synthesize(&nominal, &cfg).expect("synth") {
-                rows.push(r.observed());
-                groups.push(format!("v{v}-{}", r.run_id));
-            }
-        }
+        let voltages = [165.0, 175.0, 185.0, 195.0, 205.0, 215.0, 225.0, 235.0];
+        let (rows, groups) = one_motor(&nominal, Campaign::Stability, 41, &voltages);
         let zeros = rows.iter().flat_map(|r| &r.readings).filter(|x| x.0 == Observable::SpeedStdRpm && x.1 == 0.0);
         assert!(zeros.count() >= 16, "the readings are no longer clipped noise: the test needs new data");
         let opts = DiagnoseOptions {
