@@ -93,6 +93,7 @@ impl Case {
                     .map(|&(o, v)| (o, v, (self.noise * reading_noise(o, v)).max(1e-12)))
                     .collect(),
                 ambient_c: r.ambient_c,
+                speed_std_clipped: false,
             })
             .collect();
         let mut start = true_motor(&self.motor_with(fitted), &cfg);

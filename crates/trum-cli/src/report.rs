@@ -226,7 +226,7 @@ fn residual_maps(h: &mut String, d: &Diagnosis, bench: &BenchData) {
     };
     let _ = writeln!(
         h,
-        "<p class=\"cap\">Residual = measured − model prediction, where every prediction comes from a fit that did not see \
+        "<p class=\"cap\">Residual = measured − model prediction (for a speed std clipped at zero, the expected reading of clipped noise), where every prediction comes from a fit that did not see \
          that reading's operating region. Rings: calibrated baseline.{after_txt} Shaded band: ±2 noise standard deviations.</p>"
     );
     let all: Vec<&ObservedRow> = bench.rows.iter().collect();

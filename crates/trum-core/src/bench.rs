@@ -47,7 +47,7 @@ pub fn observations(m: &Measurements, motor: &Motor) -> BenchData {
         let readings =
             present.iter().filter_map(|&o| m.value(column_of(o), i).map(|v| (o, v, o.default_sigma(v)))).collect();
         let ambient_c = m.value(Column::AmbientC, i).unwrap_or(motor.thermal.ambient_c);
-        rows.push(ObservedRow { op, readings, ambient_c });
+        rows.push(ObservedRow { op, readings, ambient_c, speed_std_clipped: false });
     }
     let groups = (0..m.len()).map(|i| m.run_id_at(i).unwrap_or("").to_string()).collect();
     BenchData { rows, groups, lines: m.lines.clone(), observables: present }

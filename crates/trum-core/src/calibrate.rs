@@ -73,17 +73,18 @@ impl Observable {
         }
     }
 
-    /// The expected reading of this quantity when the model gives `model` and the reading's
-    /// noise has standard deviation `sigma`. A speed standard deviation cannot be read below
-    /// zero: where the motor runs smoothly (true value near 0), its readings are the
-    /// non-negative part of noise, whose mean, σ/√(2π) at a true value of zero, a model
-    /// predicting 0 misses in every reading alike (eccentricity, which adds a speed ripple,
-    /// then fits that bias: 1000-row null data, evidence 9.6). The expected reading of
-    /// max(0, m + ε), ε ~ N(0, σ²), is m·Φ(m/σ) + σ·φ(m/σ), which is m to within 1e-9·σ
-    /// once m > 6σ. Every other quantity: `model`.
-    pub fn expected_reading(self, model: f64, sigma: f64) -> f64 {
+    /// The expected reading of this quantity in row `row` when the model gives `model` and
+    /// the reading's noise has standard deviation `sigma`. Where the bench clips the speed
+    /// standard deviation at zero (`ObservedRow::speed_std_clipped`), its readings of a
+    /// smoothly running motor (true value near 0) are the non-negative part of the noise,
+    /// whose mean, σ/√(2π) at a true value of zero, a model predicting 0 misses in every
+    /// reading alike (eccentricity, which adds a speed ripple, then fits that bias: 1000-row
+    /// null data, evidence 9.6). The expected reading of max(0, m + ε), ε ~ N(0, σ²), is
+    /// m·Φ(m/σ) + σ·φ(m/σ), which is m to within 1e-9·σ once m > 6σ. Otherwise, and for
+    /// every other quantity: `model`.
+    pub fn expected_reading(self, row: &ObservedRow, model: f64, sigma: f64) -> f64 {
         match self {
-            Observable::SpeedStdRpm if sigma > 0.0 && model < 8.0 * sigma => {
+            Observable::SpeedStdRpm if row.speed_std_clipped && sigma > 0.0 && model < 8.0 * sigma => {
                 let x = model / sigma;
                 let cdf = 0.5 * libm::erfc(-x / std::f64::consts::SQRT_2);
                 let pdf = (-0.5 * x * x).exp() / (2.0 * std::f64::consts::PI).sqrt();
@@ -118,6 +119,11 @@ pub struct ObservedRow {
     pub readings: Vec<(Observable, f64, f64)>,
     /// Ambient temperature for temperature readings [°C].
     pub ambient_c: f64,
+    /// The bench reports this row's speed standard deviation clipped at zero, and its σ is
+    /// the readings' own noise level: the reading is compared with the expected reading of
+    /// clipped noise ([`Observable::expected_reading`]). Set by the diagnosis where the
+    /// data show both (docs/DIAGNOSIS.md, "Calibration").
+    pub speed_std_clipped: bool,
 }
 
 /// Which parameter a fit moves.
@@ -359,7 +365,9 @@ fn motor_at(base: &Motor, params: &[FitParam], u: &DVector<f64>) -> Motor {
 }
 
 /// Normalised residuals (prediction − measurement)/σ of every reading of `rows`, in
-/// order; a point the model cannot solve contributes a large residual (50 σ).
+/// order, the prediction being the expected reading ([`Observable::expected_reading`]: the
+/// model value but for a clipped speed std); a point the model cannot solve contributes a
+/// large residual (50 σ).
 pub fn residuals(motor: &Motor, rows: &[ObservedRow]) -> Vec<f64> {
     let p = Prepared::new(motor).without_stall_torque();
     // cold starts, as in `Problem::pass_at`
@@ -375,7 +383,7 @@ fn row_residuals(r: &ObservedRow, s: &Solution) -> Vec<f64> {
 fn row_residuals_iter<'a>(r: &'a ObservedRow, s: &'a Solution) -> impl Iterator<Item = f64> + 'a {
     r.readings.iter().map(|&(o, v, sigma)| {
         if s.status.is_valid() {
-            (o.expected_reading(o.predict(s, r.ambient_c), sigma) - v) / sigma
+            (o.expected_reading(r, o.predict(s, r.ambient_c), sigma) - v) / sigma
         } else {
             50.0
         }
@@ -992,7 +1000,7 @@ pub(crate) mod tests {
                         (o, v, o.default_sigma(v))
                     })
                     .collect();
-                rows.push(ObservedRow { op, readings, ambient_c: 25.0 });
+                rows.push(ObservedRow { op, readings, ambient_c: 25.0, speed_std_clipped: false });
             }
         }
         rows
@@ -1203,6 +1211,12 @@ pub(crate) mod tests {
     #[test]
     fn expected_speed_std_reading_is_the_mean_of_the_clipped_noise() {
         let sigma = 0.03;
+        let clipped = ObservedRow {
+            op: OperatingPoint::new(250.0, 0.0, 200.0, 43e3),
+            readings: vec![(Observable::SpeedStdRpm, 0.0, sigma)],
+            ambient_c: 25.0,
+            speed_std_clipped: true,
+        };
         for x in [-3.0, -1.0, -0.2, 0.0, 0.3, 1.0, 2.5, 5.0, 7.9, 8.1, 12.0] {
             let m = x * sigma;
             let n = 24_000;
@@ -1221,12 +1235,15 @@ pub(crate) mod tests {
                 acc += w * (m + e).max(0.0) * pdf;
             }
             let direct = acc * h / 3.0;
-            let closed = Observable::SpeedStdRpm.expected_reading(m, sigma);
+            let closed = Observable::SpeedStdRpm.expected_reading(&clipped, m, sigma);
             assert!((closed - direct).abs() < 1e-9 * sigma, "m/σ = {x}: {closed} vs {direct}");
         }
-        assert_eq!(Observable::SpeedStdRpm.expected_reading(0.5, 0.0), 0.5);
+        assert_eq!(Observable::SpeedStdRpm.expected_reading(&clipped, 0.5, 0.0), 0.5);
+        // a row not marked clipped is compared as read
+        let plain = ObservedRow { speed_std_clipped: false, ..clipped.clone() };
+        assert_eq!(Observable::SpeedStdRpm.expected_reading(&plain, 0.0, sigma), 0.0);
         for o in [Observable::SpeedRpm, Observable::Efficiency, Observable::InputPowerW] {
-            assert_eq!(o.expected_reading(0.0, 0.1), 0.0);
+            assert_eq!(o.expected_reading(&clipped, 0.0, 0.1), 0.0);
         }
     }
 
@@ -1327,7 +1344,7 @@ pub(crate) mod tests {
                         (o, v * 1.01 + 0.01, o.default_sigma(v))
                     })
                     .collect();
-                ObservedRow { op, readings, ambient_c: 25.0 }
+                ObservedRow { op, readings, ambient_c: 25.0, speed_std_clipped: false }
             };
             let mut rows = Vec::new();
             for (i, &f) in [120.0, 250.0, 380.0].iter().enumerate() {
@@ -1419,6 +1436,7 @@ pub(crate) mod tests {
             op: OperatingPoint::new(100.0, 0.0, 200.0, 43e3),
             readings: vec![(Observable::SpeedRpm, 100.0, 1.0)],
             ambient_c: 25.0,
+            speed_std_clipped: false,
         }];
         let err = calibrate(&m, &rows, &baseline_params(&m, &rows), &FitOptions::default()).unwrap_err();
         assert!(err.to_string().contains("cannot determine"), "{err}");

@@ -137,6 +137,7 @@ mod tests {
                     op: OperatingPoint::new(100.0 + 50.0 * p as f64, t, 200.0, 43e3),
                     readings: vec![(Observable::SpeedRpm, y, stated)],
                     ambient_c: 25.0,
+                    speed_std_clipped: false,
                 });
                 g.push(format!("run{p}"));
             }
