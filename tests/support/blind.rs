@@ -103,7 +103,7 @@ impl Case {
             params.extend(effect_params(trum_core::effects::Effect::from_name(name).expect("effect name")));
         }
         // a generous budget: this is the reference the verdicts are judged against
-        let opts = FitOptions { huber_k: f64::INFINITY, irls_passes: 0, max_evaluations: 4000 };
+        let opts = FitOptions { huber_k: f64::INFINITY, irls_passes: 0, max_evaluations: 4000, fold_rtol: 0.0 };
         calibrate(&start, &rows, &params, &opts).map(|c| c.chi2).unwrap_or(f64::NAN)
     }
 

@@ -64,7 +64,7 @@ impl Default for DiagnoseOptions {
             try_pairs: true,
             bootstrap: 200,
             seed: 7,
-            fit: FitOptions { huber_k: 3.0, irls_passes: 1, max_evaluations: 300 },
+            fit: FitOptions { huber_k: 3.0, irls_passes: 1, max_evaluations: 300, ..FitOptions::default() },
             exact_cv: false,
         }
     }
