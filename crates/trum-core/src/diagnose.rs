@@ -198,6 +198,25 @@ fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
 /// clips at zero) and their noise level was `estimated` from the data. With the stated
 /// (default) level, 2.5-5× the synthetic bench's, that expectation would overshoot; exact
 /// data (the blind benchmark's reference fits) have no noise to clip.
+/// The rows with each reading's σ scaled by the noise factor estimated for its quantity
+/// (clamped to [1/4, 4]), marked clipped where `speed_std_clipped` says so.
+fn noise_scaled(rows: &[ObservedRow], est: &BTreeMap<Observable, crate::noise::NoiseScale>) -> Vec<ObservedRow> {
+    let scaled: Vec<ObservedRow> = rows
+        .iter()
+        .map(|r| {
+            let mut r = r.clone();
+            for x in r.readings.iter_mut() {
+                if let Some(n) = est.get(&x.0) {
+                    x.2 *= n.factor.clamp(0.25, 4.0);
+                }
+            }
+            r
+        })
+        .collect();
+    let clipped = speed_std_clipped(&scaled, est.contains_key(&Observable::SpeedStdRpm));
+    scaled.into_iter().map(|r| ObservedRow { speed_std_clipped: clipped, ..r }).collect()
+}
+
 fn speed_std_clipped(rows: &[ObservedRow], estimated: bool) -> bool {
     estimated && rows.iter().flat_map(|r| &r.readings).any(|x| x.0 == Observable::SpeedStdRpm && x.1 == 0.0)
 }
@@ -559,21 +578,7 @@ pub fn diagnose(
     // Noise levels from the data, so that χ² and the evidence are on the scale of the
     // actual noise; clamped to [1/4, 4] × the stated levels.
     let est = crate::noise::estimate(rows, groups);
-    let scaled: Vec<ObservedRow> = rows
-        .iter()
-        .map(|r| {
-            let mut r = r.clone();
-            for x in r.readings.iter_mut() {
-                if let Some(n) = est.get(&x.0) {
-                    x.2 *= n.factor.clamp(0.25, 4.0);
-                }
-            }
-            r
-        })
-        .collect();
-    let clipped = speed_std_clipped(&scaled, est.contains_key(&Observable::SpeedStdRpm));
-    let scaled: Vec<ObservedRow> =
-        scaled.into_iter().map(|r| ObservedRow { speed_std_clipped: clipped, ..r }).collect();
+    let scaled = noise_scaled(rows, &est);
     let rows = &scaled[..];
     let noise_scale: Vec<(String, f64, usize)> =
         est.iter().map(|(o, n)| (o.column().to_string(), n.factor.clamp(0.25, 4.0), n.triples)).collect();
@@ -634,6 +639,20 @@ pub fn diagnose(
     // full-data baseline fit (the start of every other fit; "where", BIC, reported parameters)
     let (start0, bparams) = fit_params(motor, motor, rows, &[], reduced);
     let base_cal = calibrate(&start0, rows, &bparams, &opts.fit)?;
+    // A baseline that ends with a parameter on a bound can be held there by the logistic
+    // transform, whose slope all but vanishes at the bound: refitted from its own end (a
+    // start on a bound is placed 1e-3 inside it, `calibrate::fit`), it can move on. The
+    // better of the two is the baseline. (1000-row benchmark, seeds 31-38: the damping on
+    // its upper bound at χ² 0.72 million; every single fit, started there, first refitted
+    // the baseline to 0.27 million whatever its effect.)
+    let base_cal = if base_cal.params.iter().any(|p| p.at_bound) {
+        match calibrate(&base_cal.motor, rows, &bparams, &opts.fit) {
+            Ok(c) if c.chi2 < base_cal.chi2 => c,
+            _ => base_cal,
+        }
+    } else {
+        base_cal
+    };
     let start = base_cal.motor.clone();
     let base_cv = if opts.exact_cv {
         cross_validate(motor, &start, rows, &folds, k, &[], opts, reduced)
@@ -1479,12 +1498,14 @@ mod tests {
     }
 
     /// One motor measured at four drive voltages (preload-torque runs, radial friction in its
-    /// truth form): the baseline fit presses the modal damping onto its upper bound, a valley
-    /// the radial-friction fit started from it stays in (held-out χ² 108 per reading, ρ far
-    /// from the truth). A fit that ends with a baseline parameter on a bound short of the
-    /// noise level gets the second start from the nominal motor, which finds the truth.
+    /// truth form): calibrated from the nominal motor, the baseline presses the modal damping
+    /// onto its upper bound, where the logistic transform holds it (a radial-friction fit
+    /// started there stayed in that valley: held-out χ² 108 per reading, until stop 28's
+    /// second start from the nominal motor). Refitted from its own end, the baseline leaves
+    /// the bound at a fraction of the χ²; the diagnosis does that, and finds radial friction
+    /// at its truth.
     #[test]
-    fn a_fit_left_on_the_baselines_bound_gets_a_second_start() {
+    fn a_baseline_left_on_a_bound_is_refitted_from_its_end() {
         let nominal = preset("trum60a").expect("preset");
         let mut truth = nominal.clone();
         truth.effects.set_strength(Effect::RadialFriction, 1.0);
@@ -1495,12 +1516,20 @@ mod tests {
             bootstrap: 50,
             ..DiagnoseOptions::default()
         };
+        // (the rows as the diagnosis fits them: σ scaled by the estimated noise levels)
+        let scaled = noise_scaled(&rows, &crate::noise::estimate(&rows, &groups));
+        let (s0, bp) = fit_params(&nominal, &nominal, &scaled, &[], false);
+        let on_damping_bound =
+            |c: &Calibration| c.params.iter().any(|p| p.name.ends_with("modal_damping_ns_per_m") && p.at_bound);
+        let first = calibrate(&s0, &scaled, &bp, &opts.fit).expect("baseline");
+        assert!(on_damping_bound(&first), "the baseline no longer ends on the damping bound: the test needs new data");
+        let again = calibrate(&first.motor, &scaled, &bp, &opts.fit).expect("refit");
+        assert!(!on_damping_bound(&again));
+        // (χ² 1.74e5 → 6.3e4 when written)
+        assert!(again.chi2 < 0.5 * first.chi2, "χ² {} → {}", first.chi2, again.chi2);
         let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnose");
         let damping = d.baseline_params.iter().find(|p| p.0.ends_with("modal_damping_ns_per_m")).expect("damping").1;
-        assert!(
-            damping > 49.9,
-            "the baseline no longer ends on the damping bound ({damping}): the test needs new data"
-        );
+        assert!(damping < 49.0, "the diagnosis's baseline damping {damping}");
         let rf = d.ranking.iter().find(|r| r.effect == "radial_friction").expect("ranked");
         assert_eq!(d.verdict, "radial_friction");
         assert!(rf.heldout_chi2_after < 5.0, "held-out χ² per reading {}", rf.heldout_chi2_after);
