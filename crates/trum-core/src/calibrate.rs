@@ -1531,7 +1531,7 @@ pub(crate) mod tests {
     /// 1e-3.
     #[test]
     fn a_fit_pressed_against_a_fold_stops_there() {
-        let nominal = preset("trum60a").unwrap();
+        let nominal = preset("trum60a").expect("preset");
         let mut truth = nominal.clone();
         truth.effects.set(Effect::RadialFriction, &[1.0]);
         let mut rows = Vec::new();
@@ -1556,7 +1556,7 @@ pub(crate) mod tests {
         let params = baseline_params(&nominal, &rows);
         let fit_with = |fold_rtol: f64| {
             let opts = FitOptions { irls_passes: 1, fold_rtol, ..FitOptions::default() };
-            calibrate(&nominal, &rows, &params, &opts).unwrap()
+            calibrate(&nominal, &rows, &params, &opts).expect("fit")
         };
         let (stopped, crawled) = (fit_with(FOLD_RTOL), fit_with(0.0));
         // (94 and 50 passes when written)

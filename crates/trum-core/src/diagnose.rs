@@ -1627,12 +1627,12 @@ mod tests {
     #[test]
     fn an_effect_fitted_to_next_to_zero_counts_as_collapsed() {
         let tc = Effect::TangentialCompliance;
-        let nominal = preset("trum60a").unwrap();
+        let nominal = preset("trum60a").expect("preset");
         let grid =
             |m: &Motor| crate::calibrate::tests::rows_on_grid(m, &[100.0, 200.0, 300.0, 400.0], &[0.0, 0.2, 0.4, 0.6]);
         let rows = grid(&nominal);
         let (start, params) = fit_params(&nominal, &nominal, &rows, &[tc], false);
-        let hi = params.iter().find(|fp| fp.param == ParamRef::Effect(tc, 0)).unwrap().hi;
+        let hi = params.iter().find(|fp| fp.param == ParamRef::Effect(tc, 0)).expect("strength").hi;
         let fitted = |v: f64| {
             params
                 .iter()
@@ -1650,12 +1650,12 @@ mod tests {
         // only an added effect's strength counts (for a pair, the lead's is not added)
         assert!(!added_near_zero(&params, &fitted(0.0), &[Effect::RadialFriction]));
         let opts = FitOptions { huber_k: 3.0, irls_passes: 1, max_evaluations: 300, ..FitOptions::default() };
-        let without = calibrate_adding(&start, &rows, &params, &opts, &[tc]).unwrap();
+        let without = calibrate_adding(&start, &rows, &params, &opts, &[tc]).expect("fit");
         // (not abandoned when written: 0.3 % of the range, on its bound by the 0.5 % rule)
         assert!(without.abandoned || added_near_zero(&params, &without.params, &[tc]), "{:?}", without.params);
         let mut truth = nominal.clone();
         truth.effects.set(tc, &[tc.info().params[0].typical]);
-        let with = calibrate_adding(&start, &grid(&truth), &params, &opts, &[tc]).unwrap();
+        let with = calibrate_adding(&start, &grid(&truth), &params, &opts, &[tc]).expect("fit");
         assert!(!with.abandoned && !added_near_zero(&params, &with.params, &[tc]), "{:?}", with.params);
     }
 }
