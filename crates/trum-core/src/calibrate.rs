@@ -1068,12 +1068,10 @@ pub(crate) mod tests {
     use crate::presets::preset;
 
     /// Noise-free readings (speed, input power, feedback voltage at their default σ) of `m`
-    /// over a preload × torque grid at 200 V, 43 kHz.
-    pub(crate) fn rows_on_grid(m: &Motor, preloads: &[f64], torques: &[f64]) -> Vec<ObservedRow> {
-        let mut rows = Vec::new();
-        for &f in preloads {
-            for &t in torques {
-                let op = OperatingPoint::new(f, t, 200.0, 43e3);
+    /// at each operating point of `ops`.
+    fn rows_at(m: &Motor, ops: impl IntoIterator<Item = OperatingPoint>) -> Vec<ObservedRow> {
+        ops.into_iter()
+            .map(|op| {
                 let s = crate::solve(m, &op);
                 let readings = [Observable::SpeedRpm, Observable::InputPowerW, Observable::FeedbackV]
                     .iter()
@@ -1082,10 +1080,14 @@ pub(crate) mod tests {
                         (o, v, o.default_sigma(v))
                     })
                     .collect();
-                rows.push(ObservedRow { op, readings, ambient_c: 25.0, speed_std_clipped: false });
-            }
-        }
-        rows
+                ObservedRow { op, readings, ambient_c: 25.0, speed_std_clipped: false }
+            })
+            .collect()
+    }
+
+    /// [`rows_at`] a preload × torque grid at 200 V, 43 kHz.
+    pub(crate) fn rows_on_grid(m: &Motor, preloads: &[f64], torques: &[f64]) -> Vec<ObservedRow> {
+        rows_at(m, preloads.iter().flat_map(|&f| torques.iter().map(move |&t| OperatingPoint::new(f, t, 200.0, 43e3))))
     }
 
     fn rows_from(m: &Motor) -> Vec<ObservedRow> {
@@ -1534,25 +1536,15 @@ pub(crate) mod tests {
         let nominal = preset("trum60a").expect("preset");
         let mut truth = nominal.clone();
         truth.effects.set(Effect::RadialFriction, &[1.0]);
-        let mut rows = Vec::new();
-        for &f in &[100.0, 175.0, 251.0, 325.0, 400.0] {
-            for &v in &[110.0, 131.0, 165.0, 200.0] {
-                for &hz in &[41e3, 43e3] {
-                    for &t in &[0.0, 0.3] {
-                        let op = OperatingPoint::new(f, t, v, hz);
-                        let s = crate::solve(&truth, &op);
-                        let readings = [Observable::SpeedRpm, Observable::InputPowerW, Observable::FeedbackV]
-                            .iter()
-                            .map(|&o| {
-                                let v = o.predict(&s, 25.0);
-                                (o, v, o.default_sigma(v))
-                            })
-                            .collect();
-                        rows.push(ObservedRow { op, readings, ambient_c: 25.0, speed_std_clipped: false });
-                    }
+        let mut ops = Vec::new();
+        for f in [100.0, 175.0, 251.0, 325.0, 400.0] {
+            for v in [110.0, 131.0, 165.0, 200.0] {
+                for hz in [41e3, 43e3] {
+                    ops.extend([0.0, 0.3].map(|t| OperatingPoint::new(f, t, v, hz)));
                 }
             }
         }
+        let rows = rows_at(&truth, ops);
         let params = baseline_params(&nominal, &rows);
         let fit_with = |fold_rtol: f64| {
             let opts = FitOptions { irls_passes: 1, fold_rtol, ..FitOptions::default() };
