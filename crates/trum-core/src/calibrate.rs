@@ -542,7 +542,8 @@ impl<'a> Problem<'a> {
     }
     /// The model pass at `u`, remembered as the latest one.
     fn pass_at(&self, u: &DVector<f64>) -> std::cell::Ref<'_, Pass> {
-        // (two passes kept: after a rejected trial the accepted point is asked for again)
+        // (two passes kept: a run that ends on a rejected trial, or stops at a fold, is read
+        // again at its accepted point, the pass before)
         if self.last.borrow().as_ref().is_none_or(|p| &p.u != u)
             && self.prev.borrow().as_ref().is_some_and(|p| &p.u == u)
         {
@@ -937,6 +938,10 @@ fn fit(
         // ones: then it is finished as a full run (`stopped_early` below).
         problem.early_rtol = early_weights.filter(|_| pass == 0 && irls_passes > 0 && !problem.stopped_early.get());
         problem.last_sum.set(None);
+        // (each run measures its own steps: a run finished after an early stop restarts at
+        // the same point, which is no step)
+        problem.accepted_sum.set(None);
+        problem.last_gain.set(None);
         let (p, report) = lm_pass(problem, opts);
         problem = p;
         if problem.fold.replace(false) {

@@ -193,11 +193,6 @@ fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
         .collect()
 }
 
-/// Whether the speed-std readings of `rows` are compared with the expected reading of
-/// clipped noise (`ObservedRow::speed_std_clipped`): some read exactly zero (the bench
-/// clips at zero) and their noise level was `estimated` from the data. With the stated
-/// (default) level, 2.5-5× the synthetic bench's, that expectation would overshoot; exact
-/// data (the blind benchmark's reference fits) have no noise to clip.
 /// The rows with each reading's σ scaled by the noise factor estimated for its quantity
 /// (clamped to [1/4, 4]), marked clipped where `speed_std_clipped` says so.
 fn noise_scaled(rows: &[ObservedRow], est: &BTreeMap<Observable, crate::noise::NoiseScale>) -> Vec<ObservedRow> {
@@ -217,6 +212,11 @@ fn noise_scaled(rows: &[ObservedRow], est: &BTreeMap<Observable, crate::noise::N
     scaled.into_iter().map(|r| ObservedRow { speed_std_clipped: clipped, ..r }).collect()
 }
 
+/// Whether the speed-std readings of `rows` are compared with the expected reading of
+/// clipped noise (`ObservedRow::speed_std_clipped`): some read exactly zero (the bench
+/// clips at zero) and their noise level was `estimated` from the data. With the stated
+/// (default) level, 2.5-5× the synthetic bench's, that expectation would overshoot; exact
+/// data (the blind benchmark's reference fits) have no noise to clip.
 fn speed_std_clipped(rows: &[ObservedRow], estimated: bool) -> bool {
     estimated && rows.iter().flat_map(|r| &r.readings).any(|x| x.0 == Observable::SpeedStdRpm && x.1 == 0.0)
 }
@@ -455,8 +455,6 @@ fn pseudo_inverse(h: &DMatrix<f64>) -> DMatrix<f64> {
     }
 }
 
-/// Start point and parameters of a fit: bounds around the nominal `motor`, starting from
-/// `start` (the full-data baseline calibration, which saves most LM iterations).
 /// True when a fit ended with an added effect's primary strength within 1 % of its range
 /// above zero: the data pulled it there from the nested model's fit, as in a fit abandoned
 /// as collapsing (which is tested at 1e-3 of the range, where the logistic transform
@@ -470,6 +468,8 @@ fn added_near_zero(params: &[FitParam], fitted: &[FittedParam], added: &[Effect]
     })
 }
 
+/// Start point and parameters of a fit: bounds around the nominal `motor`, starting from
+/// `start` (the full-data baseline calibration, which saves most LM iterations).
 fn fit_params(
     motor: &Motor,
     start: &Motor,
