@@ -266,7 +266,7 @@ pub(crate) const FIT_DECREMENT_TOL: f64 = 1e-2;
 
 /// A fit's unweighted first run, which only places the first Huber weights, stops once an
 /// accepted step removed less than this fraction of the sum of squares (see `fit`).
-const IRLS_START_RTOL: f64 = 1e-3;
+pub(crate) const IRLS_START_RTOL: f64 = 1e-3;
 
 /// Options of a fit.
 #[derive(Clone, Debug, PartialEq)]
@@ -481,11 +481,11 @@ struct Problem<'a> {
     off: Vec<usize>,
     /// Set when one of them was pressed against zero (also a user stop for the crate).
     collapsed: std::cell::Cell<bool>,
-    /// A second start (`calibrate_restart`): one of `off` within BOUND_T of zero is
+    /// A second start (`Start::Restart`): one of `off` within BOUND_T of zero is
     /// collapsed whatever its gradient.
     off_at_zero: bool,
     /// Set for the unweighted first run of a fit from a converged nested fit, which only
-    /// places the Huber weights (`calibrate_extending`): the run also stops once an
+    /// places the Huber weights (`Start::Extending`): the run also stops once an
     /// accepted step removed less than this fraction of the sum of squares. `last_sum`
     /// keeps the sum at the latest Jacobian; `stopped_early` records such a stop.
     early_rtol: Option<f64>,
@@ -781,11 +781,24 @@ pub fn calibrate(
 }
 
 /// [`calibrate`] for a model that adds the effects `added` to a nested model already fitted
-/// (the baseline for a single effect, the lead effect's fit for a pair). The fit is
-/// abandoned (returned where it stopped, with a warning and without its parameters'
-/// uncertainties) when the primary strength of an added effect is pressed against zero:
-/// it is collapsing onto the nested model, whose fit exists, and would otherwise crawl there
-/// through the logistic transform for many passes.
+/// (the baseline for a single effect, the lead effect's fit for a pair), from `start`
+/// (which sets the early stops, [`Start`]). The fit is abandoned (returned where it
+/// stopped, with a warning and without its parameters' uncertainties) when the primary
+/// strength of an added effect is pressed against zero: it is collapsing onto the nested
+/// model, whose fit exists, and would otherwise crawl there through the logistic transform
+/// for many passes.
+pub(crate) fn calibrate_nested(
+    motor: &Motor,
+    rows: &[ObservedRow],
+    params: &[FitParam],
+    opts: &FitOptions,
+    added: &[Effect],
+    start: Start,
+) -> Result<Calibration, TrumError> {
+    fit(motor, rows, params, opts, added, None, start)
+}
+
+/// [`calibrate_nested`] from a fresh start.
 pub(crate) fn calibrate_adding(
     motor: &Motor,
     rows: &[ObservedRow],
@@ -793,38 +806,7 @@ pub(crate) fn calibrate_adding(
     opts: &FitOptions,
     added: &[Effect],
 ) -> Result<Calibration, TrumError> {
-    fit(motor, rows, params, opts, added, None, Start::Fresh)
-}
-
-/// [`calibrate_adding`] for a second start of a nested fit (the diagnosis's start from the
-/// nominal motor, tried where the first start may have stayed in the nested model's
-/// valley). Such a start is there to find a valley with the added effects on: it is
-/// abandoned as soon as an added effect's primary strength is within BOUND_T of zero after
-/// a step, whatever its gradient. From there the logistic transform's dp/du (below 1e-3 of
-/// the range) all but freezes it, and the fit spends its budget refitting the nested model,
-/// whose fit exists (1000-row benchmark, motor seed 1: `tangential_compliance` at 8e-8 of
-/// its range for 37 of 42 passes).
-pub(crate) fn calibrate_restart(
-    motor: &Motor,
-    rows: &[ObservedRow],
-    params: &[FitParam],
-    opts: &FitOptions,
-    added: &[Effect],
-) -> Result<Calibration, TrumError> {
-    fit(motor, rows, params, opts, added, None, Start::Restart)
-}
-
-/// [`calibrate_adding`] from a converged fit of the nested model (a pair from its lead's
-/// fit): the unweighted first run, which only places the Huber weights, stops once an
-/// accepted step removes less than IRLS_START_RTOL of the sum of squares.
-pub(crate) fn calibrate_extending(
-    motor: &Motor,
-    rows: &[ObservedRow],
-    params: &[FitParam],
-    opts: &FitOptions,
-    added: &[Effect],
-) -> Result<Calibration, TrumError> {
-    fit(motor, rows, params, opts, added, None, Start::Extending(IRLS_START_RTOL))
+    calibrate_nested(motor, rows, params, opts, added, Start::Fresh)
 }
 
 /// [`calibrate`] with the Huber weights fixed at `weights` (one per reading, in row order):
@@ -841,15 +823,23 @@ pub(crate) fn calibrate_weighted(
     fit(motor, rows, params, opts, &[], Some(weights), Start::Fresh)
 }
 
-/// Where a fit starts, which sets its early stops (see the `calibrate_*` functions).
+/// Where a fit starts, which sets its early stops.
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Start {
+pub(crate) enum Start {
     /// Any fit: the full unweighted first run, collapse only when pushed onto zero.
     Fresh,
-    /// From a converged nested fit: the weights-only first run stops once an accepted step
-    /// removes less than this fraction of the sum of squares.
+    /// From a converged fit of the nested model (a pair from its lead's fit): the
+    /// weights-only first run stops once an accepted step removes less than this fraction
+    /// of the sum of squares (the diagnosis: IRLS_START_RTOL).
     Extending(f64),
-    /// A second start: collapsed as soon as an added effect is at zero.
+    /// A second start of a nested fit (the diagnosis's start from the nominal motor, tried
+    /// where the first start may have stayed in the nested model's valley). Such a start is
+    /// there to find a valley with the added effects on: it is abandoned as soon as an
+    /// added effect's primary strength is within BOUND_T of zero after a step, whatever its
+    /// gradient. From there the logistic transform's dp/du (below 1e-3 of the range) all but
+    /// freezes it, and the fit spends its budget refitting the nested model, whose fit
+    /// exists (1000-row benchmark, motor seed 1: `tangential_compliance` at 8e-8 of its range
+    /// for 37 of 42 passes).
     Restart,
 }
 
@@ -1336,7 +1326,7 @@ pub(crate) mod tests {
         }
     }
 
-    /// A second start (`calibrate_restart`) counts an added effect within BOUND_T of zero
+    /// A second start (`Start::Restart`) counts an added effect within BOUND_T of zero
     /// as collapsed even where the data pull it back up; a first start only where they
     /// push it further down. Data with 300 Ω of voltage sag, the sag at 5e-4 of its range.
     #[test]

@@ -25,8 +25,8 @@ pub mod json;
 mod signature;
 
 use crate::calibrate::{
-    baseline_params, calibrate, calibrate_adding, calibrate_extending, calibrate_restart, calibrate_weighted,
-    effect_params, residuals, Calibration, FitOptions, FitParam, FittedParam, Observable, ObservedRow, ParamRef,
+    baseline_params, calibrate, calibrate_adding, calibrate_nested, calibrate_weighted, effect_params, residuals,
+    Calibration, FitOptions, FitParam, FittedParam, Observable, ObservedRow, ParamRef, Start, IRLS_START_RTOL,
 };
 use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
@@ -761,7 +761,7 @@ pub fn diagnose(
         // a pair led by a fitted single starts at that fit's optimum (a parameter within
         // 1e-3 of a bound moved to 1e-3 from it, `calibrate::fit`)
         let mut cal = if nested.is_some() {
-            calibrate_extending(&s0, rows, &params, &opts.fit, added)
+            calibrate_nested(&s0, rows, &params, &opts.fit, added, Start::Extending(IRLS_START_RTOL))
         } else {
             calibrate_adding(&s0, rows, &params, &opts.fit, added)
         };
@@ -782,7 +782,7 @@ pub fn diagnose(
                 let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
                 s1.effects.set(e, &typical);
             }
-            if let Ok(c1) = calibrate_restart(&s1, rows, &params, &opts.fit, added) {
+            if let Ok(c1) = calibrate_nested(&s1, rows, &params, &opts.fit, added, Start::Restart) {
                 if !c1.abandoned && !cal.as_ref().is_ok_and(|c| !c.abandoned && c1.chi2 >= c.chi2) {
                     cal = Ok(c1);
                 }
