@@ -22,43 +22,51 @@ impl std::fmt::Debug for Quantity {
     }
 }
 
-macro_rules! q {
-    ($field:ident, $unit:literal, $doc:literal) => {
-        Quantity { name: stringify!($field), unit: $unit, doc: $doc, get: |s: &Solution| s.$field }
+/// The table and, from the same list, a reader of every value at once.
+macro_rules! quantities {
+    ($(($field:ident, $unit:literal, $doc:literal)),* $(,)?) => {
+        /// Every numeric output quantity, in the order maps and `trum point` print them.
+        pub const QUANTITIES: &[Quantity] =
+            &[$(Quantity { name: stringify!($field), unit: $unit, doc: $doc, get: |s: &Solution| s.$field }),*];
+
+        /// Every quantity of `s` in [`QUANTITIES`] order: the loops that write or check them
+        /// all for every solved point read them here, without a call through `get` each.
+        pub fn values(s: &Solution) -> [f64; QUANTITIES.len()] {
+            [$(s.$field),*]
+        }
     };
 }
 
-/// Every numeric output quantity, in the order maps and `trum point` print them.
-pub const QUANTITIES: &[Quantity] = &[
-    q!(speed_rpm, "rpm", "rotor speed"),
-    q!(speed_rad_s, "rad/s", "rotor speed"),
-    q!(efficiency, "-", "output power / electrical input power"),
-    q!(output_power_w, "W", "mechanical output power"),
-    q!(input_power_w, "W", "electrical input power, both phases"),
-    q!(stall_torque_nm, "N m", "stall (blocking) torque at this preload and drive"),
-    q!(amplitude_m, "m", "wave amplitude at the contact surface"),
-    q!(contact_angle_deg, "deg", "contact angle Xc, full arc per wave"),
-    q!(driving_angle_deg, "deg", "driving angle Xs, full arc per wave"),
-    q!(driving_ratio, "-", "proportion of the driving zone in the contact zone"),
-    q!(contact_half_angle_rad, "rad", "contact half-angle phi0 in wave phase"),
-    q!(stick_half_angle_rad, "rad", "stick half-angle theta_s in wave phase"),
-    q!(contact_length_m, "m", "contact length per wave"),
-    q!(crest_speed_m_s, "m/s", "peak tangential surface speed of the stator"),
-    q!(axial_force_n, "N", "axial contact force"),
-    q!(dielectric_loss_w, "W", "dielectric loss"),
-    q!(damping_loss_w, "W", "stator damping loss"),
-    q!(friction_loss_w, "W", "contact friction loss"),
-    q!(radial_friction_loss_w, "W", "radial-slip part of the friction loss"),
-    q!(rotor_loss_w, "W", "rotor viscous loss"),
-    q!(current_a, "A", "drive current amplitude per phase"),
-    q!(feedback_v, "V", "feedback electrode voltage amplitude"),
-    q!(electrode_voltage_v, "V", "voltage at the electrodes (zero-to-peak)"),
-    q!(phase_lag_rad, "rad", "phase lag of the wave behind the drive"),
-    q!(modal_stiffness_n_per_m, "N/m", "effective modal stiffness"),
-    q!(temperature_rise_k, "K", "steady-state temperature rise over ambient"),
-    q!(temperature_rise_at_elapsed_k, "K", "temperature rise at the point's elapsed time"),
-    q!(speed_std_rpm, "rpm", "speed standard deviation over a revolution"),
-];
+quantities! {
+    (speed_rpm, "rpm", "rotor speed"),
+    (speed_rad_s, "rad/s", "rotor speed"),
+    (efficiency, "-", "output power / electrical input power"),
+    (output_power_w, "W", "mechanical output power"),
+    (input_power_w, "W", "electrical input power, both phases"),
+    (stall_torque_nm, "N m", "stall (blocking) torque at this preload and drive"),
+    (amplitude_m, "m", "wave amplitude at the contact surface"),
+    (contact_angle_deg, "deg", "contact angle Xc, full arc per wave"),
+    (driving_angle_deg, "deg", "driving angle Xs, full arc per wave"),
+    (driving_ratio, "-", "proportion of the driving zone in the contact zone"),
+    (contact_half_angle_rad, "rad", "contact half-angle phi0 in wave phase"),
+    (stick_half_angle_rad, "rad", "stick half-angle theta_s in wave phase"),
+    (contact_length_m, "m", "contact length per wave"),
+    (crest_speed_m_s, "m/s", "peak tangential surface speed of the stator"),
+    (axial_force_n, "N", "axial contact force"),
+    (dielectric_loss_w, "W", "dielectric loss"),
+    (damping_loss_w, "W", "stator damping loss"),
+    (friction_loss_w, "W", "contact friction loss"),
+    (radial_friction_loss_w, "W", "radial-slip part of the friction loss"),
+    (rotor_loss_w, "W", "rotor viscous loss"),
+    (current_a, "A", "drive current amplitude per phase"),
+    (feedback_v, "V", "feedback electrode voltage amplitude"),
+    (electrode_voltage_v, "V", "voltage at the electrodes (zero-to-peak)"),
+    (phase_lag_rad, "rad", "phase lag of the wave behind the drive"),
+    (modal_stiffness_n_per_m, "N/m", "effective modal stiffness"),
+    (temperature_rise_k, "K", "steady-state temperature rise over ambient"),
+    (temperature_rise_at_elapsed_k, "K", "temperature rise at the point's elapsed time"),
+    (speed_std_rpm, "rpm", "speed standard deviation over a revolution"),
+}
 
 /// Looks up a quantity by column name; the error lists the valid names.
 pub fn find(name: &str) -> Result<&'static Quantity, String> {

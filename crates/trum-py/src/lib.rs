@@ -397,6 +397,7 @@ fn map_grid<'py>(
         .status
         .iter()
         .enumerate()
+        .filter(|(_, &s)| !vector::is_valid_code(s))
         .filter_map(|(i, &s)| vector::reason(s, &grid.point(i as u64)).map(|r| (i, r)))
         .collect();
     let d = PyDict::new(py);

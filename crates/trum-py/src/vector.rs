@@ -4,7 +4,7 @@
 //! serial, parallel, or split over processes.
 
 use rayon::prelude::*;
-use trum_core::quantities::QUANTITIES;
+use trum_core::quantities::{values, QUANTITIES};
 use trum_core::solve::{solve_prepared, OperatingPoint, Prepared};
 use trum_core::sweep::{solve_range, Grid};
 use trum_core::{Motor, Solution, Status};
@@ -100,8 +100,8 @@ impl ChunkOut<'_> {
     fn write(&mut self, j: usize, s: &Solution) {
         self.status[j] = status_code(s.status);
         let valid = s.status.is_valid();
-        for (col, q) in self.values.iter_mut().zip(QUANTITIES) {
-            col[j] = if valid { (q.get)(s) } else { f64::NAN };
+        for (col, v) in self.values.iter_mut().zip(values(s)) {
+            col[j] = if valid { v } else { f64::NAN };
         }
     }
 }
@@ -170,6 +170,11 @@ pub fn solve_points(motor: &Motor, cols: &[Column<'_>; 5], n: usize, parallel: b
     Some(out)
 }
 
+/// Whether a status code is of a solved point (ok, stall, clamped): one without a reason.
+pub fn is_valid_code(status: u8) -> bool {
+    status < 3
+}
+
 /// Why the point `i` of a solve is not valid (`None` when it is).
 pub fn reason(status: u8, op: &OperatingPoint) -> Option<String> {
     match status {
@@ -184,7 +189,7 @@ pub fn reasons(cols: &[Column<'_>; 5], status: &[u8]) -> Vec<(usize, String)> {
     status
         .iter()
         .enumerate()
-        .filter(|(_, &s)| s >= 3)
+        .filter(|(_, &s)| !is_valid_code(s))
         .filter_map(|(i, &s)| {
             let op = OperatingPoint {
                 preload_n: cols[0].at(i),
