@@ -77,10 +77,22 @@ pub fn contact_from_ratio(y: f64) -> Contact {
     contact_from_ratio_near(y, None).0
 }
 
-/// [`contact_from_ratio`] started from `guess_rad` (a nearby φ0, e.g. of the previous
+/// Where an angle solve starts: an angle [rad] and, where the caller has them, its sine
+/// and cosine (then the first Newton step costs no `sin_cos`).
+pub type AngleStart = (f64, Option<(f64, f64)>);
+
+/// sin and cos of x + δ from those of x by their Taylor series to δ³ (error below δ⁴/24:
+/// 5e-18 at the |δ| ≤ 1e-4 the solver carries them over).
+#[inline]
+pub fn sin_cos_step((s, c): (f64, f64), d: f64) -> (f64, f64) {
+    let (d2, d3) = (0.5 * d * d, d * d * d / 6.0);
+    (s + d * c - d2 * s - d3 * c, c - d * s - d2 * c + d3 * s)
+}
+
+/// [`contact_from_ratio`] started from `guess` (a nearby φ0, e.g. of the previous
 /// amplitude iterate; the root is unique, so the start only changes the cost). Also
 /// returns (sin φ0, cos φ0), which the solver would otherwise recompute.
-pub fn contact_from_ratio_near(y: f64, guess_rad: Option<f64>) -> (Contact, f64, f64) {
+pub fn contact_from_ratio_near(y: f64, guess: Option<AngleStart>) -> (Contact, f64, f64) {
     if y >= PI {
         // Full contact: p = k_f W (cos θ − c) over the whole wave, ∫ = −2π c / k  ⇒  c = −y/π.
         return (Contact { half_angle_rad: PI, offset: -y / PI, full: true }, PI.sin(), -1.0);
@@ -88,10 +100,10 @@ pub fn contact_from_ratio_near(y: f64, guess_rad: Option<f64>) -> (Contact, f64,
     if y <= 0.0 {
         return (Contact { half_angle_rad: 0.0, offset: 1.0, full: false }, 0.0, 1.0);
     }
-    let start = guess_rad.filter(|g| *g > 0.0 && *g < PI).unwrap_or(if y < 1.5 {
-        (3.0 * y).cbrt().min(PI * 0.999)
+    let start = guess.filter(|g| g.0 > 0.0 && g.0 < PI).unwrap_or(if y < 1.5 {
+        ((3.0 * y).cbrt().min(PI * 0.999), None)
     } else {
-        PI - (2.0 * (PI - y) / PI).sqrt()
+        (PI - (2.0 * (PI - y) / PI).sqrt(), None)
     });
     // g' = φ·sin φ, g'' = sin φ + φ·cos φ.
     let (phi, s, c) = newton_sin_cos(|p, s, c| (s - p * c - y, p * s, s + p * c), (0.0, -y), (PI, PI - y), start);
@@ -101,7 +113,8 @@ pub fn contact_from_ratio_near(y: f64, guess_rad: Option<f64>) -> (Contact, f64,
 /// Root of an increasing f on the bracket [lo, hi] (f(lo) ≤ 0 ≤ f(hi), values given) by
 /// safeguarded Newton. `f(x, sin x, cos x)` returns (f, f', f''): every function solved
 /// here is made of sin and cos of the unknown, so one `sin_cos` per iteration serves the
-/// value, the derivatives and the caller, who gets (x, sin x, cos x) back.
+/// value, the derivatives and the caller, who gets (x, sin x, cos x) back; a start with
+/// its sine and cosine saves the first.
 ///
 /// A step that would leave the bracket is replaced by regula falsi on the bracket
 /// (bisection if that stalls): near a root at the bracket's edge, Newton from the far side
@@ -113,10 +126,11 @@ fn newton_sin_cos(
     f: impl Fn(f64, f64, f64) -> (f64, f64, f64),
     (mut lo, mut flo): (f64, f64),
     (mut hi, mut fhi): (f64, f64),
-    start: f64,
+    (start, start_sin_cos): AngleStart,
 ) -> (f64, f64, f64) {
-    let mut x = if start > lo && start < hi { start } else { 0.5 * (lo + hi) };
-    let (mut s, mut c) = x.sin_cos();
+    let inside = start > lo && start < hi;
+    let mut x = if inside { start } else { 0.5 * (lo + hi) };
+    let (mut s, mut c) = start_sin_cos.filter(|_| inside).unwrap_or_else(|| x.sin_cos());
     let mut stalled = 0;
     for _ in 0..100 {
         let (v, d, dd) = f(x, s, c);
@@ -131,7 +145,7 @@ fn newton_sin_cos(
             // (The step bound keeps the cubic term negligible where f'' happens to vanish.)
             if step.abs() <= 1e-7 * x.abs() && step * step * dd.abs() <= 2e-16 * d * x.abs() {
                 // Converged: carry sin and cos over the last (tiny) step.
-                let (s1, c1) = (s - step * c - 0.5 * step * step * s, c + step * s - 0.5 * step * step * c);
+                let (s1, c1) = sin_cos_step((s, c), -step);
                 return (next, s1, c1);
             }
             x = next;
@@ -212,8 +226,8 @@ pub fn stick_half_angle_rad(
     guess_rad: Option<f64>,
 ) -> Option<f64> {
     let (s0, c0) = contact.half_angle_rad.sin_cos();
-    stick_half_angle_sin_cos(contact, (s0, c0), torque_scale_nm, load_torque_nm, viscous_nm_per_cos, guess_rad)
-        .map(|r| r.0)
+    let guess = guess_rad.map(|g| (g, None));
+    stick_half_angle_sin_cos(contact, (s0, c0), torque_scale_nm, load_torque_nm, viscous_nm_per_cos, guess).map(|r| r.0)
 }
 
 /// [`stick_half_angle_rad`] given (sin φ0, cos φ0) of the contact half-angle (cos φ0 = −1
@@ -224,7 +238,7 @@ pub fn stick_half_angle_sin_cos(
     torque_scale_nm: f64,
     load_torque_nm: f64,
     viscous_nm_per_cos: f64,
-    guess_rad: Option<f64>,
+    guess: Option<AngleStart>,
 ) -> Option<(f64, f64, f64)> {
     let c = contact.offset;
     let chi0 = sin_phi0 - contact.half_angle_rad * c;
@@ -243,7 +257,7 @@ pub fn stick_half_angle_sin_cos(
     }
     let (f0, _, _) = f(0.0, 0.0, 1.0);
     // Starting point: warm start, else the middle of the range.
-    let start = guess_rad.filter(|g| *g > 0.0 && *g < tmax).unwrap_or(0.5 * tmax);
+    let start = guess.filter(|g| g.0 > 0.0 && g.0 < tmax).unwrap_or((0.5 * tmax, None));
     Some(newton_sin_cos(f, (0.0, f0), (tmax, fmax), start))
 }
 
@@ -314,9 +328,12 @@ mod tests {
             let phi = cold.half_angle_rad;
             assert!((s - phi.sin()).abs() < 1e-15 && (c - phi.cos()).abs() < 1e-15 && c == cold.offset);
             for g in [1e-12, phi * (1.0 - 1e-9), phi * (1.0 + 1e-9), PI - 1e-12, 1.0] {
-                let (w, s, c) = contact_from_ratio_near(y, Some(g));
-                assert!((w.half_angle_rad - phi).abs() < 1e-14 * (1.0 + phi), "y={y} start {g}");
-                assert!((s - w.half_angle_rad.sin()).abs() < 1e-15 && (c - w.half_angle_rad.cos()).abs() < 1e-15);
+                // (a start with its sine and cosine given, as the solver carries them)
+                for start in [(g, None), (g, Some(g.sin_cos()))] {
+                    let (w, s, c) = contact_from_ratio_near(y, Some(start));
+                    assert!((w.half_angle_rad - phi).abs() < 1e-14 * (1.0 + phi), "y={y} start {start:?}");
+                    assert!((s - w.half_angle_rad.sin()).abs() < 1e-15 && (c - w.half_angle_rad.cos()).abs() < 1e-15);
+                }
             }
         }
         for &(y, load) in &[(0.5, 0.1), (2.5, 0.3), (2.5, 0.0), (4.0, 1.5)] {
@@ -329,11 +346,30 @@ mod tests {
             assert!(resid.abs() < 1e-13, "y={y}: {resid}");
             let tmax = stall_stick_half_angle_rad(&ct);
             for g in [1e-12, t * (1.0 - 1e-9), t * (1.0 + 1e-9), tmax * (1.0 - 1e-12), 1.0] {
-                let (w, s, c) = stick_half_angle_sin_cos(&ct, sc0, 2.0, load, 0.05, Some(g)).expect("root");
-                assert!((w - t).abs() < 1e-14, "y={y} start {g}: {w} vs {t}");
-                assert!((s - w.sin()).abs() < 1e-15 && (c - w.cos()).abs() < 1e-15);
+                for start in [(g, None), (g, Some(g.sin_cos()))] {
+                    let (w, s, c) = stick_half_angle_sin_cos(&ct, sc0, 2.0, load, 0.05, Some(start)).expect("root");
+                    assert!((w - t).abs() < 1e-14, "y={y} start {start:?}: {w} vs {t}");
+                    assert!((s - w.sin()).abs() < 1e-15 && (c - w.cos()).abs() < 1e-15);
+                }
             }
         }
+    }
+
+    /// The carry of sine and cosine over an angle step (the solver's, up to 1e-4 rad)
+    /// against `sin_cos` of the moved angle: within rounding (a few units in the last place).
+    #[test]
+    fn sine_and_cosine_carried_over_a_step_are_those_of_the_moved_angle() {
+        for i in 0..=64 {
+            let x = PI * i as f64 / 64.0;
+            for d in [1e-4, -1e-4, 3e-6, -2e-9, 0.0] {
+                let (s, c) = sin_cos_step(x.sin_cos(), d);
+                let (se, ce) = (x + d).sin_cos();
+                assert!((s - se).abs() < 5e-16 && (c - ce).abs() < 5e-16, "x {x} step {d}: {s} {c} vs {se} {ce}");
+            }
+        }
+        // a step ten times longer than the solver carries is visibly off (δ⁴/24 ≈ 4e-14)
+        let (s, _) = sin_cos_step(1.0f64.sin_cos(), 1e-3);
+        assert!((s - 1.001f64.sin()).abs() > 1e-14);
     }
 
     #[test]
@@ -353,7 +389,7 @@ mod tests {
         let (lo, hi) = ((0.0, f(0.0, 0.0, 1.0).0), (0.5 * PI, f(0.5 * PI, 1.0, 0.0).0));
         for start in [0.8762107029595234, 0.8762107257814344, 0.5, 1.2] {
             n.set(0);
-            let (t, s, co) = newton_sin_cos(f, lo, hi, start);
+            let (t, s, co) = newton_sin_cos(f, lo, hi, (start, None));
             assert!((t - 0.8762107257814344).abs() < 1e-15, "start {start}: {t}");
             assert!((s - t.sin()).abs() < 1e-15 && (co - t.cos()).abs() < 1e-15);
             assert!(n.get() <= 6, "start {start}: {} evaluations", n.get());

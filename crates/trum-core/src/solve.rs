@@ -313,8 +313,14 @@ impl Prepared {
     /// True when every quantity `s` reports is a number (the stall torque excepted where
     /// it is not computed).
     fn all_finite(&self, s: &Solution) -> bool {
+        use crate::quantities::{values, QUANTITIES};
+        // 0·x is ±0 for a number and NaN for ±∞ and NaN: one sum without a branch per
+        // quantity (this runs for every solved point)
+        if values(s).iter().map(|v| 0.0 * v).sum::<f64>() == 0.0 {
+            return true;
+        }
         let skip = !self.stall_torque && s.stall_torque_nm.is_nan();
-        crate::quantities::QUANTITIES.iter().all(|q| (skip && q.name == "stall_torque_nm") || (q.get)(s).is_finite())
+        skip && QUANTITIES.iter().all(|q| q.name == "stall_torque_nm" || (q.get)(s).is_finite())
     }
 }
 
@@ -343,6 +349,8 @@ impl Prepared {
 pub(crate) struct Trial {
     w: f64,
     contact: Contact,
+    /// χ(φ0) = sin φ0 − φ0·c.
+    chi0: f64,
     ts: f64,
     /// Rotor surface speed [m/s]: v0·cos θs, or below it when the whole contact drives.
     vr: f64,
@@ -360,6 +368,10 @@ pub(crate) struct Trial {
     k_eff: f64,
     /// Θ·V/|Z|: the amplitude this trial implies.
     w_next: f64,
+    /// d(W − w_next)/dW, exact: the baseline Coulomb interface only (NaN elsewhere).
+    slope: f64,
+    /// Contact and stick angles for the next trial's start (baseline Coulomb interface).
+    carry: [Option<AngleCarry>; 2],
 }
 
 /// Per-point inputs after effects that act on the drive (voltage sag, thermal state).
@@ -410,20 +422,59 @@ fn sagged_voltage_v(p: &Prepared, op: &OperatingPoint, s: &Solution) -> f64 {
     op.voltage_v / re.hypot(im)
 }
 
-/// Baseline 2-D Coulomb interface: closed forms (seed 001 eq. 10-11; crate::contact).
-/// `sc0` = (sin φ0, cos φ0). Returns (θs, v_r, stalled, torque factor 2χ(θs) − χ(φ0),
-/// power factor 2E(θs) − E(φ0), stall torque factor). χ and E are written out here with
-/// the sines and cosines the root finds already have: one `sin_cos` per Newton step is
-/// the whole transcendental cost of a trial.
+/// An angle of a trial with its sine and cosine and its derivative in the amplitude: the
+/// next trial's angle solve starts at the angle moved along that derivative, its sine and
+/// cosine carried by [`contact::sin_cos_step`].
+#[derive(Clone, Copy, Debug)]
+struct AngleCarry {
+    rad: f64,
+    sin_cos: (f64, f64),
+    per_w: f64,
+}
+
+impl AngleCarry {
+    /// Largest angle step [rad] the sine and cosine are carried over (error < 5e-18).
+    const MAX_STEP: f64 = 1e-4;
+
+    /// The start of the same angle's solve at amplitude `w`, the carry made at `from`.
+    fn start_at(&self, from: f64, w: f64) -> Option<contact::AngleStart> {
+        let step = self.per_w * (w - from);
+        (step.abs() <= Self::MAX_STEP).then(|| (self.rad + step, Some(contact::sin_cos_step(self.sin_cos, step))))
+    }
+}
+
+/// The baseline Coulomb interface's state at one trial amplitude.
+struct Coulomb {
+    ts: f64,
+    vr: f64,
+    stalled: bool,
+    /// Torque factor 2χ(θs) − χ(φ0), power factor 2E(θs) − E(φ0), stall torque factor.
+    tf: f64,
+    pf: f64,
+    tf0: f64,
+    /// d(power factor)/dW.
+    pf_per_w: f64,
+    /// Contact and stick angles to start the next trial from (the stick angle where it is
+    /// a root of the torque balance, not the end of its range).
+    carry: [Option<AngleCarry>; 2],
+}
+
+/// Baseline 2-D Coulomb interface at amplitude `w`: closed forms (seed 001 eq. 10-11;
+/// crate::contact). `sc0` = (sin φ0, cos φ0). χ and E are written out here with the sines
+/// and cosines the root finds already have: one `sin_cos` per Newton step is the whole
+/// transcendental cost of a trial, and none where the angles carried from the previous
+/// trial are already roots.
+#[allow(clippy::too_many_arguments)]
 fn coulomb_interface(
     p: &Prepared,
     d: &Drive,
     ct: &Contact,
     (s0, c0): (f64, f64),
+    w: f64,
     tscale: f64,
     v0: f64,
-    ts_guess: Option<f64>,
-) -> (f64, f64, bool, f64, f64, f64) {
+    ts_guess: Option<contact::AngleStart>,
+) -> Coulomb {
     let (phi, c) = (ct.half_angle_rad, ct.offset);
     let chi0 = s0 - phi * c;
     let e0 = 0.5 * phi + 0.5 * s0 * c0 - c * s0;
@@ -431,24 +482,40 @@ fn coulomb_interface(
     let (smax, cmax) = if tmax < phi { (1.0, 0.0) } else { (s0, c0) };
     let tf0 = 2.0 * (smax - tmax * c) - chi0;
     let visc = p.dr * v0 / p.r0;
-    let (ts, st, cs, vr, stalled) =
-        match contact::stick_half_angle_sin_cos(ct, (s0, c0), tscale, d.t_load, visc, ts_guess) {
-            Some((t, st, cs)) => (t, st, cs, v0 * cs, false),
-            None => {
-                // Narrow contact (φ0 < π/2): below v_r = v0·cos φ0 the whole contact drives with
-                // the constant torque R0·μ·F, and the rotor's viscous torque sets the speed.
-                let drive = tscale * tf0;
-                if tmax < 0.5 * PI && p.dr > 0.0 && d.t_load < drive {
-                    (tmax, smax, cmax, ((drive - d.t_load) / p.dr * p.r0).min(v0 * cmax), false)
-                } else {
-                    (tmax, smax, cmax, 0.0, true)
-                }
+    // How the contact moves with W (A ∝ W, so y = F/A ∝ 1/W): in partial contact
+    // g(φ0) = χ(φ0) = y gives dφ0/dW = −χ(φ0)/(W·φ0·sin φ0) and dc/dW = −sin φ0·dφ0/dW;
+    // in full contact c = −y/π, dc/dW = −c/W.
+    let (dphi, dc) = if ct.full { (0.0, -c / w) } else { (-chi0 / (w * phi * s0), chi0 / (w * phi)) };
+    let running = contact::stick_half_angle_sin_cos(ct, (s0, c0), tscale, d.t_load, visc, ts_guess);
+    let (ts, st, cs, vr, stalled) = match running {
+        Some((t, st, cs)) => (t, st, cs, v0 * cs, false),
+        None => {
+            // Narrow contact (φ0 < π/2): below v_r = v0·cos φ0 the whole contact drives with
+            // the constant torque R0·μ·F, and the rotor's viscous torque sets the speed.
+            let drive = tscale * tf0;
+            if tmax < 0.5 * PI && p.dr > 0.0 && d.t_load < drive {
+                (tmax, smax, cmax, ((drive - d.t_load) / p.dr * p.r0).min(v0 * cmax), false)
+            } else {
+                (tmax, smax, cmax, 0.0, true)
             }
-        };
+        }
+    };
     let tf = 2.0 * (st - ts * c) - chi0;
     // c_t·ω = 2Nμk_f·h0·[2E(θs) − E(φ0)]: friction power taken from the wave over (ωW)².
     let pf = 2.0 * (0.5 * ts + 0.5 * st * cs - c * st) - e0;
-    (ts, vr, stalled, tf, pf, tf0)
+    // dθs/dW: implicit in the torque balance F(θs, W) = R0μA·(2χ(θs) − χ(φ0)) − T −
+    // d_r·v0·cos θs/R0 = 0, whose ∂F/∂W is T/W + R0μA·(φ0 − 2θs)·dc/dW on the root
+    // (R0μA and v0 are ∝ W); at the end of the range θs is θmax = min(φ0, π/2).
+    let dts = match running {
+        Some(_) => -(d.t_load / w + tscale * dc * (phi - 2.0 * ts)) / (2.0 * tscale * (cs - c) + visc * st),
+        None if tmax < phi => 0.0,
+        None => dphi,
+    };
+    // dE(θ)/dθ = cos θ·(cos θ − c), ∂E/∂c = −sin θ; E(φ0)'s own θ-derivative vanishes.
+    let pf_per_w = 2.0 * (cs * (cs - c) * dts - st * dc) + s0 * dc;
+    let contact_carry = (!ct.full).then_some(AngleCarry { rad: phi, sin_cos: (s0, c0), per_w: dphi });
+    let stick_carry = running.map(|_| AngleCarry { rad: ts, sin_cos: (st, cs), per_w: dts });
+    Coulomb { ts, vr, stalled, tf, pf, tf0, pf_per_w, carry: [contact_carry, stick_carry] }
 }
 
 /// Generalised interface (radial slip, saturating traction): the rotor speed ratio
@@ -814,25 +881,43 @@ fn highest_window(
     }
 }
 
-fn trial(p: &Prepared, d: &Drive, w: f64, ts_guess: Option<f64>, phi_guess: Option<f64>) -> Trial {
+fn trial(
+    p: &Prepared,
+    d: &Drive,
+    w: f64,
+    ts_guess: Option<contact::AngleStart>,
+    phi_guess: Option<contact::AngleStart>,
+) -> Trial {
     let a = contact::force_scale_n(p.n, p.kf, w, p.k);
     let (ct, s0, c0) = contact::contact_from_ratio_near(d.f_n / a, phi_guess);
     let v0 = stator::crest_surface_speed_m_s(p.k, p.h0, d.omega, w);
     let tscale = p.r0 * d.mu * a;
-    let (ts, vr, stalled, tf, pf, rf, tf0);
+    let (ts, vr, stalled, tf, pf, rf, tf0, dpf, carry);
     if p.law.radial_ratio == 0.0 && p.compliance == 0.0 {
-        (ts, vr, stalled, tf, pf, tf0) = coulomb_interface(p, d, &ct, (s0, c0), tscale, v0, ts_guess);
+        let cb = coulomb_interface(p, d, &ct, (s0, c0), w, tscale, v0, ts_guess);
+        (ts, vr, stalled, tf, pf, tf0, dpf, carry) =
+            (cb.ts, cb.vr, cb.stalled, cb.tf, cb.pf, cb.tf0, cb.pf_per_w, cb.carry);
         rf = 0.0;
     } else {
         let law = interface_law(p, d, &ct);
-        let (t, v, st, fac, t0) = general_interface(p, d, &ct, tscale, v0, &law, ts_guess);
+        let (t, v, st, fac, t0) = general_interface(p, d, &ct, tscale, v0, &law, ts_guess.map(|g| g.0));
         (ts, vr, stalled, tf, pf, rf, tf0) = (t, v, st, fac.torque, fac.power, fac.radial, t0);
+        (dpf, carry) = (f64::NAN, [None; 2]);
     }
-    let ct_omega = 2.0 * p.n * d.mu * p.kf * p.h0 * pf;
+    let ct_omega_per_pf = 2.0 * p.n * d.mu * p.kf * p.h0;
     let k_eff = modal_stiffness(p, d, w, &ct, a);
-    let z = (k_eff - p.m * d.omega * d.omega, d.omega * d.c + ct_omega);
-    let w_next = p.theta * d.v / (z.0 * z.0 + z.1 * z.1).sqrt();
-    Trial { w, contact: ct, ts, vr, stalled, a, v0, tf, pf, rf, tf0, z, k_eff, w_next }
+    let z = (k_eff - p.m * d.omega * d.omega, d.omega * d.c + ct_omega_per_pf * pf);
+    let z2 = z.0 * z.0 + z.1 * z.1;
+    let w_next = p.theta * d.v / z2.sqrt();
+    // r = W − G(W), G = Θ·V/|Z|: dr/dW = 1 + G·Im Z·d(Im Z)/dW / |Z|² where the modal
+    // stiffness does not depend on W (NaN where it does, or dpf is not known).
+    let slope = match p.stiffening == 0.0 && p.beta == 0.0 {
+        true => 1.0 + w_next * z.1 * ct_omega_per_pf * dpf / z2,
+        false => f64::NAN,
+    };
+    // χ(φ0) with the sine the contact solve has (the axial force is A·χ(φ0))
+    let chi0 = s0 - ct.half_angle_rad * ct.offset;
+    Trial { w, contact: ct, chi0, ts, vr, stalled, a, v0, tf, pf, rf, tf0, z, k_eff, w_next, slope, carry }
 }
 
 /// Solves one operating point from scratch. Never panics; an invalid or unsolvable point
@@ -892,10 +977,13 @@ pub(crate) fn finite_or_unconverged(p: &Prepared, mut s: Solution) -> Solution {
 /// solves); `history` = the points solved before this one, oldest first, the newest being
 /// `last`'s (a sweep keeps the last [`SWEEP_HISTORY`]). The newest is the warm start's bound. Where earlier ones lie on
 /// this point's torque line too, the amplitude extrapolated through them (Lagrange, up to
-/// quadratic) is tried first, with the residual's slope extrapolated linearly for the
-/// first Newton step: within about 1e-6 of the root, where the bound is a whole torque
-/// step (1e-3) away. Where r ≥ 0 at the prediction it is the top of the descent, else it
-/// and the bound bracket the root.
+/// quadratic) is tried first: within about 1e-6 of the root, where the bound is a whole
+/// torque step (1e-3) away. The first Newton step from there takes the trial's exact slope
+/// of r (the baseline Coulomb interface; else the slope extrapolated linearly), and lands
+/// within the tolerance at 99 % of the running points of trum60a's 100-torque rows (2.02
+/// trials a point). The contact and stick angles are extrapolated the same way for the first
+/// trial's angle solves. Where r ≥ 0 at the prediction it is the top of the descent,
+/// else it and the bound bracket the root.
 /// Returns this point's solution and slope (None where the descent did not run).
 pub(crate) fn solve_in_sweep(
     p: &Prepared,
@@ -920,19 +1008,21 @@ pub(crate) fn solve_in_sweep(
     let Some(top) = top else {
         return (solve_prepared(p, motor, op, guess), None);
     };
-    // (torque, amplitude) and (torque, slope) of the newest points on this torque line,
-    // newest first, strictly falling in torque (fixed arrays: this runs once a point)
-    let (mut ws, mut nw) = ([(0.0, 0.0); SWEEP_HISTORY], 0);
-    let (mut ks, mut nk) = ([(0.0, 0.0); 2], 0);
+    // Torques and (amplitude, contact angle, stick angle), and (torque, slope), of the
+    // newest points on this torque line, newest first, strictly falling in torque (fixed
+    // arrays: this runs once a point)
+    let (mut xs, mut ys, mut nw) = ([0.0; SWEEP_HISTORY], [[0.0; 3]; SWEEP_HISTORY], 0);
+    let (mut kx, mut ky, mut nk) = ([0.0; 2], [0.0; 2], 0);
     for h in history.iter().rev() {
-        if !(on_line(h) && (nw == 0 || h.op.torque_nm < ws[nw - 1].0)) {
+        if !(on_line(h) && (nw == 0 || h.op.torque_nm < xs[nw - 1])) {
             break;
         }
-        ws[nw] = (h.op.torque_nm, h.amplitude_m);
+        xs[nw] = h.op.torque_nm;
+        ys[nw] = [h.amplitude_m, h.contact_half_angle_rad, h.stick_half_angle_rad];
         nw += 1;
         match h.slope {
             Some(k) if nk == nw - 1 && nk < 2 => {
-                ks[nk] = (h.op.torque_nm, k);
+                (kx[nk], ky[nk]) = (h.op.torque_nm, k);
                 nk += 1;
             }
             _ => {}
@@ -941,14 +1031,25 @@ pub(crate) fn solve_in_sweep(
     // In a stall G does not depend on the torque and the bound is the root itself: no
     // prediction (extrapolating across the onset of stall would land below it).
     let ahead = top.op.torque_nm < op.torque_nm && !top.stalled;
-    let predicted = (ahead && nw >= 2).then(|| lagrange_at(&ws[..nw], op.torque_nm));
+    let w = lagrange_weights(&xs[..nw], op.torque_nm);
+    let at = |j: usize| ys[..nw].iter().zip(w).map(|(y, w)| w * y[j]).sum::<f64>();
+    let predicted = (ahead && nw >= 2).then(|| at(0));
     let slope = match ahead && nk == 2 {
-        true => Some(lagrange_at(&ks, op.torque_nm)).filter(|k| *k > 0.0).or(top.slope),
+        true => {
+            let w = lagrange_weights(&kx, op.torque_nm);
+            Some(w[0] * ky[0] + w[1] * ky[1]).filter(|k| *k > 0.0).or(top.slope)
+        }
         false => top.slope,
     };
-    let warm = WarmTop { bound: top.amplitude_m, slope, predicted };
-    let (s, slope) = solve_drive_below(p, &Drive::at(p, op), op, guess, Some(warm));
-    (finite_or_unconverged(p, s), slope)
+    // The contact and stick angles extrapolated the same way start the first trial's
+    // angle solves (inside their ranges, φ0 < π and θs < min(φ0, π/2), else the newest
+    // point's angles do).
+    let contact_rad = predicted.map(|_| at(1)).filter(|&t| t > 0.0 && t < PI);
+    let stick_rad = predicted.map(|_| at(2)).filter(|&t| t > 0.0 && t < top.contact_half_angle_rad.min(0.5 * PI));
+    let warm = WarmTop { bound: top.amplitude_m, slope, predicted, contact_rad, stick_rad };
+    // (every solution of solve_drive_below comes through `finish`, which has checked it
+    // for non-finite numbers)
+    solve_drive_below(p, &Drive::at(p, op), op, guess, Some(warm))
 }
 
 /// What a sweep keeps of a solved point for the warm start of the next ones.
@@ -956,6 +1057,8 @@ pub(crate) fn solve_in_sweep(
 pub(crate) struct SweepPoint {
     op: OperatingPoint,
     amplitude_m: f64,
+    stick_half_angle_rad: f64,
+    contact_half_angle_rad: f64,
     /// Ok or Stall with a positive amplitude: a bound for the next point on its line.
     running: bool,
     stalled: bool,
@@ -967,26 +1070,29 @@ pub(crate) struct SweepPoint {
 impl SweepPoint {
     pub(crate) fn new(op: &OperatingPoint, s: &Solution, slope: Option<f64>) -> Self {
         let running = matches!(s.status, Status::Ok | Status::Stall) && s.amplitude_m > 0.0;
-        SweepPoint { op: *op, amplitude_m: s.amplitude_m, running, stalled: s.status == Status::Stall, slope }
+        SweepPoint {
+            op: *op,
+            amplitude_m: s.amplitude_m,
+            stick_half_angle_rad: s.stick_half_angle_rad,
+            contact_half_angle_rad: s.contact_half_angle_rad,
+            running,
+            stalled: s.status == Status::Stall,
+            slope,
+        }
     }
 }
 
 /// Points a sweep keeps for [`solve_in_sweep`]'s extrapolation (quadratic through three).
 pub(crate) const SWEEP_HISTORY: usize = 3;
 
-/// The polynomial through the points `xy` (distinct x), evaluated at `x`.
-fn lagrange_at(xy: &[(f64, f64)], x: f64) -> f64 {
-    xy.iter()
-        .enumerate()
-        .map(|(i, &(xi, yi))| {
-            yi * xy
-                .iter()
-                .enumerate()
-                .filter(|&(j, _)| j != i)
-                .map(|(_, &(xj, _))| (x - xj) / (xi - xj))
-                .product::<f64>()
-        })
-        .sum()
+/// Weights of the polynomial through nodes `xs` (distinct, at most [`SWEEP_HISTORY`])
+/// at `x`: its value there is Σ wᵢ·yᵢ (Lagrange), whatever the values yᵢ.
+fn lagrange_weights(xs: &[f64], x: f64) -> [f64; SWEEP_HISTORY] {
+    let mut w = [0.0; SWEEP_HISTORY];
+    for (i, &xi) in xs.iter().enumerate() {
+        w[i] = xs.iter().enumerate().filter(|&(j, _)| j != i).map(|(_, &xj)| (x - xj) / (xi - xj)).product();
+    }
+    w
 }
 
 /// Effects that depend on the solution itself (temperature from the losses, electrode
@@ -1184,7 +1290,7 @@ pub(crate) fn state_map(
     }
     let mut t = match same {
         Some(t) => *t,
-        None => trial(p, &d, z[0], Some(guess.0), guess.1),
+        None => trial(p, &d, z[0], Some((guess.0, None)), guess.1.map(|g| (g, None))),
     };
     // once, so that a reused trial carries it
     if p.stall_torque {
@@ -1419,6 +1525,9 @@ struct WarmTop {
     bound: f64,
     slope: Option<f64>,
     predicted: Option<f64>,
+    /// The contact and stick angles extrapolated to this point, for the first trial.
+    contact_rad: Option<f64>,
+    stick_rad: Option<f64>,
 }
 
 /// [`solve_drive`], the amplitude descending from a warm `top` instead of the bound
@@ -1427,8 +1536,10 @@ struct WarmTop {
 /// The prediction, when given, is tried first (the top where r ≥ 0 there; below the root
 /// it is stepped up, never past the bound, and brackets the root with the first step above).
 /// The slope of r, when positive, makes the first step a Newton step instead of a
-/// fixed-point one. Returns the slope of r at the root (from the last secant) with the
-/// solution.
+/// fixed-point one: the trial's exact slope where it has one, else `top.slope`. Inside a
+/// bracket the descent also takes Newton steps on exact slopes where they stay inside it
+/// (regula falsi otherwise). Returns the slope of r at the root (from the last secant)
+/// with the solution.
 fn solve_drive_below(
     p: &Prepared,
     d: &Drive,
@@ -1446,18 +1557,25 @@ fn solve_drive_below(
     // the bracket is then grown below.
     let w_hi0 = p.theta * d.v / (d.omega * d.c);
     let mut evals = 0u32;
-    let mut ts_guess = guess.map(|g| g.stick_half_angle_rad).filter(|t| t.is_finite());
+    let mut ts_guess =
+        top.and_then(|t| t.stick_rad).or(guess.map(|g| g.stick_half_angle_rad)).filter(|t| t.is_finite());
     // The inner root finds (contact and stick angles) have unique roots: starting them
-    // from the previous trial only makes them cheaper.
-    let mut phi_guess: Option<f64> = None;
+    // from the previous trial (the first from the neighbouring point's) only makes them
+    // cheaper.
+    let mut phi_guess =
+        top.and_then(|t| t.contact_rad).or(guess.map(|g| g.contact_half_angle_rad)).filter(|t| t.is_finite());
     // (W, θs) of the last two trials. The generalised interface's speed solve costs 2-6
     // numerical integrals per trial; late in the descent the amplitude moves along a
     // secant, and θs extrapolated linearly in W starts it within a hair of its root (7 %
     // fewer integrals). The Coulomb interface's Newton solves are cheap enough that the
     // extrapolation cost more than it saved (callgrind, +7 % per point), so it keeps the
     // previous trial's angles.
+    // The Coulomb interface instead carries each angle from the previous trial along its
+    // exact derivative in W, with its sine and cosine: late in the descent that start is
+    // the root to rounding and the angle solves need no `sin_cos` at all.
     let general = p.law.radial_ratio != 0.0 || p.compliance != 0.0;
     let mut history: [Option<(f64, f64)>; 2] = [None, None];
+    let mut carried: Option<(f64, [Option<AngleCarry>; 2])> = None;
     let mut eval = |w: f64, ts_guess: &mut Option<f64>| {
         evals += 1;
         let guess = match history {
@@ -1467,10 +1585,14 @@ fn solve_drive_below(
             }
             _ => *ts_guess,
         };
-        let t = trial(p, d, w, guess, phi_guess);
+        let start = |i: usize, plain: Option<f64>| {
+            carried.and_then(|(from, c)| c[i]?.start_at(from, w)).or(plain.map(|g| (g, None)))
+        };
+        let t = trial(p, d, w, start(1, guess), start(0, phi_guess));
         *ts_guess = Some(t.ts);
         phi_guess = Some(t.contact.half_angle_rad).filter(|_| !t.contact.full);
         history = [history[1], Some((w, t.ts))];
+        carried = Some((w, t.carry));
         t
     };
     // Upper bracket: r(W) = W − W' ≥ 0. The previous root was converged to rtol only, so
@@ -1500,6 +1622,7 @@ fn solve_drive_below(
             for _ in 0..3 {
                 let rb = b.w - b.w_next;
                 let x = match last {
+                    _ if b.slope > 0.0 => b.w - rb / b.slope,
                     Some(l) if l.w != b.w => b.w - rb * (b.w - l.w) / (rb - (l.w - l.w_next)),
                     _ => wt.slope.filter(|&k| k > 0.0).map_or(f64::NAN, |k| b.w - rb / k),
                 };
@@ -1557,14 +1680,28 @@ fn solve_drive_below(
     // tests/reliability_known_bugs.rs). The guess still warm-starts the inner stick-angle
     // solves.
     let start = match (warm, top.and_then(|t| t.slope), below) {
-        // a trial below the root and the top above it: their secant
+        // a trial below the root and the top above it: Newton from the one nearer the
+        // root where its exact slope is known and the step stays between them, else
+        // their secant
         (Some(h), _, Some(l)) => {
             let (rl, rh) = (l.w - l.w_next, h.w - h.w_next);
-            let x = l.w - rl * (h.w - l.w) / (rh - rl);
+            let near = if rh.abs() < rl.abs() { h } else { l };
+            let x = match near.w - (near.w - near.w_next) / near.slope {
+                x if near.slope > 0.0 && x > l.w && x < h.w => x,
+                _ => l.w - rl * (h.w - l.w) / (rh - rl),
+            };
             if x > l.w && x < h.w {
                 x
             } else {
                 0.5 * (l.w + h.w)
+            }
+        }
+        (Some(h), _, None) if h.slope > 0.0 => {
+            let x = h.w - (h.w - h.w_next) / h.slope;
+            if x > 0.0 && x <= h.w {
+                x
+            } else {
+                h.w_next
             }
         }
         (Some(h), Some(k), None) if k > 0.0 => {
@@ -1676,8 +1813,12 @@ fn solve_drive_below(
             break;
         }
         let next = match lo {
-            // Regula falsi (Illinois) inside [lo, hi].
-            Some(l) => bracket.regula_falsi().unwrap_or(0.5 * (l.w + hi.w)),
+            // Newton with the trial's exact slope where its step stays inside [lo, hi],
+            // else regula falsi (Illinois) there.
+            Some(l) => match cur.w - r / cur.slope {
+                x if cur.slope > 0.0 && x > l.w && x < hi.w => x,
+                _ => bracket.regula_falsi().unwrap_or(0.5 * (l.w + hi.w)),
+            },
             None => {
                 // Secant from the previous iterate if it moves down; else a fixed-point step,
                 // lengthened while the secant keeps pointing up: there the residual grows as
@@ -1765,6 +1906,7 @@ fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {
     Trial {
         w: 0.0,
         contact: Contact { half_angle_rad: PI, offset: f64::NEG_INFINITY, full: true },
+        chi0: f64::INFINITY,
         ts: 0.5 * PI,
         vr: 0.0,
         stalled: true,
@@ -1777,6 +1919,8 @@ fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {
         z: (p.ks - p.m * d.omega * d.omega, f64::INFINITY),
         k_eff: d.ks,
         w_next: 0.0,
+        slope: f64::NAN,
+        carry: [None; 2],
     }
 }
 
@@ -1845,7 +1989,7 @@ fn finish_unchecked(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, sta
         crest_speed_m_s: t.v0,
         torque_nm: op.torque_nm,
         stall_torque_nm: stall_torque,
-        axial_force_n: if clamped { op.preload_n } else { t.a * ct.chi0() },
+        axial_force_n: if clamped { op.preload_n } else { t.a * t.chi0 },
         input_power_w: input,
         output_power_w: output,
         dielectric_loss_w: dielectric,
@@ -2037,6 +2181,52 @@ mod tests {
             }
         }
         assert!(stalled > 500 && moving > 500, "{stalled} stalled, {moving} moving trials");
+    }
+
+    /// The exact slope of the amplitude residual r(W) = W − G(W) that a baseline trial
+    /// carries (implicit derivatives of the contact and stick angles) against a central
+    /// difference of r, at random amplitudes, preloads, drives and torques through
+    /// partial and full contact, running, stalled and narrow-contact states.
+    #[test]
+    fn the_trial_slope_is_the_derivative_of_the_amplitude_residual() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(29);
+        let mut seen = [0usize; 4]; // running, stalled, full contact, narrow contact
+        for name in ["trum60a", "trum60-qut", "generic60"] {
+            let m = crate::presets::preset(name).expect("preset");
+            let p = Prepared::new(&m);
+            for _ in 0..2000 {
+                let op = OperatingPoint::new(
+                    rng.random_range(5.0..700.0),
+                    rng.random_range(0.0..2.5),
+                    rng.random_range(60.0..320.0),
+                    rng.random_range(39e3..45e3),
+                );
+                let d = Drive::at(&p, &op);
+                let w = rng.random_range(0.005..1.0) * p.theta * d.v / (d.omega * d.c);
+                let t = trial(&p, &d, w, None, None);
+                let h = 1e-6 * w;
+                let (a, b) = (trial(&p, &d, w - h, None, None), trial(&p, &d, w + h, None, None));
+                // a state change inside the difference's span has no derivative to compare
+                if a.stalled != b.stalled || a.contact.full != b.contact.full {
+                    continue;
+                }
+                let fd = ((b.w - b.w_next) - (a.w - a.w_next)) / (2.0 * h);
+                // |G'| is of the order of G/W; the difference's truncation (h²) and
+                // rounding (1e-16·W/h) errors are far below 1e-6 of that
+                let scale = 1.0 + t.w_next / w;
+                assert!(
+                    (t.slope - fd).abs() <= 1e-6 * scale,
+                    "{name} {op:?} W {w}: slope {} vs difference {fd} (stalled {}, full {})",
+                    t.slope,
+                    t.stalled,
+                    t.contact.full
+                );
+                seen[usize::from(t.stalled)] += 1;
+                seen[2] += usize::from(t.contact.full);
+                seen[3] += usize::from(t.contact.half_angle_rad < 0.5 * PI);
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 150), "running, stalled, full, narrow: {seen:?}");
     }
 
     /// Without the stall torque (calibration's passes) a solve is the same solve: every
