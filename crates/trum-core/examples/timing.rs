@@ -2,7 +2,8 @@
 //!
 //! `cargo run --release -p trum-core --example timing`            all effect sets, cold
 //! `cargo run --release -p trum-core --example timing -- baseline` baseline only: cold
-//!     points, then the same grid as a warm-started sweep (for callgrind too)
+//!     points, then the same grid as a warm-started sweep, then the Python comparison's
+//!     grid as a sweep (for callgrind too)
 //!
 //! Times are medians over rows of 25 points (one preload, torque 0-0.96 N·m), so one
 //! slow row (another process scheduled) does not move them.
@@ -75,6 +76,30 @@ fn main() {
             "{:26} sweep {:.3} us/point (median), mean evals {:.2}",
             "none",
             median(per_row) * 1e6,
+            it as f64 / g.len() as f64
+        );
+        // The Python comparison's grid (benches/compare_python.py: 200 preloads × 100
+        // torques over 0-1.2 N·m) as rows of torque sweeps: what `trum.map` solves there,
+        // without the Python layer. Best of five passes.
+        let g = Grid {
+            preload_n: Axis::linspace(100.0, 500.0, 200),
+            voltage_v: Axis::fixed(200.0),
+            frequency_hz: Axis::fixed(43e3),
+            torque_nm: Axis::linspace(0.0, 1.2, 100),
+        };
+        let (mut best, mut it) = (f64::INFINITY, 0u64);
+        for _ in 0..5 {
+            it = 0;
+            let t0 = Instant::now();
+            for r in 0..200u64 {
+                solve_range(&m, &p, &g, r * 100..(r + 1) * 100, |_, _, s| it += s.iterations as u64);
+            }
+            best = best.min(t0.elapsed().as_secs_f64());
+        }
+        println!(
+            "{:26} sweep, Python comparison grid {:.3} us/point, mean evals {:.2}",
+            "none",
+            best / g.len() as f64 * 1e6,
             it as f64 / g.len() as f64
         );
         // Prepared once, no neighbour: the solver alone, without Prepared::new.
