@@ -979,19 +979,18 @@ pub(crate) fn finite_or_unconverged(p: &Prepared, mut s: Solution) -> Solution {
 /// this point's torque line too, the amplitude extrapolated through them (Lagrange, up to
 /// quadratic) is tried first: within about 1e-6 of the root, where the bound is a whole
 /// torque step (1e-3) away. The first Newton step from there takes the trial's exact slope
-/// of r (the baseline Coulomb interface; else the slope extrapolated linearly), and lands
+/// of r (every warm trial has one: the baseline Coulomb interface), and lands
 /// within the tolerance at 99 % of the running points of trum60a's 100-torque rows (2.02
 /// trials a point). The contact and stick angles are extrapolated the same way for the first
 /// trial's angle solves. Where r ≥ 0 at the prediction it is the top of the descent,
 /// else it and the bound bracket the root.
-/// Returns this point's solution and slope (None where the descent did not run).
 pub(crate) fn solve_in_sweep(
     p: &Prepared,
     motor: &Motor,
     op: &OperatingPoint,
     last: Option<&Solution>,
     history: &[SweepPoint],
-) -> (Solution, Option<f64>) {
+) -> Solution {
     let guess = last.filter(|g| g.status.is_valid());
     let on_line = |h: &SweepPoint| h.running && OperatingPoint { torque_nm: op.torque_nm, ..h.op } == *op;
     let top = history.last().filter(|h| {
@@ -1006,13 +1005,12 @@ pub(crate) fn solve_in_sweep(
             && op.invalid_reason().is_none()
     });
     let Some(top) = top else {
-        return (solve_prepared(p, motor, op, guess), None);
+        return solve_prepared(p, motor, op, guess);
     };
-    // Torques and (amplitude, contact angle, stick angle), and (torque, slope), of the
-    // newest points on this torque line, newest first, strictly falling in torque (fixed
-    // arrays: this runs once a point)
+    // Torques and (amplitude, contact angle, stick angle) of the newest points on this
+    // torque line, newest first, strictly falling in torque (fixed arrays: this runs once a
+    // point)
     let (mut xs, mut ys, mut nw) = ([0.0; SWEEP_HISTORY], [[0.0; 3]; SWEEP_HISTORY], 0);
-    let (mut kx, mut ky, mut nk) = ([0.0; 2], [0.0; 2], 0);
     for h in history.iter().rev() {
         if !(on_line(h) && (nw == 0 || h.op.torque_nm < xs[nw - 1])) {
             break;
@@ -1020,13 +1018,6 @@ pub(crate) fn solve_in_sweep(
         xs[nw] = h.op.torque_nm;
         ys[nw] = [h.amplitude_m, h.contact_half_angle_rad, h.stick_half_angle_rad];
         nw += 1;
-        match h.slope {
-            Some(k) if nk == nw - 1 && nk < 2 => {
-                (kx[nk], ky[nk]) = (h.op.torque_nm, k);
-                nk += 1;
-            }
-            _ => {}
-        }
     }
     // In a stall G does not depend on the torque and the bound is the root itself: no
     // prediction (extrapolating across the onset of stall would land below it).
@@ -1034,19 +1025,12 @@ pub(crate) fn solve_in_sweep(
     let w = lagrange_weights(&xs[..nw], op.torque_nm);
     let at = |j: usize| ys[..nw].iter().zip(w).map(|(y, w)| w * y[j]).sum::<f64>();
     let predicted = (ahead && nw >= 2).then(|| at(0));
-    let slope = match ahead && nk == 2 {
-        true => {
-            let w = lagrange_weights(&kx, op.torque_nm);
-            Some(w[0] * ky[0] + w[1] * ky[1]).filter(|k| *k > 0.0).or(top.slope)
-        }
-        false => top.slope,
-    };
     // The contact and stick angles extrapolated the same way start the first trial's
     // angle solves (inside their ranges, φ0 < π and θs < min(φ0, π/2), else the newest
     // point's angles do).
     let contact_rad = predicted.map(|_| at(1)).filter(|&t| t > 0.0 && t < PI);
     let stick_rad = predicted.map(|_| at(2)).filter(|&t| t > 0.0 && t < top.contact_half_angle_rad.min(0.5 * PI));
-    let warm = WarmTop { bound: top.amplitude_m, slope, predicted, contact_rad, stick_rad };
+    let warm = WarmTop { bound: top.amplitude_m, predicted, contact_rad, stick_rad };
     // (every solution of solve_drive_below comes through `finish`, which has checked it
     // for non-finite numbers)
     solve_drive_below(p, &Drive::at(p, op), op, guess, Some(warm))
@@ -1062,13 +1046,10 @@ pub(crate) struct SweepPoint {
     /// Ok or Stall with a positive amplitude: a bound for the next point on its line.
     running: bool,
     stalled: bool,
-    /// Slope of the amplitude residual r(W) at the root: from the descent's last secant,
-    /// or the extrapolated one where the prediction converged at once.
-    slope: Option<f64>,
 }
 
 impl SweepPoint {
-    pub(crate) fn new(op: &OperatingPoint, s: &Solution, slope: Option<f64>) -> Self {
+    pub(crate) fn new(op: &OperatingPoint, s: &Solution) -> Self {
         let running = matches!(s.status, Status::Ok | Status::Stall) && s.amplitude_m > 0.0;
         SweepPoint {
             op: *op,
@@ -1077,7 +1058,6 @@ impl SweepPoint {
             contact_half_angle_rad: s.contact_half_angle_rad,
             running,
             stalled: s.status == Status::Stall,
-            slope,
         }
     }
 }
@@ -1230,11 +1210,14 @@ fn settle(
                     // The sign change has shrunk to a point without the residual vanishing
                     // to the tolerance. Where the residual is still large, G jumps there
                     // (the stator clamps on one side and moves on the other): no steady
-                    // state, only an oscillation between the two. Where it is within 1e-9,
-                    // it is the amplitude solve's own noise near a fold of the amplitude
-                    // map (r(W) has a tiny slope there, so its 1e-13 tolerance leaves W
-                    // uncertain to ~1e-10 and G(x) to a few 1e-12: trum60-qut with a
-                    // 150 Ω sag at 640 N, 0.075 N·m, 194 V, 41.56 kHz): settled.
+                    // state, only an oscillation between the two. Where it is within 1e-9
+                    // the fixed point is pinned by the sign change and G is only resolved
+                    // more coarsely than the tolerance: near a fold of the amplitude map
+                    // r(W) has a tiny slope, so the amplitude solve's 1e-13 tolerance
+                    // leaves W uncertain to ~1e-10 and G(x) to a few 1e-12 (trum60-qut
+                    // with a 150 Ω sag at 640 N, 0.075 N·m, 194 V, 41.56 kHz), and where
+                    // G is steep (|G'| ~ 1e4) the tolerance is below x's own rounding.
+                    // Settled.
                     settled = (x - gx).abs() <= 1e-9 * scale.max(x.abs());
                     break;
                 }
@@ -1519,17 +1502,15 @@ const MULTI_BRANCH_STEP: f64 = 0.8;
 const DEEP_CLAMPED_STEP: f64 = 0.1;
 
 fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
-    solve_drive_below(p, d, op, guess, None).0
+    solve_drive_below(p, d, op, guess, None)
 }
 
 /// A sweep's warm start of the amplitude descent (`solve_in_sweep`): a proven upper bound
-/// of the largest fixed point (the previous point's amplitude), the slope of the residual
-/// r(W) = W − G(W) for the first Newton step (extrapolated along the torque line where
-/// possible), and an amplitude predicted below the bound.
+/// of the largest fixed point (the previous point's amplitude) and an amplitude predicted
+/// below the bound.
 #[derive(Clone, Copy, Debug)]
 struct WarmTop {
     bound: f64,
-    slope: Option<f64>,
     predicted: Option<f64>,
     /// The contact and stick angles extrapolated to this point, for the first trial.
     contact_rad: Option<f64>,
@@ -1541,18 +1522,17 @@ struct WarmTop {
 /// r(W) ≥ 0 holds there numerically (else from the bound as usual); see [`solve_in_sweep`].
 /// The prediction, when given, is tried first (the top where r ≥ 0 there; below the root
 /// it is stepped up, never past the bound, and brackets the root with the first step above).
-/// The slope of r, when positive, makes the first step a Newton step instead of a
-/// fixed-point one: the trial's exact slope where it has one, else `top.slope`. Inside a
-/// bracket the descent also takes Newton steps on exact slopes where they stay inside it
-/// (regula falsi otherwise). Returns the slope of r at the root (from the last secant)
-/// with the solution.
+/// From a warm top the first step is a Newton step on the trial's exact slope of r (every
+/// warm trial has one: the baseline Coulomb interface) instead of a fixed-point one.
+/// Inside a bracket the descent also takes Newton steps on exact slopes where they stay
+/// inside it (regula falsi otherwise).
 fn solve_drive_below(
     p: &Prepared,
     d: &Drive,
     op: &OperatingPoint,
     guess: Option<&Solution>,
     top: Option<WarmTop>,
-) -> (Solution, Option<f64>) {
+) -> Solution {
     // The Coulomb interface's map is smooth to rounding: 1e-13 (1e-12 left 1.7e-9 on the
     // efficiency just below stall, where the speed is a difference of nearly equal torques,
     // against the Python reference; 1e-13 costs 0.2 evaluations a point). The generalised
@@ -1573,12 +1553,11 @@ fn solve_drive_below(
     // (W, θs) of the last two trials. The generalised interface's speed solve costs 2-6
     // numerical integrals per trial; late in the descent the amplitude moves along a
     // secant, and θs extrapolated linearly in W starts it within a hair of its root (7 %
-    // fewer integrals). The Coulomb interface's Newton solves are cheap enough that the
-    // extrapolation cost more than it saved (callgrind, +7 % per point), so it keeps the
-    // previous trial's angles.
-    // The Coulomb interface instead carries each angle from the previous trial along its
-    // exact derivative in W, with its sine and cosine: late in the descent that start is
-    // the root to rounding and the angle solves need no `sin_cos` at all.
+    // fewer integrals). The Coulomb interface instead carries each angle from the previous
+    // trial along its exact derivative in W, with its sine and cosine: late in the descent
+    // that start is the root to rounding and the angle solves need no `sin_cos` at all (a
+    // secant extrapolation of its angles without them had cost more than it saved,
+    // callgrind +7 % a point).
     let general = p.law.radial_ratio != 0.0 || p.compliance != 0.0;
     let mut history: [Option<(f64, f64)>; 2] = [None, None];
     let mut carried: Option<(f64, [Option<AngleCarry>; 2])> = None;
@@ -1606,9 +1585,10 @@ fn solve_drive_below(
     // (where the load does not move G at all, in a stall, always).
     // The predicted amplitude first: a root within the tolerance there is the answer; with
     // r ≥ 0 it is the top of the descent (a further root between it and the bound would
-    // need two sign changes within one extrapolation error); with r < 0 up to three steps
-    // go up (Newton, then secants, below the bound), the first with r ≥ 0 is the top and
-    // the last below it the bracket's lower end; failing that the bound is the top.
+    // need two sign changes within one extrapolation error); with r < 0 up to three
+    // Newton steps go up (secants where a trial has no slope; below the bound), the first
+    // with r ≥ 0 is the top and the last below it the bracket's lower end; failing that
+    // the bound is the top.
     let converged_at = |t: &Trial| (t.w - t.w_next).abs() <= rtol * t.w;
     // r ≥ 0, or no number at all
     let not_below = |t: &Trial| !matches!(t.w.partial_cmp(&t.w_next), Some(std::cmp::Ordering::Less));
@@ -1621,8 +1601,8 @@ fn solve_drive_below(
             if not_below(&t) || converged_at(&t) {
                 return t;
             }
-            // Up to three steps up from below: Newton with the slope, then secants,
-            // inside the bound; the first with r ≥ 0 is the top.
+            // Up to three steps up from below inside the bound; the first with r ≥ 0 is
+            // the top.
             let mut b = t;
             let mut last: Option<Trial> = None;
             for _ in 0..3 {
@@ -1630,7 +1610,7 @@ fn solve_drive_below(
                 let x = match last {
                     _ if b.slope > 0.0 => b.w - rb / b.slope,
                     Some(l) if l.w != b.w => b.w - rb * (b.w - l.w) / (rb - (l.w - l.w_next)),
-                    _ => wt.slope.filter(|&k| k > 0.0).map_or(f64::NAN, |k| b.w - rb / k),
+                    _ => f64::NAN,
                 };
                 if !(x > b.w && x < wt.bound) {
                     break;
@@ -1649,11 +1629,7 @@ fn solve_drive_below(
     });
     if let Some(t) = warm_trial.filter(converged_at) {
         let status = if t.stalled { Status::Stall } else { Status::Ok };
-        // No secant measured a slope here: the one given (extrapolated to this torque) is
-        // the best estimate for the next point. It only sets the length of a Newton step,
-        // never which root is found (returning the previous root's slope instead: 3.30
-        // evaluations a point in the timing example instead of 3.20).
-        return (finish(p, d, op, &t, status, evals), top.and_then(|x| x.slope));
+        return finish(p, d, op, &t, status, evals);
     }
     let warm = warm_trial.filter(|t| t.w >= t.w_next);
     let below = below.filter(|_| warm.is_some());
@@ -1685,11 +1661,11 @@ fn solve_drive_below(
     // middle one of several fixed points and fall onto another branch (found by
     // tests/reliability_known_bugs.rs). The guess still warm-starts the inner stick-angle
     // solves.
-    let start = match (warm, top.and_then(|t| t.slope), below) {
+    let start = match (warm, below) {
         // a trial below the root and the top above it: Newton from the one nearer the
         // root where its exact slope is known and the step stays between them, else
         // their secant
-        (Some(h), _, Some(l)) => {
+        (Some(h), Some(l)) => {
             let (rl, rh) = (l.w - l.w_next, h.w - h.w_next);
             let near = if rh.abs() < rl.abs() { h } else { l };
             let x = match near.w - (near.w - near.w_next) / near.slope {
@@ -1702,22 +1678,12 @@ fn solve_drive_below(
                 0.5 * (l.w + h.w)
             }
         }
-        (Some(h), _, None) if h.slope > 0.0 => {
-            let x = h.w - (h.w - h.w_next) / h.slope;
-            if x > 0.0 && x <= h.w {
-                x
-            } else {
-                h.w_next
-            }
-        }
-        (Some(h), Some(k), None) if k > 0.0 => {
-            let x = h.w - (h.w - h.w_next) / k;
-            if x > 0.0 && x <= h.w {
-                x
-            } else {
-                h.w_next
-            }
-        }
+        // a warm top alone: Newton on its slope where that stays above zero (a warm
+        // top is within a torque step of the root), else the fixed-point step
+        (Some(h), None) => match h.w - (h.w - h.w_next) / h.slope {
+            x if h.slope > 0.0 && x > 0.0 && x <= h.w => x,
+            _ => h.w_next,
+        },
         _ => hi.w_next,
     };
     // Where the modal stiffness depends on W (preload stiffening, Hertz softening), G(W)
@@ -1895,17 +1861,16 @@ fn solve_drive_below(
     }
     if !converged {
         if cur.w < 1e-9 * w_hi0 {
-            return (finish(p, d, op, &clamped_trial(p, d), Status::Clamped, evals), None);
+            return finish(p, d, op, &clamped_trial(p, d), Status::Clamped, evals);
         }
         let mut s = finish(p, d, op, &cur, Status::NoConvergence, evals);
         s.status = Status::NoConvergence;
-        return (s, None);
+        return s;
     }
-    let slope = prev.filter(|pv| pv.w != cur.w).map(|pv| ((cur.w - cur.w_next) - (pv.w - pv.w_next)) / (cur.w - pv.w));
     // Use the trial consistent with the converged amplitude for every output.
     let t = cur;
     let status = if t.stalled { Status::Stall } else { Status::Ok };
-    (finish(p, d, op, &t, status, evals), slope)
+    finish(p, d, op, &t, status, evals)
 }
 
 fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {

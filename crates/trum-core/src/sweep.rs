@@ -131,12 +131,12 @@ where
     let mut last: Option<Solution> = None;
     for i in range {
         let op = grid.point(i);
-        let (s, slope) = crate::solve::solve_in_sweep(prepared, motor, &op, last.as_ref(), &history);
+        let s = crate::solve::solve_in_sweep(prepared, motor, &op, last.as_ref(), &history);
         sink(i, &op, &s);
         if history.len() == SWEEP_HISTORY {
             history.remove(0);
         }
-        history.push(SweepPoint::new(&op, &s, slope));
+        history.push(SweepPoint::new(&op, &s));
         last = Some(s);
     }
 }
