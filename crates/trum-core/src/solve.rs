@@ -374,6 +374,14 @@ pub(crate) struct Trial {
     carry: [Option<AngleCarry>; 2],
 }
 
+impl Trial {
+    /// The Newton step on this trial's exact slope of r(W) = W − G(W), where it has a
+    /// positive one (callers keep it only inside their bracket).
+    fn newton(&self) -> Option<f64> {
+        (self.slope > 0.0).then(|| self.w - (self.w - self.w_next) / self.slope)
+    }
+}
+
 /// Per-point inputs after effects that act on the drive (voltage sag, thermal state).
 #[derive(Clone, Copy, Debug)]
 struct Drive {
@@ -1607,9 +1615,9 @@ fn solve_drive_below(
             let mut last: Option<Trial> = None;
             for _ in 0..3 {
                 let rb = b.w - b.w_next;
-                let x = match last {
-                    _ if b.slope > 0.0 => b.w - rb / b.slope,
-                    Some(l) if l.w != b.w => b.w - rb * (b.w - l.w) / (rb - (l.w - l.w_next)),
+                let x = match (b.newton(), last) {
+                    (Some(x), _) => x,
+                    (None, Some(l)) if l.w != b.w => b.w - rb * (b.w - l.w) / (rb - (l.w - l.w_next)),
                     _ => f64::NAN,
                 };
                 if !(x > b.w && x < wt.bound) {
@@ -1668,10 +1676,7 @@ fn solve_drive_below(
         (Some(h), Some(l)) => {
             let (rl, rh) = (l.w - l.w_next, h.w - h.w_next);
             let near = if rh.abs() < rl.abs() { h } else { l };
-            let x = match near.w - (near.w - near.w_next) / near.slope {
-                x if near.slope > 0.0 && x > l.w && x < h.w => x,
-                _ => l.w - rl * (h.w - l.w) / (rh - rl),
-            };
+            let x = near.newton().filter(|&x| x > l.w && x < h.w).unwrap_or(l.w - rl * (h.w - l.w) / (rh - rl));
             if x > l.w && x < h.w {
                 x
             } else {
@@ -1680,10 +1685,7 @@ fn solve_drive_below(
         }
         // a warm top alone: Newton on its slope where that stays above zero (a warm
         // top is within a torque step of the root), else the fixed-point step
-        (Some(h), None) => match h.w - (h.w - h.w_next) / h.slope {
-            x if h.slope > 0.0 && x > 0.0 && x <= h.w => x,
-            _ => h.w_next,
-        },
+        (Some(h), None) => h.newton().filter(|&x| x > 0.0 && x <= h.w).unwrap_or(h.w_next),
         _ => hi.w_next,
     };
     // Where the modal stiffness depends on W (preload stiffening, Hertz softening), G(W)
@@ -1787,9 +1789,9 @@ fn solve_drive_below(
         let next = match lo {
             // Newton with the trial's exact slope where its step stays inside [lo, hi],
             // else regula falsi (Illinois) there.
-            Some(l) => match cur.w - r / cur.slope {
-                x if cur.slope > 0.0 && x > l.w && x < hi.w => x,
-                _ => bracket.regula_falsi().unwrap_or(0.5 * (l.w + hi.w)),
+            Some(l) => match cur.newton().filter(|&x| x > l.w && x < hi.w) {
+                Some(x) => x,
+                None => bracket.regula_falsi().unwrap_or(0.5 * (l.w + hi.w)),
             },
             None => {
                 // Secant from the previous iterate if it moves down; else a fixed-point step,
