@@ -125,8 +125,12 @@ pub struct Diagnosis {
     pub confounded_with: Vec<String>,
     /// Held-out NRMSE of the calibrated baseline.
     pub baseline_heldout_nrmse: f64,
-    /// NRMSE the measurement noise alone would give.
+    /// Held-out NRMSE the measurement noise alone would give, with the best noise levels
+    /// (`noise_nrmse_best`): what a model without error would score.
     pub noise_nrmse: f64,
+    /// The same with the noise levels the fits weigh readings by (upper bounds: the
+    /// verdict's tests beyond the noise use these).
+    pub noise_nrmse_weights: f64,
     /// Held-out mean squared normalised residual of the baseline (1 = at noise level).
     pub baseline_heldout_chi2_per_reading: f64,
     /// Noise levels estimated from the data (crate::noise): quantity, factor applied to
@@ -191,6 +195,98 @@ fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
             (o, sd.max(noise).max(1e-12))
         })
         .collect()
+}
+
+/// Noise factors per quantity (`noise::estimate`), each the smaller of two estimates:
+/// from the readings themselves, and from their residuals from the nominal motor's
+/// predictions. Both are biased upwards only by what the lines through neighbouring
+/// readings cannot follow; the model follows most of the curvature (stall knee, efficiency
+/// peak, resonance) that dominates that bias on coarse grids, the raw readings follow what
+/// the nominal model gets wrong in shape (a temperature time series).
+fn noise_estimate(
+    motor: &Motor,
+    rows: &[ObservedRow],
+    groups: &[String],
+) -> BTreeMap<Observable, crate::noise::NoiseScale> {
+    let raw = crate::noise::estimate(rows, groups);
+    let refs: Vec<&ObservedRow> = rows.iter().collect();
+    let detrended: Vec<ObservedRow> = rows
+        .iter()
+        .zip(predict(motor, &refs))
+        .map(|(r, p)| {
+            let mut r = r.clone();
+            for (x, y) in r.readings.iter_mut().zip(p) {
+                x.1 -= y;
+            }
+            r
+        })
+        .collect();
+    let model = crate::noise::estimate(&detrended, groups);
+    raw.into_iter()
+        .map(|(o, n)| match model.get(&o) {
+            Some(m) if m.factor < n.factor => (o, *m),
+            _ => (o, n),
+        })
+        .collect()
+}
+
+/// Mean squared residual, over σ², of a reading max(0, m + σZ) (Z standard normal, x = m/σ)
+/// that the bench clips at zero (a speed standard deviation): about its mean when the
+/// reading is compared with the expected clipped reading (`centred`), else about m.
+fn clipped_second_moment(x: f64, centred: bool) -> f64 {
+    let cdf = 0.5 * libm::erfc(-x / std::f64::consts::SQRT_2);
+    let pdf = (-0.5 * x * x).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    // E[(Y/σ − x)²] = Φ(x) − xφ(x) + x²(1 − Φ(x)); the mean of Y/σ − x is φ(x) − x(1 − Φ(x))
+    let about_m = cdf - x * pdf + x * x * (1.0 - cdf);
+    let bias = pdf - x * (1.0 - cdf);
+    if centred {
+        (about_m - bias * bias).max(0.0)
+    } else {
+        about_m
+    }
+}
+
+/// The held-out NRMSE that noise alone gives, with the best noise levels (`noise_estimate`):
+/// each reading's σ rescaled from the weights' factor `est` to `best`. A speed std is
+/// clipped at zero, its noise taken about the model's reading `pred` (`predict`). A quantity without an
+/// estimate of its own (fewer than `noise::MIN_TRIPLES` line residuals: the speed std of
+/// one stability run) takes the speed's factor if it is the speed std (the same sensor),
+/// and counts with the smaller of that noise and the baseline's own mean squared residual
+/// for it, both upper bounds of its noise (the default levels are 2.5× the synthetic
+/// bench's for the speed std, whose eight readings then outweighed the rest of the noise).
+fn noise_nrmse_best(
+    rows: &[ObservedRow],
+    est: &BTreeMap<Observable, crate::noise::NoiseScale>,
+    best: &BTreeMap<Observable, crate::noise::NoiseScale>,
+    pred: &[Vec<f64>],
+    sc: &BTreeMap<Observable, f64>,
+) -> f64 {
+    let factor = |m: &BTreeMap<Observable, crate::noise::NoiseScale>, o: Observable| {
+        let o = if o == Observable::SpeedStdRpm && !m.contains_key(&o) { Observable::SpeedRpm } else { o };
+        m.get(&o).map_or(1.0, |n| n.factor.clamp(0.25, 4.0))
+    };
+    // per quantity: Σ noise²/sc², Σ residual²/sc²
+    let mut acc: BTreeMap<Observable, (f64, f64)> = BTreeMap::new();
+    let mut n = 0usize;
+    for (r, p) in rows.iter().zip(pred) {
+        for (&(o, y, s), &m) in r.readings.iter().zip(p) {
+            let own = est.get(&o).map_or(1.0, |n| n.factor.clamp(0.25, 4.0));
+            let sigma = s / own * factor(best, o);
+            let var = if o == Observable::SpeedStdRpm && sigma > 0.0 {
+                let x = if m.is_finite() { m / sigma } else { 0.0 };
+                sigma * sigma * clipped_second_moment(x, r.speed_std_clipped)
+            } else {
+                sigma * sigma
+            };
+            let e = acc.entry(o).or_default();
+            e.0 += var / sc[&o].powi(2);
+            e.1 += if m.is_finite() { (m - y).powi(2) / sc[&o].powi(2) } else { f64::INFINITY };
+            n += 1;
+        }
+    }
+    let total: f64 =
+        acc.iter().map(|(o, &(noise, res))| if best.contains_key(o) { noise } else { noise.min(res) }).sum();
+    (total / n.max(1) as f64).sqrt()
 }
 
 /// The rows with each reading's σ scaled by the noise factor estimated for its quantity
@@ -579,6 +675,7 @@ pub fn diagnose(
     // actual noise; clamped to [1/4, 4] × the stated levels.
     let est = crate::noise::estimate(rows, groups);
     let scaled = noise_scaled(rows, &est);
+    let unscaled_rows = rows;
     let rows = &scaled[..];
     let noise_scale: Vec<(String, f64, usize)> =
         est.iter().map(|(o, n)| (o.column().to_string(), n.factor.clamp(0.25, 4.0), n.triples)).collect();
@@ -626,7 +723,7 @@ pub fn diagnose(
     // (cheap at this size).
     let opts = &DiagnoseOptions { exact_cv: opts.exact_cv || reduced, ..opts.clone() };
     let sc = scales(rows);
-    // noise level as NRMSE
+    // noise level as NRMSE, with the weights' noise levels
     let noise_nrmse = {
         let mut acc = 0.0;
         for r in rows {
@@ -660,6 +757,15 @@ pub fn diagnose(
         approx_cv(&base_cal, rows, &folds, k, &opts.fit)
     };
     let (base_nrmse, base_z2, base_e2, _) = errors(rows, &base_cv.preds, &sc);
+    // The noise NRMSE reported (the spec's `noise_nrmse`) is the best estimate of what noise
+    // alone gives; the tests beyond the noise below keep the weights' levels, upper bounds
+    // consistent with the χ² the fits minimise (with the best levels in those tests the
+    // blind benchmark lost 3 of its 45 correct verdicts: docs/DIAGNOSIS.md).
+    let noise_best = {
+        let refs: Vec<&ObservedRow> = rows.iter().collect();
+        let best = noise_estimate(motor, unscaled_rows, groups);
+        noise_nrmse_best(rows, &est, &best, &predict(&base_cal.motor, &refs), &sc)
+    };
     let bic = |chi2: f64, kpar: usize| chi2 + kpar as f64 * (n_read as f64).ln();
     let base_bic = bic(base_cal.chi2, bparams.len());
 
@@ -1151,7 +1257,8 @@ pub fn diagnose(
         verdict,
         confounded_with: confounded,
         baseline_heldout_nrmse: base_nrmse,
-        noise_nrmse,
+        noise_nrmse: noise_best,
+        noise_nrmse_weights: noise_nrmse,
         baseline_heldout_chi2_per_reading: base_z2,
         noise_scale,
         gap_where,
@@ -1360,6 +1467,67 @@ mod tests {
         let stuck = approx_cv(&short, &rows, &folds, 4, &fit);
         assert_eq!(stuck.in_sample, 4);
         assert!(gap(&stuck.preds, &in_sample) < 1e-9, "{}", gap(&stuck.preds, &in_sample));
+    }
+
+    /// The residual moments of a reading clipped at zero, against direct integration over
+    /// the normal density.
+    #[test]
+    fn clipped_noise_moments_are_those_of_the_clipped_normal() {
+        let phi = |z: f64| (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt();
+        for x in [-3.0f64, -1.0, -0.2, 0.0, 0.7, 2.0, 6.0] {
+            // Y = max(0, x + Z): zero below z = −x
+            let zero = (-x).max(-12.0);
+            let below = crate::quad::integral(phi, -12.0, zero);
+            let m1 = crate::quad::integral(|z| (x + z) * phi(z), zero, 12.0);
+            let m2 = crate::quad::integral(|z| (x + z) * (x + z) * phi(z), zero, 12.0);
+            let about_m = m2 - 2.0 * x * m1 + x * x * (below + crate::quad::integral(phi, zero, 12.0));
+            let var = m2 - m1 * m1;
+            assert!(
+                (clipped_second_moment(x, false) - about_m).abs() < 1e-9,
+                "x {x}: {} vs {about_m}",
+                clipped_second_moment(x, false)
+            );
+            assert!(
+                (clipped_second_moment(x, true) - var).abs() < 1e-9,
+                "x {x}: {} vs {var}",
+                clipped_second_moment(x, true)
+            );
+        }
+        assert!((clipped_second_moment(0.0, true) - (0.5 - 0.5 / std::f64::consts::PI)).abs() < 1e-15);
+    }
+
+    /// On data without any effect a model without error scores the noise alone: the
+    /// reported noise NRMSE is the baseline's held-out NRMSE within their scatter (over six
+    /// seeds 0.91-1.13 in the preload-torque campaign and 0.98-1.20 in the combined one;
+    /// the weights' upper-bound levels, reported until stop 31, gave 1.5-1.8 and 3.3-4.1),
+    /// and never above the weights' level.
+    #[test]
+    fn the_noise_nrmse_is_what_a_model_without_error_scores() {
+        let m = preset("trum60a").expect("preset");
+        let opts = DiagnoseOptions {
+            candidates: vec![Effect::VoltageSag],
+            try_pairs: false,
+            bootstrap: 20,
+            ..DiagnoseOptions::default()
+        };
+        for campaign in [Campaign::PreloadTorque, Campaign::Combined] {
+            for seed in [1, 2, 3] {
+                let cfg = SynthConfig { campaign, noise: 1.0, seed, ..SynthConfig::default() };
+                let synth = synthesize(&m, &cfg).expect("synth");
+                let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
+                let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+                let d = diagnose(&m, &rows, &groups, &opts).expect("diagnosis");
+                let ratio = d.noise_nrmse / d.baseline_heldout_nrmse;
+                assert!(
+                    (0.8..1.3).contains(&ratio),
+                    "{campaign:?} seed {seed}: noise {} vs baseline {}",
+                    d.noise_nrmse,
+                    d.baseline_heldout_nrmse
+                );
+                assert!(d.noise_nrmse <= d.noise_nrmse_weights, "{} > {}", d.noise_nrmse, d.noise_nrmse_weights);
+                assert_eq!(d.verdict, "none");
+            }
+        }
     }
 
     #[test]

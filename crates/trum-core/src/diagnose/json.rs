@@ -46,6 +46,7 @@ pub fn to_json(d: &Diagnosis, src: &Provenance<'_>) -> Value {
         "gap": {
             "baseline_heldout_nrmse": num(d.baseline_heldout_nrmse),
             "noise_nrmse": num(d.noise_nrmse),
+            "noise_nrmse_weights": num(d.noise_nrmse_weights),
             "baseline_heldout_chi2_per_reading": num(d.baseline_heldout_chi2_per_reading),
             "noise_scale": d.noise_scale.iter().map(|(q, f, n)| json!({"quantity": q, "factor": num(*f), "residuals": n})).collect::<Vec<_>>(),
             "where": d.gap_where.iter().map(|g| json!({
