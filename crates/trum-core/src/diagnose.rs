@@ -198,7 +198,7 @@ fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
 }
 
 /// Noise factors per quantity (`noise::estimate`), each the smaller of two estimates:
-/// from the readings themselves, and from their residuals from the nominal motor's
+/// from the readings themselves (`raw`, as estimated), and from their residuals from the nominal motor's
 /// predictions. Both are biased upwards only by what the lines through neighbouring
 /// readings cannot follow; the model follows most of the curvature (stall knee, efficiency
 /// peak, resonance) that dominates that bias on coarse grids, the raw readings follow what
@@ -207,8 +207,8 @@ fn noise_estimate(
     motor: &Motor,
     rows: &[ObservedRow],
     groups: &[String],
+    raw: &BTreeMap<Observable, crate::noise::NoiseScale>,
 ) -> BTreeMap<Observable, crate::noise::NoiseScale> {
-    let raw = crate::noise::estimate(rows, groups);
     let refs: Vec<&ObservedRow> = rows.iter().collect();
     let detrended: Vec<ObservedRow> = rows
         .iter()
@@ -222,9 +222,9 @@ fn noise_estimate(
         })
         .collect();
     let model = crate::noise::estimate(&detrended, groups);
-    raw.into_iter()
-        .map(|(o, n)| match model.get(&o) {
-            Some(m) if m.factor < n.factor => (o, *m),
+    raw.iter()
+        .map(|(&o, &n)| match model.get(&o) {
+            Some(&m) if m.factor < n.factor => (o, m),
             _ => (o, n),
         })
         .collect()
@@ -261,17 +261,16 @@ fn noise_nrmse_best(
     pred: &[Vec<f64>],
     sc: &BTreeMap<Observable, f64>,
 ) -> f64 {
-    let factor = |m: &BTreeMap<Observable, crate::noise::NoiseScale>, o: Observable| {
-        let o = if o == Observable::SpeedStdRpm && !m.contains_key(&o) { Observable::SpeedRpm } else { o };
-        m.get(&o).map_or(1.0, |n| n.factor.clamp(0.25, 4.0))
+    let best_factor = |o: Observable| {
+        let same_sensor = o == Observable::SpeedStdRpm && !best.contains_key(&o);
+        applied_factor(best, if same_sensor { Observable::SpeedRpm } else { o })
     };
     // per quantity: Σ noise²/sc², Σ residual²/sc²
     let mut acc: BTreeMap<Observable, (f64, f64)> = BTreeMap::new();
     let mut n = 0usize;
     for (r, p) in rows.iter().zip(pred) {
         for (&(o, y, s), &m) in r.readings.iter().zip(p) {
-            let own = est.get(&o).map_or(1.0, |n| n.factor.clamp(0.25, 4.0));
-            let sigma = s / own * factor(best, o);
+            let sigma = s / applied_factor(est, o) * best_factor(o);
             let var = if o == Observable::SpeedStdRpm && sigma > 0.0 {
                 let x = if m.is_finite() { m / sigma } else { 0.0 };
                 sigma * sigma * clipped_second_moment(x, r.speed_std_clipped)
@@ -289,6 +288,12 @@ fn noise_nrmse_best(
     (total / n.max(1) as f64).sqrt()
 }
 
+/// The factor applied to the stated noise levels of quantity `o`: its estimate clamped to
+/// [1/4, 4], or 1 without one.
+fn applied_factor(est: &BTreeMap<Observable, crate::noise::NoiseScale>, o: Observable) -> f64 {
+    est.get(&o).map_or(1.0, |n| n.factor.clamp(0.25, 4.0))
+}
+
 /// The rows with each reading's σ scaled by the noise factor estimated for its quantity
 /// (clamped to [1/4, 4]), marked clipped where `speed_std_clipped` says so.
 fn noise_scaled(rows: &[ObservedRow], est: &BTreeMap<Observable, crate::noise::NoiseScale>) -> Vec<ObservedRow> {
@@ -297,9 +302,7 @@ fn noise_scaled(rows: &[ObservedRow], est: &BTreeMap<Observable, crate::noise::N
         .map(|r| {
             let mut r = r.clone();
             for x in r.readings.iter_mut() {
-                if let Some(n) = est.get(&x.0) {
-                    x.2 *= n.factor.clamp(0.25, 4.0);
-                }
+                x.2 *= applied_factor(est, x.0);
             }
             r
         })
@@ -678,7 +681,7 @@ pub fn diagnose(
     let unscaled_rows = rows;
     let rows = &scaled[..];
     let noise_scale: Vec<(String, f64, usize)> =
-        est.iter().map(|(o, n)| (o.column().to_string(), n.factor.clamp(0.25, 4.0), n.triples)).collect();
+        est.iter().map(|(&o, n)| (o.column().to_string(), applied_factor(&est, o), n.triples)).collect();
     if rows.len() < 4 {
         return Err(TrumError::input(format!(
             "{} rows are too few to diagnose anything; need at least 4 operating points",
@@ -763,7 +766,7 @@ pub fn diagnose(
     // blind benchmark lost 3 of its 45 correct verdicts: docs/DIAGNOSIS.md).
     let noise_best = {
         let refs: Vec<&ObservedRow> = rows.iter().collect();
-        let best = noise_estimate(motor, unscaled_rows, groups);
+        let best = noise_estimate(motor, unscaled_rows, groups, &est);
         noise_nrmse_best(rows, &est, &best, &predict(&base_cal.motor, &refs), &sc)
     };
     let bic = |chi2: f64, kpar: usize| chi2 + kpar as f64 * (n_read as f64).ln();
