@@ -9,7 +9,9 @@ use clap::Args;
 use serde_json::json;
 use std::io::Write;
 use std::path::PathBuf;
-use trum_core::calibrate::{baseline_params, calibrate, residuals, Calibration, FitOptions, ObservedRow};
+use trum_core::calibrate::{
+    baseline_params, calibrate_refitting_bounds, residuals, Calibration, FitOptions, ObservedRow,
+};
 
 #[derive(Args, Debug)]
 pub struct CalibrateArgs {
@@ -34,8 +36,8 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     let (motor, _) = a.motor.load()?;
     let (_, bench) = read_data(&a.data, &motor, err)?;
     let params = baseline_params(&motor, &bench.rows);
-    let mut cal =
-        calibrate(&motor, &bench.rows, &params, &FitOptions::default()).map_err(|e| anyhow!("{}: {e}", a.data))?;
+    let mut cal = calibrate_refitting_bounds(&motor, &bench.rows, &params, &FitOptions::default())
+        .map_err(|e| anyhow!("{}: {e}", a.data))?;
     rescale_uncertainties(&mut cal, &bench.rows);
     let chi2_per = cal.chi2 / cal.n_readings.max(1) as f64;
     if let Some(path) = &a.json {

@@ -25,8 +25,9 @@ pub mod json;
 mod signature;
 
 use crate::calibrate::{
-    baseline_params, calibrate, calibrate_adding, calibrate_nested, calibrate_weighted, effect_params, residuals,
-    Calibration, FitOptions, FitParam, FittedParam, Observable, ObservedRow, ParamRef, Start, IRLS_START_RTOL,
+    baseline_params, calibrate, calibrate_adding, calibrate_nested, calibrate_refitting_bounds, calibrate_weighted,
+    effect_params, residuals, Calibration, FitOptions, FitParam, FittedParam, Observable, ObservedRow, ParamRef, Start,
+    IRLS_START_RTOL,
 };
 use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
@@ -248,7 +249,8 @@ fn clipped_second_moment(x: f64, centred: bool) -> f64 {
 
 /// The held-out NRMSE that noise alone gives, with the best noise levels (`noise_estimate`):
 /// each reading's σ rescaled from the weights' factor `est` to `best`. A speed std is
-/// clipped at zero, its noise taken about the model's reading `pred` (`predict`). A quantity without an
+/// clipped at zero, its noise taken about the model's value `pred` (or about the expected
+/// clipped reading where it is compared with that). A quantity without an
 /// estimate of its own (fewer than `noise::MIN_TRIPLES` line residuals: the speed std of
 /// one stability run) takes the speed's factor if it is the speed std (the same sensor),
 /// and counts with the smaller of that noise and the baseline's own mean squared residual
@@ -738,21 +740,11 @@ pub fn diagnose(
     };
     // full-data baseline fit (the start of every other fit; "where", BIC, reported parameters)
     let (start0, bparams) = fit_params(motor, motor, rows, &[], reduced);
-    let base_cal = calibrate(&start0, rows, &bparams, &opts.fit)?;
-    // A baseline that ends with a parameter on a bound can be held there by the logistic
-    // transform, whose slope all but vanishes at the bound: refitted from its own end (a
-    // start on a bound is placed 1e-3 inside it, `calibrate::fit`), it can move on. The
-    // better of the two is the baseline. (1000-row benchmark, seeds 31-38: the damping on
-    // its upper bound at χ² 0.72 million; every single fit, started there, first refitted
-    // the baseline to 0.27 million whatever its effect.)
-    let base_cal = if base_cal.params.iter().any(|p| p.at_bound) {
-        match calibrate(&base_cal.motor, rows, &bparams, &opts.fit) {
-            Ok(c) if c.chi2 < base_cal.chi2 => c,
-            _ => base_cal,
-        }
-    } else {
-        base_cal
-    };
+    // A baseline that ends with a parameter on a bound is refitted from its own end
+    // (`calibrate_refitting_bounds`). (1000-row benchmark, seeds 31-38: every single fit,
+    // started from the baseline left on the damping bound, first refitted the baseline
+    // whatever its effect.)
+    let base_cal = calibrate_refitting_bounds(&start0, rows, &bparams, &opts.fit)?;
     let start = base_cal.motor.clone();
     let base_cv = if opts.exact_cv {
         cross_validate(motor, &start, rows, &folds, k, &[], opts, reduced)
@@ -765,7 +757,10 @@ pub fn diagnose(
     // consistent with the χ² the fits minimise (with the best levels in those tests the
     // blind benchmark lost 3 of its 45 correct verdicts: docs/DIAGNOSIS.md).
     let noise_best = {
-        let refs: Vec<&ObservedRow> = rows.iter().collect();
+        // the model's own values, not expected clipped readings
+        let plain: Vec<ObservedRow> =
+            rows.iter().map(|r| ObservedRow { speed_std_clipped: false, ..r.clone() }).collect();
+        let refs: Vec<&ObservedRow> = plain.iter().collect();
         let best = noise_estimate(motor, unscaled_rows, groups, &est);
         noise_nrmse_best(rows, &est, &best, &predict(&base_cal.motor, &refs), &sc)
     };
@@ -1673,8 +1668,8 @@ mod tests {
     /// onto its upper bound, where the logistic transform holds it (a radial-friction fit
     /// started there stayed in that valley: held-out χ² 108 per reading, until stop 28's
     /// second start from the nominal motor). Refitted from its own end, the baseline leaves
-    /// the bound at a fraction of the χ²; the diagnosis does that, and finds radial friction
-    /// at its truth.
+    /// the bound at a fraction of the χ²; `calibrate_refitting_bounds` and so the diagnosis
+    /// do that, and the diagnosis finds radial friction at its truth.
     #[test]
     fn a_baseline_left_on_a_bound_is_refitted_from_its_end() {
         let nominal = preset("trum60a").expect("preset");
@@ -1698,6 +1693,10 @@ mod tests {
         assert!(!on_damping_bound(&again));
         // (χ² 1.74e5 → 6.3e4 when written)
         assert!(again.chi2 < 0.5 * first.chi2, "χ² {} → {}", first.chi2, again.chi2);
+        // what `trum calibrate` and the diagnosis call does both
+        let refitted = calibrate_refitting_bounds(&s0, &scaled, &bp, &opts.fit).expect("refitting");
+        assert_eq!(refitted.chi2, again.chi2);
+        assert_eq!(refitted.motor, again.motor);
         let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnose");
         let damping = d.baseline_params.iter().find(|p| p.0.ends_with("modal_damping_ns_per_m")).expect("damping").1;
         assert!(damping < 49.0, "the diagnosis's baseline damping {damping}");
