@@ -57,9 +57,9 @@ pub struct Factors {
 
 impl Factors {
     /// The factors at u + `du` to first order (the integrand's derivatives at fixed nodes,
-    /// which agree with the quadrature's own to 1e-9 relative at moderate ρ and 1e-3 at
-    /// ρ = 0.05): for a step |du| ≤ 1e-8, the error of the carry is below 1e-11 of the
-    /// factors at worst and the step's own δ² term below 1e-16.
+    /// which agree with central differences of the rule to 1e-9 relative, test below): for
+    /// a step |du| ≤ 1e-8, the error of the carry is below 1e-11 of the factors at worst and
+    /// the step's own δ² term below 1e-16.
     pub fn carried(&self, du: f64) -> Factors {
         Factors {
             torque: self.torque + self.torque_du * du,
@@ -158,18 +158,22 @@ fn sin_cos_small(y: f64) -> (f64, f64) {
     (y + y * z * s, 1.0 - 0.5 * z + z * z * c)
 }
 
-/// Quadrature nodes of one `factors` call: sin θ, cos θ and weight. Two panels (split at
-/// the stick point) of two sub-panels of [`NODES`] Gauss–Legendre nodes each.
-struct Nodes {
-    sin: [f64; 4 * NODES],
-    cos: [f64; 4 * NODES],
-    weight: [f64; 4 * NODES],
+/// Quadrature nodes of one `factors` call: sin θ, cos θ and weight, for up to N/(2·NODES)
+/// panels of two sub-panels of [`NODES`] Gauss–Legendre nodes each. The plain rule has two
+/// panels (split at the stick point), the graded rule up to [`MAX_PANELS`].
+struct Nodes<const N: usize> {
+    sin: [f64; N],
+    cos: [f64; N],
+    weight: [f64; N],
     len: usize,
 }
 
-impl Nodes {
+/// Nodes of the plain rule: two panels.
+const PLAIN_NODES: usize = 4 * NODES;
+
+impl<const N: usize> Nodes<N> {
     fn new() -> Self {
-        Nodes { sin: [0.0; 4 * NODES], cos: [0.0; 4 * NODES], weight: [0.0; 4 * NODES], len: 0 }
+        Nodes { sin: [0.0; N], cos: [0.0; N], weight: [0.0; N], len: 0 }
     }
 
     /// Adds each [a, b] of `panels` (width at most π, at most two of them) as two equal
@@ -184,7 +188,7 @@ impl Nodes {
         // then r). The compiler evaluates them two lanes at a time in vector registers, each
         // lane with the operations of a scalar call, so the nodes are the same to the bit;
         // the Horner chains of both panels overlap instead of running one after the other.
-        debug_assert!(panels.len() <= 2);
+        debug_assert!(panels.len() <= 2 && self.len + 2 * NODES * panels.len() <= N);
         let mut y = [0.0; 16];
         for (p, &(a, b, _)) in panels.iter().enumerate() {
             let r = 0.25 * (b - a);
@@ -266,7 +270,7 @@ fn accumulate(f: &mut Factors, s: f64, co: f64, w: f64, c: f64, u: f64, rho: f64
 /// rounding at its edge) gets weight 0; D = 0 cannot occur at an interior node with ρ > 0,
 /// and with ρ = 0 only where u = cos θ at a node, which the split at θs rules out; the
 /// floor on D² keeps even that case at zero terms instead of NaN.
-fn coulomb_sums(nodes: &Nodes, c: f64, u: f64, rho: f64, weight: f64) -> Factors {
+fn coulomb_sums<const N: usize>(nodes: &Nodes<N>, c: f64, u: f64, rho: f64, weight: f64) -> Factors {
     const L: usize = 4;
     let (mut t, mut slip, mut t_u, mut rad, mut rad_u) = ([0.0; L], [0.0; L], [0.0; L], [0.0; L], [0.0; L]);
     // (panels add NODES = 12 nodes at a time)
@@ -308,7 +312,7 @@ fn coulomb_sums(nodes: &Nodes, c: f64, u: f64, rho: f64, weight: f64) -> Factors
 /// branch) and ∂g_t/∂u = −(1 − g_t²)/σ, with power = ∫q·g_t·cos θ: one exp and one
 /// division a node (the general route, [`accumulate`], takes D = |dt|, g = S(D/σ)/D and
 /// dg/dD: a square root and two more divisions). The two agree to rounding (test below).
-fn compliance_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64, weight: f64) -> Factors {
+fn compliance_sums<const N: usize>(nodes: &Nodes<N>, c: f64, u: f64, slip_scale: f64, weight: f64) -> Factors {
     let inv_s = 1.0 / slip_scale;
     let (mut t, mut t_u, mut p, mut p_u) = (0.0, 0.0, 0.0, 0.0);
     for k in 0..nodes.len {
@@ -334,13 +338,16 @@ fn compliance_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64, weight: f64) 
 
 /// Interface factors for contact `ct`, rotor speed ratio u = v_r/v0 ∈ [0, 1] and `law`.
 /// The integration splits at the stick point θs = acos u where the tangential slip
-/// changes sign.
+/// changes sign, and where the law turns from driving to braking within a narrow band
+/// around θs (small ρ or σ), it grades the panels towards θs ([`graded_ends`]).
 pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
     let phi0 = ct.half_angle_rad;
-    let c = ct.offset;
     let uc = u.clamp(-1.0, 1.0);
     let ts = uc.acos();
-    let mut nodes = Nodes::new();
+    if let Some((ends, n)) = graded_ends(ts, phi0, feature_width(law, uc)) {
+        return graded_factors(&ends[..n], ct.offset, u, law);
+    }
+    let mut nodes = Nodes::<PLAIN_NODES>::new();
     if ts > 0.0 && ts < phi0 {
         // the centre of [0, θs] by the half-angle formulas of cos θs = u (no sin_cos call)
         nodes.panels(&[
@@ -350,10 +357,33 @@ pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
     } else {
         nodes.panels(&[(0.0, phi0, (0.5 * phi0).sin_cos())]);
     }
+    node_sums(&nodes, ct.offset, u, law)
+}
+
+/// [`factors`] on the graded panels between `ends`. Kept out of `factors`, so that its
+/// node arrays (11.5 kB) are not in every plain call's frame.
+#[inline(never)]
+fn graded_factors(ends: &[f64], c: f64, u: f64, law: &Law) -> Factors {
+    let mut nodes = Nodes::<{ 2 * NODES * MAX_PANELS }>::new();
+    let mut panels = [(0.0, 0.0, (0.0, 0.0)); MAX_PANELS];
+    for (p, e) in panels.iter_mut().zip(ends.windows(2)) {
+        *p = (e[0], e[1], (0.5 * (e[0] + e[1])).sin_cos());
+    }
+    for pair in panels[..ends.len() - 1].chunks(2) {
+        nodes.panels(pair);
+    }
+    node_sums(&nodes, c, u, law)
+}
+
+/// The factors as sums over `nodes`, each of the law's radii by the cheapest route.
+/// Inlined: as a call of its own, the plain rule's node sums lost their two-lane vector
+/// form (`coulomb_sums`) and a `radial_friction` map took 20 % longer.
+#[inline(always)]
+fn node_sums<const N: usize>(nodes: &Nodes<N>, c: f64, u: f64, law: &Law) -> Factors {
     let mut f = Factors::default();
     for (rho, weight) in radii(law) {
         let part = if law.slip_scale > 0.0 && rho == 0.0 && !law.truth {
-            compliance_sums(&nodes, c, u, law.slip_scale, weight)
+            compliance_sums(nodes, c, u, law.slip_scale, weight)
         } else if law.slip_scale > 0.0 {
             let mut g = Factors::default();
             for k in 0..nodes.len {
@@ -361,7 +391,7 @@ pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
             }
             g
         } else {
-            coulomb_sums(&nodes, c, u, rho, weight)
+            coulomb_sums(nodes, c, u, rho, weight)
         };
         f.torque += part.torque;
         f.power += part.power;
@@ -371,6 +401,88 @@ pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
         f.radial_du += part.radial_du;
     }
     f
+}
+
+/// Most panels of the graded rule: eight graded ends a side of θs at the narrowest width
+/// ([`MIN_FEATURE_WIDTH`]), θs itself and the contact's two ends make 19 ends.
+const MAX_PANELS: usize = 20;
+/// The first graded end sits GRADE_FIRST feature widths from θs, each further one
+/// GRADE_RATIO times as far. A panel [d, 6d] is then split into sub-panels whose nearer one
+/// sees the singularity (at distance w off the real axis, w ≤ d/3) from its end; the
+/// Gauss–Legendre error on it is of order E⁻²⁴ with E ≈ 3.4 the Bernstein ellipse through
+/// the singularity: 2e-13. The panel [θs, θs + 3w] next to it: E ≈ 3.5, 1e-13.
+const GRADE_FIRST: f64 = 3.0;
+const GRADE_RATIO: f64 = 6.0;
+/// Narrower features are graded as this wide (at most MAX_PANELS panels). Below it the
+/// turn is a step at θs on the scale of the panel next to it, which the split at θs
+/// integrates like the Coulomb law's sign change.
+const MIN_FEATURE_WIDTH: f64 = 1e-6;
+
+/// Half-width [rad] of the band around the stick point θs over which the traction turns
+/// from driving to braking: the distance from the real θ axis of the integrand's nearest
+/// complex singularity, which sets how fast Gauss–Legendre converges on a panel next to θs.
+/// With θ = θs + x near θs, cos θ − u ≈ −x·sin θs and the radial slip ≈ ρ·sin θs, so the
+/// slip D = 0 at x = ±iρ (radial slip, Coulomb); the saturation S(D/σ)/D is analytic at D = 0
+/// but has its singularities at D = ±iπσ/2 (tanh) or ±iσ (algebraic truth form), at
+/// x ≈ ±i·√((kσ)² + (ρ sin θs)²)/sin θs. Infinite for the Coulomb law, whose sign change the
+/// split at θs integrates exactly. The truth form's smallest radius counts. `uc` is
+/// cos θs (sin θs = √(1 − uc²), without a transcendental call).
+fn feature_width(law: &Law, uc: f64) -> f64 {
+    let rho = radii(law).map(|(r, _)| r).fold(f64::INFINITY, f64::min);
+    if law.slip_scale > 0.0 {
+        let k = if law.truth { 1.0 } else { std::f64::consts::FRAC_PI_2 };
+        let s = ((1.0 - uc) * (1.0 + uc)).sqrt();
+        ((k * law.slip_scale).powi(2) + (rho * s).powi(2)).sqrt() / s
+    } else if rho > 0.0 {
+        rho
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Panel ends of the graded rule on [0, φ0]: 0, the ends θs ∓ 3w·6^k that fall inside the
+/// contact, θs when inside, and φ0 (ascending; the count is the second value). `None` when
+/// no graded end falls inside: the plain rule's two panels are then no wider than 3w each
+/// side of θs, and as accurate. The ends move continuously with θs, w and φ0, and a panel
+/// appears or leaves with zero width, so the factors stay continuous in u. (The plain rule
+/// alone, its panels much wider than w, had relative errors up to 3.5e-4 and a ∂torque/∂u
+/// 20-30 % off at ρ = 0.0035 or σ = 0.003; 89 of 18 697 points of a trum60a map at
+/// ρ = 0.0035 ended without convergence, the same amplitude trial returning two rotor
+/// speeds depending on its start: tests/solver_convergence.rs.)
+fn graded_ends(ts: f64, phi0: f64, w: f64) -> Option<([f64; MAX_PANELS + 1], usize)> {
+    if !w.is_finite() {
+        return None;
+    }
+    let w = w.max(MIN_FEATURE_WIDTH);
+    let inside = |x: f64| x > 0.0 && x < phi0;
+    let mut ends = [0.0; MAX_PANELS + 1];
+    let mut n = 1;
+    // below θs, nearest first; reversed into ascending order below
+    let mut d = GRADE_FIRST * w;
+    let mut graded = 0;
+    while ts - d > 0.0 && n < MAX_PANELS / 2 {
+        if inside(ts - d) {
+            ends[n] = ts - d;
+            n += 1;
+        }
+        d *= GRADE_RATIO;
+    }
+    ends[1..n].reverse();
+    graded += n - 1;
+    if inside(ts) {
+        ends[n] = ts;
+        n += 1;
+    }
+    let mut d = GRADE_FIRST * w;
+    while inside(ts + d) && n < MAX_PANELS {
+        ends[n] = ts + d;
+        n += 1;
+        graded += 1;
+        d *= GRADE_RATIO;
+    }
+    ends[n] = phi0;
+    n += 1;
+    (graded > 0).then_some((ends, n))
 }
 
 /// Five-point Gauss–Legendre nodes and weights on [−1, 1], across the contact width.
@@ -435,11 +547,13 @@ mod tests {
     fn factors_direct(ct: &Contact, u: f64, law: &Law) -> Factors {
         let mut f = Factors::default();
         let ts = u.clamp(-1.0, 1.0).acos();
-        let panels: Vec<(f64, f64)> = if ts > 0.0 && ts < ct.half_angle_rad {
-            vec![(0.0, ts), (ts, ct.half_angle_rad)]
-        } else {
-            vec![(0.0, ct.half_angle_rad)]
+        let phi0 = ct.half_angle_rad;
+        let ends = match graded_ends(ts, phi0, feature_width(law, u.clamp(-1.0, 1.0))) {
+            Some((ends, n)) => ends[..n].to_vec(),
+            None if ts > 0.0 && ts < phi0 => vec![0.0, ts, phi0],
+            None => vec![0.0, phi0],
         };
+        let panels: Vec<(f64, f64)> = ends.windows(2).map(|e| (e[0], e[1])).collect();
         for (rho, wr) in radii(law) {
             for &(a, b) in &panels {
                 let h = 0.5 * (b - a);
@@ -461,7 +575,9 @@ mod tests {
             Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false },
             Law { radial_ratio: 0.7, slip_scale: 0.0, truth: false },
             Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false },
+            Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false },
             Law { radial_ratio: 0.0, slip_scale: 0.03, truth: false },
+            Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false },
             Law { radial_ratio: 0.3, slip_scale: 0.02, truth: true },
             Law { radial_ratio: 0.0, slip_scale: 0.2, truth: true },
         ] {
@@ -469,12 +585,16 @@ mod tests {
                 let ct = contact_from_ratio(y);
                 for &u in &[0.0, 0.03, 0.4, 0.77, 0.999, 1.0] {
                     let (a, b) = (factors(&ct, u, &law), factors_direct(&ct, u, &law));
-                    let scale = b.torque.abs().max(b.power.abs()).max(1e-3);
-                    for (x, y) in [(a.torque, b.torque), (a.power, b.power), (a.radial, b.radial)] {
-                        assert!((x - y).abs() <= 1e-13 * scale, "{law:?} y={y} u={u}: {x} vs {y}");
+                    // (rounding on the order of the integrand's magnitude, O(0.1) and more, not
+                    // of a near-cancelling sum: at u = 1 a torque of −0.05 differs by 8e-15)
+                    let scale = b.torque.abs().max(b.power.abs()).max(0.1);
+                    for (x, z) in [(a.torque, b.torque), (a.power, b.power), (a.radial, b.radial)] {
+                        assert!((x - z).abs() <= 1e-13 * scale, "{law:?} y={y} u={u}: {x} vs {z}");
                     }
-                    for (x, y) in [(a.torque_du, b.torque_du), (a.power_du, b.power_du), (a.radial_du, b.radial_du)] {
-                        assert!((x - y).abs() <= 1e-12 * y.abs().max(1.0), "{law:?} u={u}: {x} vs {y}");
+                    // (at u = 1 with radial slip, ∂torque/∂u is log-divergent at θ = 0: the
+                    // graded rule's many panels next to 0 sum ~1/θ terms, 4e-12 apart at ρ = 0.0035)
+                    for (x, z) in [(a.torque_du, b.torque_du), (a.power_du, b.power_du), (a.radial_du, b.radial_du)] {
+                        assert!((x - z).abs() <= 1e-11 * z.abs().max(1.0), "{law:?} u={u}: {x} vs {z}");
                     }
                 }
             }
@@ -498,15 +618,23 @@ mod tests {
         }
     }
 
+    /// The derivatives at fixed nodes against central differences of the rule. For weak
+    /// radial slip or compliance (ρ = 0.0035, σ = 0.003) ∂torque/∂u is a narrow peak at θs
+    /// that the plain rule's nodes straddled: 20-30 % too small before the panels were
+    /// graded, and the rotor-speed solve's Newton steps and their carried last step
+    /// (solve::general_interface) rested on it.
     #[test]
     fn torque_derivative_matches_central_differences() {
+        let mut worst: f64 = 0.0;
         for law in [
             Law { radial_ratio: 0.5, slip_scale: 0.0, truth: false },
             Law { radial_ratio: 0.0, slip_scale: 0.05, truth: false },
             Law { radial_ratio: 0.3, slip_scale: 0.02, truth: true },
+            Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false },
+            Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false },
         ] {
-            let ct = contact_from_ratio(1.5);
-            for &u in &[0.1, 0.5, 0.9] {
+            for (&y, &u) in [0.8, 1.5].iter().flat_map(|y| [0.1, 0.5, 0.9].iter().map(move |u| (y, u))) {
+                let ct = contact_from_ratio(y);
                 let h = 1e-6;
                 let (up, dn, at) = (factors(&ct, u + h, &law), factors(&ct, u - h, &law), factors(&ct, u, &law));
                 let pairs = [
@@ -514,9 +642,10 @@ mod tests {
                     (at.power_du, (up.power - dn.power) / (2.0 * h)),
                     (at.radial_du, (up.radial - dn.radial) / (2.0 * h)),
                 ];
-                // the quadrature's split point moves with u, so agreement is to quadrature accuracy
+                // the panels move with θs, so the two agree to the rule's accuracy (9e-10 measured)
                 for (an, fd) in pairs {
-                    assert!((an - fd).abs() < 2e-3 * fd.abs().max(1.0), "{law:?} u={u}: {an} vs {fd}");
+                    worst = worst.max((an - fd).abs() / fd.abs().max(1.0));
+                    assert!((an - fd).abs() < 1e-8 * fd.abs().max(1.0), "{law:?} y={y} u={u}: {an} vs {fd}");
                 }
                 assert!(at.torque_du < 0.0);
                 // carried over a last Newton step (≤ 1e-8, solve::general_interface)
@@ -527,34 +656,40 @@ mod tests {
                 }
             }
         }
+        eprintln!("worst relative difference {worst:.1e}");
     }
 
-    /// The fixed 48-node rule against adaptive Gauss–Kronrod (`crate::quad`, 1e-12
-    /// relative) of the defining integrals ∫₀^φ0 (cos θ − c)·(…) dθ, split at the stick
-    /// point θs like the rule, over both friction laws in both forms, contacts from small to
-    /// full and rotor speeds up to just below the crest speed. The rule's error is largest
-    /// where the law is closest to Coulomb (small ρ or σ): the traction then turns from
-    /// driving to braking over |θ − θs| of order ρ or σ/sin θs, steep on the scale of the
-    /// Gauss–Legendre sub-panels next to θs; and as u → 1 (the slip nearly vanishes at the
-    /// crest). Measured worst relative errors (of the larger of torque and power): ρ = 0.05:
-    /// 7.2e-5, ρ = 0.3: 1.3e-5 and ρ = 1: 3.3e-5 (both at u = 0.9999 only), σ = 0.02:
-    /// 3.5e-4, σ = 0.2: 6.2e-8; truth forms ρ = 0.5: 8.8e-6, σ = 0.05: 3.7e-5 (docs/EFFECTS.md).
-    /// Each law's bound below is about 1.5× its measured worst, so a rule that got worse
-    /// fails here.
+    /// The rule against adaptive Gauss–Kronrod (`crate::quad`, 1e-12 relative) of the
+    /// defining integrals ∫₀^φ0 (cos θ − c)·(…) dθ, split at the stick point θs, over both
+    /// friction laws in both forms, contacts from small to full and rotor speeds up to just
+    /// below the crest speed. Near the crest (u → 1, θs → 0) the slip nearly vanishes and
+    /// the turn of the traction is no longer a band of width w about θs (the rule's
+    /// `feature_width`), so the error grows there. Measured worst relative errors (of the
+    /// larger of torque and power), all at u = 0.9999: ρ = 0.0035: 7.6e-15, ρ = 0.05: 1.7e-12,
+    /// ρ = 0.3: 1.9e-6, ρ = 1: 3.3e-5; σ = 0.003: 3.5e-5, σ = 0.02: 8.3e-5, σ = 0.2: 6.2e-8;
+    /// truth forms ρ = 0.003: 2.8e-14, ρ = 0.5: 2.0e-7, σ = 0.003: 5.0e-7, σ = 0.05: 7.9e-6.
+    /// Up to u = 0.8 every law is within 1.2e-11 (σ = 0.2). Before the panels were graded
+    /// towards θs the errors were 7.2e-5 at ρ = 0.05 and 3.5e-4 at σ = 0.02 at any u (and at
+    /// ρ = 0.0035 the torque was not monotonic in u). Each law's bound below is about 1.5×
+    /// its measured worst (rounding-level ones 1e-13), so a rule that got worse fails here.
     #[test]
     fn factors_agree_with_adaptive_quadrature_of_their_integrals() {
         use crate::quad::integrate;
         let laws = [
-            (Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false }, 1.1e-4),
-            (Law { radial_ratio: 0.3, slip_scale: 0.0, truth: false }, 2e-5),
+            (Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false }, 1e-13),
+            (Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false }, 3e-12),
+            (Law { radial_ratio: 0.3, slip_scale: 0.0, truth: false }, 3e-6),
             (Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false }, 5e-5),
-            (Law { radial_ratio: 0.0, slip_scale: 0.02, truth: false }, 5.3e-4),
+            (Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false }, 5.3e-5),
+            (Law { radial_ratio: 0.0, slip_scale: 0.02, truth: false }, 1.3e-4),
+            (Law { radial_ratio: 0.003, slip_scale: 0.0, truth: true }, 1e-13),
+            (Law { radial_ratio: 0.0, slip_scale: 0.003, truth: true }, 7.5e-7),
             (Law { radial_ratio: 0.0, slip_scale: 0.2, truth: false }, 1e-7),
-            (Law { radial_ratio: 0.5, slip_scale: 0.0, truth: true }, 1.3e-5),
-            (Law { radial_ratio: 0.0, slip_scale: 0.05, truth: true }, 5.5e-5),
+            (Law { radial_ratio: 0.5, slip_scale: 0.0, truth: true }, 3e-7),
+            (Law { radial_ratio: 0.0, slip_scale: 0.05, truth: true }, 1.2e-5),
         ];
         for (law, tol) in laws {
-            let mut worst: f64 = 0.0;
+            let (mut worst, mut worst_mid): (f64, f64) = (0.0, 0.0);
             for &y in &[0.3, 1.5, 3.0, 4.0] {
                 let ct = contact_from_ratio(y);
                 for &u in &[0.0, 0.3, 0.8, 0.99, 0.9999] {
@@ -581,11 +716,15 @@ mod tests {
                             cuts.windows(2).map(|w| integrate(|th| part(pick, th), w[0], w[1], 1e-15, 1e-12).0).sum();
                         let err = (got - want).abs() / scale;
                         worst = worst.max(err);
+                        if u <= 0.8 {
+                            worst_mid = worst_mid.max(err);
+                            assert!(err <= 2e-11, "{law:?} y={y} u={u} {name}: rule {got} vs adaptive {want}");
+                        }
                         assert!(err <= tol, "{law:?} y={y} u={u} {name}: rule {got} vs adaptive {want}");
                     }
                 }
             }
-            eprintln!("{law:?}: worst relative error of the 48-node rule {worst:.1e}");
+            eprintln!("{law:?}: worst relative error of the rule {worst:.1e} ({worst_mid:.1e} up to u = 0.8)");
         }
     }
 
