@@ -86,9 +86,7 @@ impl Observable {
         match self {
             Observable::SpeedStdRpm if row.speed_std_clipped && sigma > 0.0 && model < 8.0 * sigma => {
                 let x = model / sigma;
-                let cdf = 0.5 * libm::erfc(-x / std::f64::consts::SQRT_2);
-                let pdf = (-0.5 * x * x).exp() / (2.0 * std::f64::consts::PI).sqrt();
-                model * cdf + sigma * pdf
+                model * crate::noise::normal_cdf(x) + sigma * crate::noise::normal_pdf(x)
             }
             _ => model,
         }

@@ -235,8 +235,7 @@ fn noise_estimate(
 /// that the bench clips at zero (a speed standard deviation): about its mean when the
 /// reading is compared with the expected clipped reading (`centred`), else about m.
 fn clipped_second_moment(x: f64, centred: bool) -> f64 {
-    let cdf = 0.5 * libm::erfc(-x / std::f64::consts::SQRT_2);
-    let pdf = (-0.5 * x * x).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    let (cdf, pdf) = (crate::noise::normal_cdf(x), crate::noise::normal_pdf(x));
     // E[(Y/σ − x)²] = Φ(x) − xφ(x) + x²(1 − Φ(x)); the mean of Y/σ − x is φ(x) − x(1 − Φ(x))
     let about_m = cdf - x * pdf + x * x * (1.0 - cdf);
     let bias = pdf - x * (1.0 - cdf);
