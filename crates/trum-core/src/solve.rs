@@ -1094,7 +1094,7 @@ fn lagrange_weights(xs: &[f64], x: f64) -> [f64; SWEEP_HISTORY] {
 /// clamped …); the one consistent state lies between V and G(V) (210.1 V, moving). An
 /// unbounded secant on every pass (tried: 1.6× faster) left that interval.
 pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
-    solve_effects_with(p, op, guess, |d, g| solve_drive(p, d, op, g))
+    solve_effects_with(p, op, guess, true, |d, g| solve_drive(p, d, op, g))
 }
 
 /// The clamped state of `p` at `op` (W = 0) with the effects' fixed point solved on it,
@@ -1103,14 +1103,17 @@ pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&So
 /// to slightly changed motors (the descent to W = 0 is the costliest solve there is: 10-80
 /// trials).
 pub(crate) fn solve_clamped(p: &Prepared, op: &OperatingPoint) -> Solution {
-    solve_effects_with(p, op, None, |d, _| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0))
+    solve_effects_with(p, op, None, false, |d, _| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0))
 }
 
-/// [`solve_effects`] with `drive(d, guess)` solving the amplitude under drive `d`.
+/// [`solve_effects`] with `drive(d, guess)` solving the amplitude under drive `d`;
+/// `branches`: `drive` is the amplitude solve, whose lower (stalled) branch is searched
+/// where the electrode voltage jumps ([`settle_lower_branch`]).
 fn solve_effects_with(
     p: &Prepared,
     op: &OperatingPoint,
     guess: Option<&Solution>,
+    branches: bool,
     drive: impl Fn(&Drive, Option<&Solution>) -> Solution,
 ) -> Solution {
     let (thermal, sag) = iterated(p, op);
@@ -1119,6 +1122,11 @@ fn solve_effects_with(
     }
     let direct = |d: &Drive, _: f64, g: Option<&Solution>| drive(d, g);
     let (mut s, mut rise, mut settled) = settle(p, op, guess, (thermal, sag), 0.0, &direct);
+    if branches && sag && !thermal && !settled {
+        if let Some(stalled) = settle_lower_branch(p, op, &s, 0.0) {
+            (s, settled) = (stalled, true);
+        }
+    }
     if thermal && sag && !settled && s.status.is_valid() {
         // The joint passes can cycle (trum60a, sag 150 Ω, nominal thermal_drift, 439.7 N,
         // 1.0 N·m, 173.7 V, 39.9 kHz, 611 s: a 4-cycle between running and stalled states
@@ -1142,7 +1150,12 @@ fn solve_effects_with(
         let inner_settled = std::cell::Cell::new(true);
         let unsettled = std::cell::Cell::new(0);
         let inner = |_: &Drive, r: f64, g: Option<&Solution>| {
-            let (s, _, ok) = settle(p, op, g, (false, true), r, &direct);
+            let (mut s, _, mut ok) = settle(p, op, g, (false, true), r, &direct);
+            if branches && !ok {
+                if let Some(stalled) = settle_lower_branch(p, op, &s, r) {
+                    (s, ok) = (stalled, true);
+                }
+            }
             inner_settled.set(ok);
             if !ok {
                 unsettled.set(unsettled.get() + 1);
@@ -1217,8 +1230,10 @@ fn settle(
                 if bracket.width().is_some_and(|w| w <= 1e-12 * scale.max(x.abs())) {
                     // The sign change has shrunk to a point without the residual vanishing
                     // to the tolerance. Where the residual is still large, G jumps there
-                    // (the stator clamps on one side and moves on the other): no steady
-                    // state, only an oscillation between the two. Where it is within 1e-9
+                    // (the stator clamps or the rotor stalls on one side and moves on the
+                    // other): no steady state on the branch the amplitude solve takes, only
+                    // an oscillation between the two (a lower branch may still have one:
+                    // `settle_lower_branch`). Where it is within 1e-9
                     // the fixed point is pinned by the sign change and G is only resolved
                     // more coarsely than the tolerance: near a fold of the amplitude map
                     // r(W) has a tiny slope, so the amplitude solve's 1e-13 tolerance
@@ -1253,6 +1268,59 @@ fn settle(
         }
     }
     (s, rise, settled)
+}
+
+/// A consistent state on a lower branch of the amplitude map where the electrode
+/// voltage's passes found none on the upper one. The typical case: the running state draws
+/// so much current that the sagged voltage falls below the fold of the running branch, and
+/// the stalled state so little that the voltage recovers above it (trum60a, 10 Ω sag,
+/// 490 N, 1.2 N·m, 165 V, 41 kHz: stalled up to 161.3 V with G ≈ 162.6 V, running above
+/// with G ≈ 160 V). At the voltage the stalled state sets, the stall is a lower fixed point
+/// of the amplitude map, below the running one that the descent from the top finds; a
+/// rotor at rest stays at rest there (its blocking torque is below the load), so it is the
+/// motor's steady state, as on a bench that loses speed under load. Its amplitude is found
+/// by descending from a cap just above the lower root instead of from the top: below the
+/// unstable middle root, where r(W) ≥ 0. `rise` [K]: the temperature rise.
+///
+/// `None` (the point stays `no_convergence`) where `s` is neither a stall nor a running
+/// state whose sagged voltage gives a moving stator (a clamped one: the clamping edge,
+/// docs/EFFECTS.md), or where the passes on the lower branch do not settle either.
+fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f64) -> Option<Solution> {
+    let at = |v: f64| {
+        let mut d = Drive::at(p, op);
+        if rise != 0.0 {
+            d.warm(p, rise);
+        }
+        d.v = v;
+        d
+    };
+    let low = match s.status {
+        Status::Stall => s.clone(),
+        Status::Ok => solve_drive(p, &at(sagged_voltage_v(p, op, s)), op, Some(s)),
+        _ => return None,
+    };
+    if !matches!(low.status, Status::Stall | Status::Ok) || !(low.amplitude_m > 0.0) {
+        return None;
+    }
+    // The cap: the stalled amplitude scaled with the voltage, stepped up by 1.25× until
+    // r(W) ≥ 0 (the stalled branch steepens near clamping: 500 N, 1.1 N·m above, 0.33 µm
+    // at 160 V, 0.8 µm at 162.7 V). r stays ≥ 0 from the stalled root up to the middle one
+    // (0.8-3.5 µm there; 1.9-3.3 µm at 470 N, 1.4 N·m), so the first such step is a cap.
+    let per_volt = low.amplitude_m / low.electrode_voltage_v;
+    let below = |d: &Drive, _: f64, g: Option<&Solution>| {
+        let mut cap = per_volt * d.v;
+        for _ in 0..12 {
+            let t = trial(p, d, cap, None, None);
+            if t.w >= t.w_next {
+                break;
+            }
+            cap *= 1.25;
+        }
+        let top = WarmTop { bound: cap, predicted: None, contact_rad: None, stick_rad: None };
+        solve_drive_below(p, d, op, g, Some(top))
+    };
+    let (lower, _, settled) = settle(p, op, Some(&low), (false, true), rise, &below);
+    (settled && matches!(lower.status, Status::Stall | Status::Ok)).then_some(lower)
 }
 
 /// Which solution-dependent inputs [`solve_effects`] iterates on at `op`: (the temperature
@@ -2542,6 +2610,37 @@ mod tests {
         assert!((warm.amplitude_m - cold.amplitude_m).abs() <= 1e-9 * cold.amplitude_m, "{warm:?} vs {cold:?}");
         // near clamping: 1.9 µm of a 2.6 µm neighbour, 184 V of 194 V on the electrode
         assert!((1.8e-6..2.0e-6).contains(&cold.amplitude_m) && (183.0..185.0).contains(&cold.electrode_voltage_v));
+    }
+
+    /// Under load near the fold of the running branch a sagging drive has no running steady
+    /// state (its current sags the electrode voltage below the fold) but a stalled one (its
+    /// smaller current lets the voltage recover, and the rotor at rest stays at rest): the
+    /// point is a stall, a lower fixed point of the amplitude map at its own sagged
+    /// voltage. These three were `no_convergence` before the lower branch was searched.
+    #[test]
+    fn a_sagging_drive_stalls_where_its_running_state_sags_past_the_fold() {
+        let m = motor_with("trum60a", "voltage_sag=10", false);
+        let p = Prepared::new(&m);
+        for (f, t) in [(480.0, 1.3), (490.0, 1.2), (500.0, 1.1)] {
+            let op = OperatingPoint::new(f, t, 165.0, 41_000.0);
+            let s = solve(&m, &op);
+            assert_eq!(s.status, Status::Stall, "{op:?}: {s:?}");
+            // its own electrode voltage
+            let v = sagged_voltage_v(&p, &op, &s);
+            assert!((v - s.electrode_voltage_v).abs() <= 1e-9 * op.voltage_v, "{op:?}: {v} V vs {s:?}");
+            // a fixed point of the amplitude map at that voltage, stalled, and held there
+            let mut d = Drive::at(&p, &op);
+            d.v = s.electrode_voltage_v;
+            let tr = trial(&p, &d, s.amplitude_m, None, None);
+            assert!(tr.stalled && (tr.w - tr.w_next).abs() <= 1e-9 * tr.w, "{op:?}: {tr:?}");
+            assert!(s.stall_torque_nm < t, "{op:?}: blocking torque {} N·m", s.stall_torque_nm);
+            // a lower one: the descent from the top finds a running state at this voltage,
+            // whose current sags the voltage by more than a volt below it
+            let top = solve_drive(&p, &d, &op, None);
+            assert_eq!(top.status, Status::Ok, "{op:?}: {top:?}");
+            assert!(top.amplitude_m > 2.0 * s.amplitude_m, "{op:?}: {top:?} vs {s:?}");
+            assert!(sagged_voltage_v(&p, &op, &top) < s.electrode_voltage_v - 1.0, "{op:?}: {top:?}");
+        }
     }
 
     /// Just past a fold, where r has a minimum a hair above zero, the descent goes on down
