@@ -6,7 +6,8 @@
 //! rewrites the confusion matrix in docs/DIAGNOSIS.md (between the `blind:begin` and
 //! `blind:end` markers) and the per-case table docs/data/blind_cases.csv.
 //! `cargo bench --bench blind -- --slice` runs only the test suite's slice; `--no-write`
-//! prints without touching the docs; `--signals` prints only each case's signal χ²;
+//! prints without touching the docs; `--signals` prints only each case's signal χ² and the χ²
+//! the candidate forms leave on the truth forms' noise-free readings;
 //! `--only NAME` keeps the cases whose injected set contains NAME (`--only +`: the pairs).
 //! Each case's CSV and JSON stay in target/blind/.
 
@@ -35,7 +36,15 @@ fn main() {
         // only what each case's injected effects leave after a baseline calibration
         for c in &cases {
             let sig: Vec<String> = c.effects.iter().zip(c.signals()).map(|(e, s)| format!("{e} {s:.0}")).collect();
-            println!("{:<16} x{} noise {:<4} seed {}: {}", c.campaign, c.factor, c.noise, c.seed, sig.join(", "));
+            println!(
+                "{:<16} x{} noise {:<4} seed {}: {}; candidate form error {:.0}",
+                c.campaign,
+                c.factor,
+                c.noise,
+                c.seed,
+                sig.join(", "),
+                c.form_error_chi2()
+            );
         }
         return;
     }

@@ -107,6 +107,12 @@ impl Case {
         calibrate(&start, &rows, &params, &opts).map(|c| c.chi2).unwrap_or(f64::NAN)
     }
 
+    /// χ² the candidate forms of the injected effects leave on the noise-free readings of
+    /// their truth forms (strengths and baseline free): the form error no fit can remove.
+    pub fn form_error_chi2(&self) -> f64 {
+        self.leftover_chi2(&self.effects, &self.effects)
+    }
+
     /// Signal of each injected effect. For a single effect its [`Case::signal_chi2`]; in a
     /// combination, what the effect adds beyond the others: the χ² the others' candidates
     /// leave minus the χ² all candidates together leave (0 when its own signal is below
