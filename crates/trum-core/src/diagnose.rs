@@ -211,13 +211,17 @@ fn noise_estimate(
     raw: &BTreeMap<Observable, crate::noise::NoiseScale>,
 ) -> BTreeMap<Observable, crate::noise::NoiseScale> {
     let refs: Vec<&ObservedRow> = rows.iter().collect();
+    // (a speed std keeps its readings: whether one is clipped is a property of the reading,
+    // and a residual from a model that predicts a spread is ≤ 0 half the time)
     let detrended: Vec<ObservedRow> = rows
         .iter()
         .zip(predict(motor, &refs))
         .map(|(r, p)| {
             let mut r = r.clone();
             for (x, y) in r.readings.iter_mut().zip(p) {
-                x.1 -= y;
+                if x.0 != Observable::SpeedStdRpm {
+                    x.1 -= y;
+                }
             }
             r
         })
@@ -235,10 +239,10 @@ fn noise_estimate(
 /// that the bench clips at zero (a speed standard deviation): about its mean when the
 /// reading is compared with the expected clipped reading (`centred`), else about m.
 fn clipped_second_moment(x: f64, centred: bool) -> f64 {
-    let (cdf, pdf) = (crate::noise::normal_cdf(x), crate::noise::normal_pdf(x));
+    let (cdf, upper, pdf) = (crate::noise::normal_cdf(x), crate::noise::normal_cdf(-x), crate::noise::normal_pdf(x));
     // E[(Y/σ − x)²] = Φ(x) − xφ(x) + x²(1 − Φ(x)); the mean of Y/σ − x is φ(x) − x(1 − Φ(x))
-    let about_m = cdf - x * pdf + x * x * (1.0 - cdf);
-    let bias = pdf - x * (1.0 - cdf);
+    let about_m = cdf - x * pdf + x * x * upper;
+    let bias = pdf - x * upper;
     if centred {
         (about_m - bias * bias).max(0.0)
     } else {
@@ -318,7 +322,7 @@ fn noise_scaled(rows: &[ObservedRow], est: &BTreeMap<Observable, crate::noise::N
 /// (default) level, 2.5-5× the synthetic bench's, that expectation would overshoot; exact
 /// data (the blind benchmark's reference fits) have no noise to clip.
 fn speed_std_clipped(rows: &[ObservedRow], estimated: bool) -> bool {
-    estimated && rows.iter().flat_map(|r| &r.readings).any(|x| x.0 == Observable::SpeedStdRpm && x.1 == 0.0)
+    estimated && rows.iter().flat_map(|r| &r.readings).any(|x| crate::noise::clipped_reading(x.0, x.1))
 }
 
 /// Predictions of `motor` for `rows` (NaN where the model has no solution).
@@ -682,7 +686,7 @@ pub fn diagnose(
     let unscaled_rows = rows;
     let rows = &scaled[..];
     let noise_scale: Vec<(String, f64, usize)> =
-        est.iter().map(|(&o, n)| (o.column().to_string(), applied_factor(&est, o), n.triples)).collect();
+        est.iter().map(|(&o, n)| (o.column().to_string(), applied_factor(&est, o), n.residuals)).collect();
     if rows.len() < 4 {
         return Err(TrumError::input(format!(
             "{} rows are too few to diagnose anything; need at least 4 operating points",
