@@ -301,15 +301,15 @@ fn weak_interface_effects_converge_everywhere() {
         torque_nm: Axis::linspace(0.1, 1.0, 37),
     };
     let base = preset("trum60a").unwrap();
+    let baseline: Vec<_> = (0..g.len()).map(|i| (g.point(i), solve(&base, &g.point(i)))).collect();
     let mut bad = Vec::new();
     for (effect, strength) in
         [(Effect::RadialFriction, 0.002), (Effect::RadialFriction, 0.0035), (Effect::TangentialCompliance, 0.003)]
     {
         let mut m = preset("trum60a").unwrap();
         m.effects.set_strength(effect, strength);
-        for i in 0..g.len() {
-            let op = g.point(i);
-            let (s, b) = (solve(&m, &op), solve(&base, &op));
+        for (op, b) in &baseline {
+            let s = solve(&m, op);
             if s.status != b.status || !s.status.is_valid() {
                 bad.push(format!("{effect} {strength} {op:?}: {} (baseline {})", s.status, b.status));
             } else if (s.speed_rpm - b.speed_rpm).abs() > 0.02 * b.speed_rpm.abs().max(1.0) {

@@ -56,6 +56,17 @@ pub struct Factors {
 }
 
 impl Factors {
+    /// Adds `o` field by field.
+    #[inline(always)]
+    fn add(&mut self, o: &Factors) {
+        self.torque += o.torque;
+        self.power += o.power;
+        self.radial += o.radial;
+        self.torque_du += o.torque_du;
+        self.power_du += o.power_du;
+        self.radial_du += o.radial_du;
+    }
+
     /// The factors at u + `du` to first order (the integrand's derivatives at fixed nodes,
     /// which agree with central differences of the rule to 1e-9 relative, test below): for
     /// a step |du| ≤ 1e-8, the error of the carry is below 1e-11 of the factors at worst and
@@ -158,22 +169,22 @@ fn sin_cos_small(y: f64) -> (f64, f64) {
     (y + y * z * s, 1.0 - 0.5 * z + z * z * c)
 }
 
-/// Quadrature nodes of one `factors` call: sin θ, cos θ and weight, for up to N/(2·NODES)
-/// panels of two sub-panels of [`NODES`] Gauss–Legendre nodes each. The plain rule has two
-/// panels (split at the stick point), the graded rule up to [`MAX_PANELS`].
-struct Nodes<const N: usize> {
-    sin: [f64; N],
-    cos: [f64; N],
-    weight: [f64; N],
+/// Quadrature nodes of up to two panels, each of two sub-panels of [`NODES`]
+/// Gauss–Legendre nodes: sin θ, cos θ and weight. The plain rule has two panels (split at
+/// the stick point); the graded rule sums its panels two at a time.
+struct Nodes {
+    sin: [f64; PANEL_PAIR_NODES],
+    cos: [f64; PANEL_PAIR_NODES],
+    weight: [f64; PANEL_PAIR_NODES],
     len: usize,
 }
 
-/// Nodes of the plain rule: two panels.
-const PLAIN_NODES: usize = 4 * NODES;
+/// Nodes of two panels.
+const PANEL_PAIR_NODES: usize = 4 * NODES;
 
-impl<const N: usize> Nodes<N> {
+impl Nodes {
     fn new() -> Self {
-        Nodes { sin: [0.0; N], cos: [0.0; N], weight: [0.0; N], len: 0 }
+        Nodes { sin: [0.0; PANEL_PAIR_NODES], cos: [0.0; PANEL_PAIR_NODES], weight: [0.0; PANEL_PAIR_NODES], len: 0 }
     }
 
     /// Adds each [a, b] of `panels` (width at most π, at most two of them) as two equal
@@ -188,7 +199,7 @@ impl<const N: usize> Nodes<N> {
         // then r). The compiler evaluates them two lanes at a time in vector registers, each
         // lane with the operations of a scalar call, so the nodes are the same to the bit;
         // the Horner chains of both panels overlap instead of running one after the other.
-        debug_assert!(panels.len() <= 2 && self.len + 2 * NODES * panels.len() <= N);
+        debug_assert!(panels.len() <= 2 && self.len + 2 * NODES * panels.len() <= PANEL_PAIR_NODES);
         let mut y = [0.0; 16];
         for (p, &(a, b, _)) in panels.iter().enumerate() {
             let r = 0.25 * (b - a);
@@ -270,7 +281,7 @@ fn accumulate(f: &mut Factors, s: f64, co: f64, w: f64, c: f64, u: f64, rho: f64
 /// rounding at its edge) gets weight 0; D = 0 cannot occur at an interior node with ρ > 0,
 /// and with ρ = 0 only where u = cos θ at a node, which the split at θs rules out; the
 /// floor on D² keeps even that case at zero terms instead of NaN.
-fn coulomb_sums<const N: usize>(nodes: &Nodes<N>, c: f64, u: f64, rho: f64, weight: f64) -> Factors {
+fn coulomb_sums(nodes: &Nodes, c: f64, u: f64, rho: f64, weight: f64) -> Factors {
     const L: usize = 4;
     let (mut t, mut slip, mut t_u, mut rad, mut rad_u) = ([0.0; L], [0.0; L], [0.0; L], [0.0; L], [0.0; L]);
     // (panels add NODES = 12 nodes at a time)
@@ -312,7 +323,7 @@ fn coulomb_sums<const N: usize>(nodes: &Nodes<N>, c: f64, u: f64, rho: f64, weig
 /// branch) and ∂g_t/∂u = −(1 − g_t²)/σ, with power = ∫q·g_t·cos θ: one exp and one
 /// division a node (the general route, [`accumulate`], takes D = |dt|, g = S(D/σ)/D and
 /// dg/dD: a square root and two more divisions). The two agree to rounding (test below).
-fn compliance_sums<const N: usize>(nodes: &Nodes<N>, c: f64, u: f64, slip_scale: f64, weight: f64) -> Factors {
+fn compliance_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64, weight: f64) -> Factors {
     let inv_s = 1.0 / slip_scale;
     let (mut t, mut t_u, mut p, mut p_u) = (0.0, 0.0, 0.0, 0.0);
     for k in 0..nodes.len {
@@ -347,7 +358,7 @@ pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
     if let Some((ends, n)) = graded_ends(ts, phi0, feature_width(law, uc)) {
         return graded_factors(&ends[..n], ct.offset, u, law);
     }
-    let mut nodes = Nodes::<PLAIN_NODES>::new();
+    let mut nodes = Nodes::new();
     if ts > 0.0 && ts < phi0 {
         // the centre of [0, θs] by the half-angle formulas of cos θs = u (no sin_cos call)
         nodes.panels(&[
@@ -360,26 +371,33 @@ pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
     node_sums(&nodes, ct.offset, u, law)
 }
 
-/// [`factors`] on the graded panels between `ends`. Kept out of `factors`, so that its
-/// node arrays (11.5 kB) are not in every plain call's frame.
+/// [`factors`] on the graded panels between `ends`, two panels at a time (one node array
+/// of the plain rule's size, rather than one for all panels: zeroing 11.5 kB a call had cost
+/// 1-14 % of a graded call, most at few panels). Kept out of `factors` (never inlined), so that the node sums
+/// are not compiled into it twice. (The panels' centres by angle addition from θs and the
+/// series of their offsets saved another 4 %, but their 2-ulp rounding moved the torque
+/// at the crest, u = 1, where cos θ − u cancels, by 2e-14 of 0.05.)
 #[inline(never)]
 fn graded_factors(ends: &[f64], c: f64, u: f64, law: &Law) -> Factors {
-    let mut nodes = Nodes::<{ 2 * NODES * MAX_PANELS }>::new();
-    let mut panels = [(0.0, 0.0, (0.0, 0.0)); MAX_PANELS];
-    for (p, e) in panels.iter_mut().zip(ends.windows(2)) {
-        *p = (e[0], e[1], (0.5 * (e[0] + e[1])).sin_cos());
+    let panel = |a: f64, b: f64| (a, b, (0.5 * (a + b)).sin_cos());
+    let mut f = Factors::default();
+    for k in (0..ends.len() - 1).step_by(2) {
+        let mut nodes = Nodes::new();
+        if k + 2 < ends.len() {
+            nodes.panels(&[panel(ends[k], ends[k + 1]), panel(ends[k + 1], ends[k + 2])]);
+        } else {
+            nodes.panels(&[panel(ends[k], ends[k + 1])]);
+        }
+        f.add(&node_sums(&nodes, c, u, law));
     }
-    for pair in panels[..ends.len() - 1].chunks(2) {
-        nodes.panels(pair);
-    }
-    node_sums(&nodes, c, u, law)
+    f
 }
 
 /// The factors as sums over `nodes`, each of the law's radii by the cheapest route.
 /// Inlined: as a call of its own, the plain rule's node sums lost their two-lane vector
 /// form (`coulomb_sums`) and a `radial_friction` map took 20 % longer.
 #[inline(always)]
-fn node_sums<const N: usize>(nodes: &Nodes<N>, c: f64, u: f64, law: &Law) -> Factors {
+fn node_sums(nodes: &Nodes, c: f64, u: f64, law: &Law) -> Factors {
     let mut f = Factors::default();
     for (rho, weight) in radii(law) {
         let part = if law.slip_scale > 0.0 && rho == 0.0 && !law.truth {
@@ -393,18 +411,15 @@ fn node_sums<const N: usize>(nodes: &Nodes<N>, c: f64, u: f64, law: &Law) -> Fac
         } else {
             coulomb_sums(nodes, c, u, rho, weight)
         };
-        f.torque += part.torque;
-        f.power += part.power;
-        f.radial += part.radial;
-        f.torque_du += part.torque_du;
-        f.power_du += part.power_du;
-        f.radial_du += part.radial_du;
+        f.add(&part);
     }
     f
 }
 
-/// Most panels of the graded rule: eight graded ends a side of θs at the narrowest width
-/// ([`MIN_FEATURE_WIDTH`]), θs itself and the contact's two ends make 19 ends.
+/// Most panels of the graded rule. At the narrowest width ([`MIN_FEATURE_WIDTH`]) and the
+/// widest contact (φ0 = π) eight graded ends fit on either side of θs (3w·6^k < π for
+/// k ≤ 7); with θs and the contact's two ends that is 19 ends, 18 panels. The caps in
+/// [`graded_ends`] (nine ends below θs, twenty in all) are never reached.
 const MAX_PANELS: usize = 20;
 /// The first graded end sits GRADE_FIRST feature widths from θs, each further one
 /// GRADE_RATIO times as far. A panel [d, 6d] is then split into sub-panels whose nearer one
@@ -415,7 +430,8 @@ const GRADE_FIRST: f64 = 3.0;
 const GRADE_RATIO: f64 = 6.0;
 /// Narrower features are graded as this wide (at most MAX_PANELS panels). Below it the
 /// turn is a step at θs on the scale of the panel next to it, which the split at θs
-/// integrates like the Coulomb law's sign change.
+/// integrates like the Coulomb law's sign change (ρ or σ = 1e-7 and ρ = 1e-14: within
+/// 1.1e-14 of adaptive quadrature, test below).
 const MIN_FEATURE_WIDTH: f64 = 1e-6;
 
 /// Half-width [rad] of the band around the stick point θs over which the traction turns
@@ -687,6 +703,10 @@ mod tests {
             (Law { radial_ratio: 0.0, slip_scale: 0.2, truth: false }, 1e-7),
             (Law { radial_ratio: 0.5, slip_scale: 0.0, truth: true }, 3e-7),
             (Law { radial_ratio: 0.0, slip_scale: 0.05, truth: true }, 1.2e-5),
+            // narrower than MIN_FEATURE_WIDTH (graded as that wide)
+            (Law { radial_ratio: 1e-7, slip_scale: 0.0, truth: false }, 1e-13),
+            (Law { radial_ratio: 0.0, slip_scale: 1e-7, truth: false }, 1e-13),
+            (Law { radial_ratio: 1e-14, slip_scale: 0.0, truth: false }, 1e-13),
         ];
         for (law, tol) in laws {
             let (mut worst, mut worst_mid): (f64, f64) = (0.0, 0.0);
@@ -696,7 +716,19 @@ mod tests {
                     let rule = factors(&ct, u, &law);
                     let ts = u.acos();
                     let phi0 = ct.half_angle_rad;
-                    let cuts: Vec<f64> = if ts > 0.0 && ts < phi0 { vec![0.0, ts, phi0] } else { vec![0.0, phi0] };
+                    // (cut at θs and at powers of ten of the feature width about it: a band
+                    // narrower than its first Kronrod nodes' spacing is invisible to the
+                    // adaptive rule's error estimate, and at ρ = 1e-7 it missed 1.8e-7)
+                    let w = feature_width(&law, u);
+                    let mut cuts = vec![0.0, phi0];
+                    let mut d = w;
+                    while d.is_finite() && d < phi0 {
+                        cuts.extend([ts - d, ts + d]);
+                        d *= 10.0;
+                    }
+                    cuts.push(ts);
+                    cuts.retain(|&x| (0.0..=phi0).contains(&x));
+                    cuts.sort_by(f64::total_cmp);
                     // one component of the integrand at θ, summed over the law's radii
                     let part = |pick: fn(&Factors) -> f64, th: f64| {
                         let mut f = Factors::default();

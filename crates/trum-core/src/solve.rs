@@ -1299,7 +1299,7 @@ fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f6
         Status::Ok => solve_drive(p, &at(sagged_voltage_v(p, op, s)), op, Some(s)),
         _ => return None,
     };
-    if !matches!(low.status, Status::Stall | Status::Ok) || !(low.amplitude_m > 0.0) {
+    if !matches!(low.status, Status::Stall | Status::Ok) || low.amplitude_m <= 0.0 {
         return None;
     }
     // The cap: the stalled amplitude scaled with the voltage, stepped up by 1.25× until
