@@ -1282,9 +1282,13 @@ fn settle(
 /// by descending from a cap just above the lower root instead of from the top: below the
 /// unstable middle root, where r(W) ≥ 0. `rise` [K]: the temperature rise.
 ///
-/// `None` (the point stays `no_convergence`) where `s` is neither a stall nor a running
-/// state whose sagged voltage gives a moving stator (a clamped one: the clamping edge,
-/// docs/EFFECTS.md), or where the passes on the lower branch do not settle either.
+/// At the clamping edge the lower state is the clamped stator (W = 0), at the voltage its
+/// capacitive current leaves, if the drive cannot start it there: a small amplitude falls
+/// back (r(W) ≥ 0; near W = 0 the map is linear in W, its slope ∝ V/(μ·F)).
+///
+/// `None` (the point stays `no_convergence`) where the lower state's passes do not settle,
+/// a clamped stator would start at its own voltage (then the motor hunts between the two:
+/// docs/EFFECTS.md), or `s` is none of a stall, a clamped state or a running state.
 fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f64) -> Option<Solution> {
     let at = |v: f64| {
         let mut d = Drive::at(p, op);
@@ -1295,10 +1299,20 @@ fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f6
         d
     };
     let low = match s.status {
-        Status::Stall => s.clone(),
+        Status::Stall | Status::Clamped => s.clone(),
         Status::Ok => solve_drive(p, &at(sagged_voltage_v(p, op, s)), op, Some(s)),
         _ => return None,
     };
+    if low.status == Status::Clamped {
+        // The clamped stator at the voltage its own (capacitive) current leaves, where it
+        // stays clamped if the drive cannot start it: a small amplitude falls back, r(W) ≥ 0
+        // (near W = 0 the map is linear, W' ∝ V·W/(μ·F), so one trial decides).
+        let rest = |d: &Drive, _: f64, _: Option<&Solution>| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0);
+        let (c, _, settled) = settle(p, op, Some(&low), (false, true), rise, &rest);
+        let d = at(c.electrode_voltage_v);
+        let t = trial(p, &d, 1e-9 * p.theta * d.v / (d.omega * d.c), None, None);
+        return (settled && c.status == Status::Clamped && t.w >= t.w_next).then_some(c);
+    }
     if !matches!(low.status, Status::Stall | Status::Ok) || low.amplitude_m <= 0.0 {
         return None;
     }
@@ -2641,6 +2655,32 @@ mod tests {
             assert!(top.amplitude_m > 2.0 * s.amplitude_m, "{op:?}: {top:?} vs {s:?}");
             assert!(sagged_voltage_v(&p, &op, &top) < s.electrode_voltage_v - 1.0, "{op:?}: {top:?}");
         }
+    }
+
+    /// At the clamping edge of a sagging drive: the moving stator's current sags the
+    /// voltage to where it clamps (about 60 V of 120 V set, 150 Ω), the clamped one's
+    /// small capacitive current leaves 117.4 V, where the stator moves if it is moving but
+    /// a small amplitude dies away. The point is clamped, at its own sagged voltage (it was
+    /// `no_convergence`).
+    #[test]
+    fn a_sagging_drive_stays_clamped_where_its_moving_state_sags_below_clamping() {
+        let m = motor_with("trum60a", "voltage_sag=150", false);
+        let p = Prepared::new(&m);
+        let op = OperatingPoint::new(380.0, 0.2, 120.0, 41_000.0);
+        let s = solve(&m, &op);
+        assert_eq!(s.status, Status::Clamped, "{s:?}");
+        let v = sagged_voltage_v(&p, &op, &s);
+        assert!((v - s.electrode_voltage_v).abs() <= 1e-9 * op.voltage_v, "{v} V vs {s:?}");
+        assert!((117.0..118.0).contains(&v), "{v} V");
+        let mut d = Drive::at(&p, &op);
+        d.v = v;
+        for w in [1e-12, 1e-9] {
+            let t = trial(&p, &d, w, None, None);
+            assert!(t.w_next < t.w, "W = {w} m grows to {} m", t.w_next);
+        }
+        let top = solve_drive(&p, &d, &op, None);
+        assert_eq!(top.status, Status::Ok, "{top:?}");
+        assert!(sagged_voltage_v(&p, &op, &top) < 0.6 * v, "{top:?}");
     }
 
     /// Just past a fold, where r has a minimum a hair above zero, the descent goes on down
