@@ -268,9 +268,9 @@ fn stress_baseline_always_converges() {
 }
 
 /// With strong `voltage_sag` or `thermal_drift`, alone or together, every valid state is
-/// its own fixed point; `no_convergence` stays rare (a clamped stator that its own
-/// recovered voltage would start, so that the motor hunts, or a thermal runaway past the
-/// resonance far beyond typical strength: docs/EFFECTS.md). At the default size 12 (sag),
+/// its own fixed point; `no_convergence` stays rare (mostly a motor hunting between a
+/// moving and a clamped state, or a thermal runaway past the resonance far beyond typical
+/// strength: docs/EFFECTS.md). At the default size 12 (sag),
 /// 4 (drift) and 8 (both) of 2 000 since the sagging drive's lower branches (stop 32;
 /// 20 and 17 with the stalled branch only, which these bounds fail; both together 58
 /// before the nested fallback of stop 27).

@@ -180,7 +180,8 @@ fn censored_speed_std<'a>(runs: impl Iterator<Item = &'a [&'a ObservedRow]>) -> 
         .collect();
     let n = z.len();
     let zeros = z.iter().filter(|&&x| x == 0.0).count();
-    if n < MIN_CENSORED || zeros == n {
+    // (no zero left: the runs' zeros had no stated noise level)
+    if n < MIN_CENSORED || zeros == n || zeros == 0 {
         return None;
     }
     // a ≥ 0 with Φ(a) = 1 − p0 (Φ is monotonic); 0 where half or more are zeros
