@@ -109,7 +109,9 @@ fn status_note(s: Status, full: bool) -> &'static str {
         Status::Ok => " (rotor turning)",
         Status::Stall => " (load torque at or above the stall torque: rotor at rest)",
         Status::Clamped => " (friction clamps the stator: no vibration at this drive)",
-        Status::NoConvergence => " (the solver did not converge; numbers withheld)",
+        Status::NoConvergence => {
+            " (no steady state found: not converged, or the motor hunts between states; numbers withheld)"
+        }
         Status::InvalidInput => " (invalid operating point)",
     }
 }

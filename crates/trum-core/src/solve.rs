@@ -73,9 +73,14 @@ pub enum Status {
     /// All quantities are valid (speed and output power are zero).
     Stall,
     /// The friction forces clamp the stator: no vibrating steady state exists at this
-    /// drive (amplitude zero). Valid, with zero amplitude, speed and output.
+    /// drive (amplitude zero), or, with `voltage_sag`, the moving stator would sag its
+    /// drive below clamping and the clamped one's recovered voltage cannot start it. Valid,
+    /// with zero amplitude, speed and output.
     Clamped,
-    /// The iteration did not converge; numbers are the last iterate and must not be used.
+    /// No steady state was found: the iteration did not converge, or, with `voltage_sag`
+    /// or `thermal_drift`, the state jumps between a moving and a clamped (or stalled) one
+    /// at every pass (the motor hunts, docs/EFFECTS.md). Numbers are the last iterate and
+    /// must not be used.
     NoConvergence,
     /// The operating point itself is invalid (non-finite, non-positive preload, ...).
     InvalidInput,
