@@ -178,7 +178,7 @@ pub fn is_valid_code(status: u8) -> bool {
 /// Why the point `i` of a solve is not valid (`None` when it is).
 pub fn reason(status: u8, op: &OperatingPoint) -> Option<String> {
     match status {
-        3 => Some("the steady-state iteration did not converge".into()),
+        3 => Some("no steady state found: the iteration did not converge, or the motor hunts between states".into()),
         4 => Some(op.invalid_reason().unwrap_or_else(|| "invalid operating point".into())),
         _ => None,
     }
