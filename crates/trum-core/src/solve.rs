@@ -2703,13 +2703,10 @@ mod tests {
     /// `no_convergence`).
     #[test]
     fn a_sagging_drive_stays_clamped_where_its_moving_state_sags_below_clamping() {
-        let m = motor_with("trum60a", "voltage_sag=150", false);
-        let p = Prepared::new(&m);
-        let op = OperatingPoint::new(380.0, 0.2, 120.0, 41_000.0);
-        let s = solve(&m, &op);
+        let (p, op, s) = sagging_trum60a(150.0, OperatingPoint::new(380.0, 0.2, 120.0, 41_000.0));
         assert_eq!(s.status, Status::Clamped, "{s:?}");
-        let v = sagged_voltage_v(&p, &op, &s);
-        assert!((v - s.electrode_voltage_v).abs() <= 1e-9 * op.voltage_v, "{v} V vs {s:?}");
+        assert!(fixed_point_problem(&p, &op, &s).is_none(), "{:?}", fixed_point_problem(&p, &op, &s));
+        let v = s.electrode_voltage_v;
         assert!((117.0..118.0).contains(&v), "{v} V");
         let mut d = Drive::at(&p, &op);
         d.v = v;
@@ -2726,10 +2723,7 @@ mod tests {
     /// W = 0 (it was `no_convergence`; reporting it clamped would not be a steady state).
     #[test]
     fn a_sagging_drive_stalls_just_above_clamping_where_a_clamped_stator_would_start() {
-        let m = motor_with("trum60a", "voltage_sag=10", false);
-        let p = Prepared::new(&m);
-        let op = OperatingPoint::new(490.0, 0.95, 155.0, 41_000.0);
-        let s = solve(&m, &op);
+        let (p, op, s) = sagging_trum60a(10.0, OperatingPoint::new(490.0, 0.95, 155.0, 41_000.0));
         assert_eq!(s.status, Status::Stall, "{s:?}");
         assert!(s.amplitude_m > 0.0 && s.amplitude_m < 1e-7, "{s:?}");
         assert!(fixed_point_problem(&p, &op, &s).is_none(), "{:?}", fixed_point_problem(&p, &op, &s));
@@ -2738,6 +2732,13 @@ mod tests {
         d.v = s.electrode_voltage_v;
         let t = trial(&p, &d, 1e-3 * s.amplitude_m, None, None);
         assert!(t.w_next > t.w, "{t:?}");
+    }
+
+    /// trum60a with a `voltage_sag` of `ohm` [Ω], prepared, and its solution at `op`.
+    fn sagging_trum60a(ohm: f64, op: OperatingPoint) -> (Prepared, OperatingPoint, Solution) {
+        let m = motor_with("trum60a", &format!("voltage_sag={ohm}"), false);
+        let s = solve(&m, &op);
+        (Prepared::new(&m), op, s)
     }
 
     /// Why a sagging point's state is not its own steady state, if it is not: the electrode
