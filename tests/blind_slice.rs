@@ -14,6 +14,12 @@
 //! the noise (most typical-strength cases here; docs/DIAGNOSIS.md). The spec's shrink
 //! itself must have a median ≥ 0.7 over the cases whose baseline gap is at least 3.5 ×
 //! the noise, and be positive for every visible single injected effect.
+//!
+//! And against the true motor itself (the injected effects in their truth forms, the
+//! synthesised parameters; `Case::oracle_nrmse`), whose spec shrink is the most any
+//! diagnosis can reach on a case: the median shortfall from it must be at most 0.05, and
+//! no visible case may fall below 60 % of it (the `preload_stiffening` case, whose
+//! candidate form cannot follow its truth form, reaches 0.35 of 0.49).
 
 #[path = "support/blind.rs"]
 mod blind;
@@ -57,6 +63,17 @@ fn blind_slice_meets_the_issue_criteria() {
     assert!(!reachable.is_empty(), "no case with a gap well above noise:\n{report}");
     let m = blind::median(reachable);
     assert!(m >= 0.7, "median shrink {m:.2} < 0.7 where the gap is ≥ 3.5 × noise:\n{report}");
+    let visible: Vec<&blind::Outcome> = outcomes.iter().filter(|o| o.observable()).collect();
+    let shortfall = blind::median(visible.iter().map(|o| o.oracle_shrink - o.true_shrink.unwrap_or(0.0)).collect());
+    assert!(shortfall <= 0.05, "median shrink {shortfall:.2} short of the true motor's:\n{report}");
+    for o in &visible {
+        let s = o.true_shrink.unwrap_or(0.0);
+        assert!(
+            s >= 0.6 * o.oracle_shrink,
+            "shrink {s:.2} < 60 % of the true motor's {:.2}:\n{report}",
+            o.oracle_shrink
+        );
+    }
     for o in outcomes.iter().filter(|o| o.observable() && !o.expected.contains('+')) {
         assert!(o.true_shrink.is_some_and(|s| s > 0.0), "the injected effect does not shrink the gap:\n{report}");
     }

@@ -107,6 +107,32 @@ impl Case {
         calibrate(&start, &rows, &params, &opts).map(|c| c.chi2).unwrap_or(f64::NAN)
     }
 
+    /// Held-out NRMSE of the true motor itself (the injected effects in their truth forms,
+    /// the synthesised perturbation of its parameters, at the recorded operating points)
+    /// on the case's data `rows`, scaled per quantity like the diagnosis's (`scale`): what
+    /// a model without any error scores. Every reading is held out of some fold, and the
+    /// true motor has nothing to fit, so `1 − oracle/before` is the most any diagnosis can
+    /// shrink the spec's gap on this case.
+    pub fn oracle_nrmse(
+        &self,
+        rows: &[trum_core::calibrate::ObservedRow],
+        scale: &BTreeMap<trum_core::calibrate::Observable, f64>,
+    ) -> f64 {
+        use trum_core::synth::{true_motor, Campaign, SynthConfig};
+        let cfg = SynthConfig {
+            campaign: Campaign::from_name(self.campaign).expect("campaign"),
+            noise: self.noise,
+            seed: self.seed,
+            ..SynthConfig::default()
+        };
+        let truth = true_motor(&self.motor_with(&self.effects), &cfg);
+        // residuals are (prediction − reading)/σ; a point without a solution counts 50 σ
+        let z = trum_core::calibrate::residuals(&truth, rows);
+        let sigmas = rows.iter().flat_map(|r| r.readings.iter().map(|x| (x.0, x.2)));
+        let sum: f64 = z.iter().zip(sigmas).map(|(z, (o, s))| (z * s / scale[&o]).powi(2)).sum();
+        (sum / z.len().max(1) as f64).sqrt()
+    }
+
     /// χ² the candidate forms of the injected effects leave on the noise-free readings of
     /// their truth forms (strengths and baseline free): the form error no fit can remove.
     pub fn form_error_chi2(&self) -> f64 {
@@ -163,6 +189,9 @@ pub struct Outcome {
     /// The same on the gap beyond noise: 1 − √(after² − noise²)/√(before² − noise²) in
     /// NRMSE (the spec's shrink cannot exceed 1 − noise/before when the gap is small).
     pub true_excess_shrink: Option<f64>,
+    /// The spec's shrink of the true motor itself ([`Case::oracle_nrmse`]): the most any
+    /// diagnosis could reach on this case.
+    pub oracle_shrink: f64,
     /// Held-out shrink of the verdict's entry.
     pub verdict_shrink: Option<f64>,
     pub baseline_nrmse: f64,
@@ -258,6 +287,7 @@ pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
         v["gap"]["noise_nrmse"].as_f64().unwrap_or(f64::NAN),
     );
     let excess = |x: f64| (x * x - noise * noise).max(0.0).sqrt();
+    let oracle = oracle_shrink(case, &data, &v, before);
     let after_of = |name: &str| {
         ranking
             .iter()
@@ -271,6 +301,7 @@ pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
             after_of(&expected).map(|a| 1.0 - excess(a) / excess(before).max(1e-12))
         },
         true_shrink: if expected == "none" { None } else { shrink_of(&expected) },
+        oracle_shrink: oracle,
         expected,
         signal,
         verdict_shrink: shrink_of(&verdict),
@@ -282,6 +313,35 @@ pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
         seconds,
         case: case.clone(),
     }
+}
+
+/// `1 − oracle/before` for the case whose data file is `data` and diagnosis JSON `v`
+/// (`before`: its baseline held-out NRMSE), on the diagnosis's quantity scales (the
+/// baseline's NRMSE recomputed from the JSON's held-out readings on them must agree).
+fn oracle_shrink(case: &Case, data: &std::path::Path, v: &serde_json::Value, before: f64) -> f64 {
+    use trum_core::calibrate::Observable;
+    let bytes = std::fs::read(data).expect("case CSV");
+    let m = trum_core::measurements::parse_measurements(&bytes, &data.display().to_string()).expect("case CSV");
+    let bench = trum_core::bench::observations(&m, &trum_core::presets::preset(MOTOR).expect("preset"));
+    let scale = trum_core::diagnose::nrmse_scales(&bench.rows, &bench.groups);
+    let held = v["heldout"].as_array().expect("heldout");
+    let sum: f64 = held
+        .iter()
+        .map(|h| {
+            let q = h["quantity"].as_str().expect("quantity");
+            let o = Observable::ALL.into_iter().find(|o| o.column() == q).expect("known quantity");
+            // a point the baseline cannot solve is predicted as 0, as in the diagnosis
+            let (y, b) = (h["measured"].as_f64().expect("measured"), h["baseline"].as_f64().unwrap_or(0.0));
+            ((b - y) / scale[&o]).powi(2)
+        })
+        .sum();
+    let recomputed = (sum / held.len() as f64).sqrt();
+    assert!(
+        (recomputed - before).abs() <= 1e-9 * before,
+        "{}: baseline NRMSE {recomputed} on the diagnosis's scales, {before} in its JSON",
+        case.truth()
+    );
+    1.0 - case.oracle_nrmse(&bench.rows, &scale) / before
 }
 
 /// Every effect named in shared/spec/diagnose.md.
@@ -377,6 +437,8 @@ pub struct Summary {
     pub nulls: usize,
     pub median_true_shrink: f64,
     pub median_true_excess_shrink: f64,
+    /// Median spec shrink of the true motor itself over the same cases: the ceiling.
+    pub median_oracle_shrink: f64,
 }
 
 pub fn summarise(outcomes: &[Outcome]) -> Summary {
@@ -390,6 +452,7 @@ pub fn summarise(outcomes: &[Outcome]) -> Summary {
         nulls,
         median_true_shrink: median(non_null.iter().filter_map(|o| o.true_shrink).collect()),
         median_true_excess_shrink: median(non_null.iter().filter_map(|o| o.true_excess_shrink).collect()),
+        median_oracle_shrink: median(non_null.iter().map(|o| o.oracle_shrink).collect()),
     }
 }
 
@@ -446,13 +509,13 @@ pub fn confusion_markdown(outcomes: &[Outcome]) -> String {
 /// One line per case, CSV.
 pub fn cases_csv(outcomes: &[Outcome]) -> String {
     let mut s = String::from(
-        "truth,factor,campaign,noise,seed,signal_chi2,expected,verdict,confounded_with,correct,correct_or_confounded,true_shrink,true_excess_shrink,verdict_shrink,baseline_heldout_nrmse,noise_nrmse,rows,diagnose_s\n",
+        "truth,factor,campaign,noise,seed,signal_chi2,expected,verdict,confounded_with,correct,correct_or_confounded,true_shrink,true_excess_shrink,oracle_shrink,verdict_shrink,baseline_heldout_nrmse,noise_nrmse,rows,diagnose_s\n",
     );
     let f = |x: Option<f64>| x.map(|v| format!("{v:.4}")).unwrap_or_default();
     for o in outcomes {
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{:.4},{},{:.2}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{},{:.4},{:.4},{},{:.2}",
             o.case.truth(),
             o.case.factor,
             o.case.campaign,
@@ -466,6 +529,7 @@ pub fn cases_csv(outcomes: &[Outcome]) -> String {
             o.correct_or_confounded(),
             f(o.true_shrink),
             f(o.true_excess_shrink),
+            o.oracle_shrink,
             f(o.verdict_shrink),
             o.baseline_nrmse,
             o.noise_nrmse,

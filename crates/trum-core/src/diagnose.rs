@@ -198,6 +198,13 @@ fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
         .collect()
 }
 
+/// The quantity scales of the held-out NRMSEs a diagnosis of `rows` (runs `groups`)
+/// reports ([`scales`] with the noise levels it estimates from the data): for outside
+/// figures on the same scale, such as the blind benchmark's model without error.
+pub fn nrmse_scales(rows: &[ObservedRow], groups: &[String]) -> BTreeMap<Observable, f64> {
+    scales(&noise_scaled(rows, &crate::noise::estimate(rows, groups)))
+}
+
 /// Noise factors per quantity (`noise::estimate`), each the smaller of two estimates:
 /// from the readings themselves (`raw`, as estimated), and from their residuals from the nominal motor's
 /// predictions. Both are biased upwards only by what the lines through neighbouring
