@@ -5,7 +5,9 @@
 //! `cargo bench --bench blind` runs all cases (7 s wall on 2 cores at stop 32, after the build) and
 //! rewrites the confusion matrix in docs/DIAGNOSIS.md (between the `blind:begin` and
 //! `blind:end` markers) and the per-case table docs/data/blind_cases.csv.
-//! `cargo bench --bench blind -- --slice` runs only the test suite's slice; `--no-write`
+//! `cargo bench --bench blind -- --slice` runs only the test suite's slice, `--strong` its
+//! strong-effect cases, `--factors 3` the full run's single effects at 3 × typical
+//! strength (these three print only); `--no-write`
 //! prints without touching the docs; `--signals` prints only each case's signal χ² and the χ²
 //! the candidate forms leave on the truth forms' noise-free readings;
 //! `--only NAME` keeps the cases whose injected set contains NAME (`--only +`: the pairs).
@@ -27,7 +29,20 @@ fn main() {
         .and_then(|i| args.get(i + 1))
         .and_then(|s| s.parse().ok())
         .unwrap_or(2);
-    let mut cases = if slice { blind::slice_cases() } else { blind::full_cases() };
+    // `--factors 3` (comma-separated): the single effects at other strengths; prints only
+    let factors: Option<Vec<f64>> = args
+        .iter()
+        .position(|a| a == "--factors")
+        .and_then(|i| args.get(i + 1))
+        .map(|s| s.split(',').map(|x| x.parse().expect("--factors: numbers, comma-separated")).collect());
+    let strong = args.iter().any(|a| a == "--strong");
+    let write = write && factors.is_none() && !strong;
+    let mut cases = match (&factors, slice, strong) {
+        (_, _, true) => blind::strong_cases(),
+        (_, true, _) => blind::slice_cases(),
+        (Some(f), _, _) => blind::cases_at(f),
+        (None, _, _) => blind::full_cases(),
+    };
     // `--only NAME`: the cases whose injected set contains NAME (`+` for the pairs)
     if let Some(only) = args.iter().position(|a| a == "--only").and_then(|i| args.get(i + 1)) {
         cases.retain(|c| c.truth().contains(only.as_str()));
