@@ -7,7 +7,8 @@
 //! `blind:end` markers) and the per-case table docs/data/blind_cases.csv.
 //! `cargo bench --bench blind -- --slice` runs only the test suite's slice, `--strong` its
 //! strong-effect cases, `--factors 3` the full run's single effects at 3 × typical
-//! strength (these three print only); `--no-write`
+//! strength, `--seed-offset 1000` the full run with every seed moved by 1000 (these print
+//! only); `--no-write`
 //! prints without touching the docs; `--signals` prints only each case's signal χ² and the χ²
 //! the candidate forms leave on the truth forms' noise-free readings;
 //! `--only NAME` keeps the cases whose injected set contains NAME (`--only +`: the pairs).
@@ -35,13 +36,18 @@ fn main() {
         .position(|a| a == "--factors")
         .and_then(|i| args.get(i + 1))
         .map(|s| s.split(',').map(|x| x.parse().expect("--factors: numbers, comma-separated")).collect());
+    // `--seed-offset K`: every seed of the full run moved by K; prints only
+    let seed_offset: u64 = args
+        .iter()
+        .position(|a| a == "--seed-offset")
+        .and_then(|i| args.get(i + 1))
+        .map_or(0, |s| s.parse().expect("--seed-offset: a whole number"));
     let strong = args.iter().any(|a| a == "--strong");
-    let write = write && factors.is_none() && !strong;
+    let write = write && factors.is_none() && !strong && seed_offset == 0;
     let mut cases = match (&factors, slice, strong) {
         (_, _, true) => blind::strong_cases(),
         (_, true, _) => blind::slice_cases(),
-        (Some(f), _, _) => blind::cases_at(f),
-        (None, _, _) => blind::full_cases(),
+        (f, _, _) => blind::cases_at(f.as_deref().unwrap_or(&blind::FACTORS), seed_offset),
     };
     // `--only NAME`: the cases whose injected set contains NAME (`+` for the pairs)
     if let Some(only) = args.iter().position(|a| a == "--only").and_then(|i| args.get(i + 1)) {

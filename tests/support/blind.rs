@@ -359,14 +359,19 @@ pub const EFFECTS: [&str; 7] = [
 /// levels (0.5 and 1 × the nominal bench noise) × two campaigns (preload-torque and
 /// combined), eight null cases, four two-effect cases at typical strength.
 pub fn full_cases() -> Vec<Case> {
-    cases_at(&[0.3, 1.0])
+    cases_at(&FACTORS, 0)
 }
 
+/// The full benchmark's strengths, × typical.
+pub const FACTORS: [f64; 2] = [0.3, 1.0];
+
 /// The full benchmark's cases with the single effects at `factors` × typical strength
-/// (`cargo bench --bench blind -- --factors 3`: the strong-effect run of docs/DIAGNOSIS.md).
-pub fn cases_at(factors: &[f64]) -> Vec<Case> {
+/// (`cargo bench --bench blind -- --factors 3`: the strong-effect run of docs/DIAGNOSIS.md)
+/// and every seed moved by `seed_offset` (`--seed-offset 1000`: another draw of the same
+/// design).
+pub fn cases_at(factors: &[f64], seed_offset: u64) -> Vec<Case> {
     let mut out = Vec::new();
-    let mut seed = 100;
+    let mut seed = 100 + seed_offset;
     let mut next = || {
         seed += 1;
         seed
