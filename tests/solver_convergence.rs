@@ -268,20 +268,21 @@ fn stress_baseline_always_converges() {
 }
 
 /// With strong `voltage_sag` or `thermal_drift`, alone or together, every valid state is
-/// its own fixed point; `no_convergence` stays rare (mostly a motor hunting between a
-/// moving and a clamped state, or a thermal runaway past the resonance far beyond typical
-/// strength: docs/EFFECTS.md). At the default size 12 (sag),
-/// 4 (drift) and 8 (both) of 2 000 since the sagging drive's lower branches (stop 32;
-/// 20 and 17 with the stalled branch only, which these bounds fail; both together 58
-/// before the nested fallback of stop 27).
+/// its own fixed point; `no_convergence` stays rare (a motor hunting between states under
+/// both effects, or a thermal runaway past the resonance far beyond typical strength:
+/// docs/EFFECTS.md), and a sagging drive alone always has a steady state (stop 33: the
+/// largest root of W − Θ·V_e(W)/|Z(W)| where the passes fail; 0 of 50 000 with
+/// `TRUM_STRESS_N=50000`, was 267). At the default size 0 (sag), 4 (drift) and 2 (both)
+/// of 2 000; 12 and 8 at stop 32, which these bounds fail (20 and 17 with the stalled
+/// branch only; both together 58 before the nested fallback of stop 27).
 #[test]
 fn stress_self_consistent_effects() {
-    for (sag, thermal, one_in) in [(true, false, 125), (false, true, 250), (true, true, 150)] {
+    for (sag, thermal, one_in) in [(true, false, usize::MAX), (false, true, 250), (true, true, 500)] {
         let n = stress_n(2_000);
         let c = stress(n, 0x2545_f491_4f6c_dd1d, sag, thermal);
         assert_eq!(c.get("inconsistent"), None, "{c:?}");
         let nc = c.get("no_convergence").copied().unwrap_or(0);
-        assert!(nc * one_in <= n, "{nc} of {n} points without a steady state: {c:?}");
+        assert!(nc == 0 || nc.saturating_mul(one_in) <= n, "{nc} of {n} points without a steady state: {c:?}");
     }
 }
 
