@@ -17,7 +17,8 @@
 //!
 //! And against the true motor itself (the injected effects in their truth forms, the
 //! synthesised parameters; `Case::oracle_nrmse`), whose spec shrink is the most any
-//! diagnosis can reach on a case: the median shortfall from it must be at most 0.05, and
+//! diagnosis can reach on a case (approximately: docs/DIAGNOSIS.md): the median shortfall
+//! from it must be at most 0.05, and
 //! no visible case may fall below 60 % of it (the `preload_stiffening` case, whose
 //! candidate form cannot follow its truth form, reaches 0.35 of 0.49).
 
