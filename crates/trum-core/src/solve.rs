@@ -1424,17 +1424,18 @@ fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<S
     let mut lo = None;
     while hi > tiny {
         let w = (0.8 * hi).max(tiny);
-        let hw = h(w).0;
+        let e = h(w);
+        let hw = e.0;
         if !hw.is_finite() {
             return None;
         }
         if hw <= 0.0 {
-            lo = Some((w, hw));
+            lo = Some((w, e));
             break;
         }
         (hi, h_hi) = (w, hw);
     }
-    let Some(lo) = lo else {
+    let Some((lo_w, lo_eval)) = lo else {
         // no root above W = 0: the clamped stator, at the voltage its own current leaves
         let rest = |d: &Drive, _: f64, _: Option<&Solution>| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0);
         let (c, _, settled) = settle(p, op, None, (false, true), rise, &rest);
@@ -1442,8 +1443,8 @@ fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<S
     };
     // Illinois regula falsi in the sign change, to the amplitude solve's tolerance
     let rtol = if p.law.radial_ratio == 0.0 && p.compliance == 0.0 { 1e-13 } else { 1e-10 };
-    let mut b = SignBracket { neg: Some(lo), pos: Some((hi, h_hi)), last_side: 0 };
-    let (mut best, mut evals) = (h(lo.0), 0u32);
+    let mut b = SignBracket { neg: Some((lo_w, lo_eval.0)), pos: Some((hi, h_hi)), last_side: 0 };
+    let (mut best, mut evals) = (lo_eval, 0u32);
     for _ in 0..200 {
         let (Some((a, _)), Some((c, _))) = (b.neg, b.pos) else { return None };
         if (c - a).abs() <= rtol * c {
