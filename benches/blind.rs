@@ -109,7 +109,7 @@ fn main() {
     let summary = format!(
         "{} cases in {:.0} s wall ({} workers; diagnosis median {:.1} s, max {:.1} s per case).\n\n\
          * observable non-null cases whose verdict is the injected effect or whose confounded set contains it: \
-         {:.0} % of {}\n* null cases with an effect claimed: {} of {}\n* median held-out shrink of the injected \
+         {:.0} % of {} (besides: `unexplained` naming the injected effect as the part of the gap it explains: {})\n* null cases with an effect claimed: {} of {}\n* median held-out shrink of the injected \
          effect(s) over the observable non-null cases: {:.2} (beyond noise: {:.2}); the true motor itself, \
          with no model error, would reach {:.2}\n",
         outcomes.len(),
@@ -119,6 +119,7 @@ fn main() {
         times.iter().cloned().fold(0.0, f64::max),
         100.0 * sum.hit_rate,
         sum.non_null,
+        sum.unexplained_naming_truth,
         sum.false_claims,
         sum.nulls,
         sum.median_true_shrink,

@@ -184,6 +184,9 @@ pub struct Outcome {
     pub signal: Vec<f64>,
     pub verdict: String,
     pub confounded: Vec<String>,
+    /// With an `unexplained` verdict, the supported effect the diagnosis says explains part
+    /// of the gap (the JSON's `partial`).
+    pub partial: Option<String>,
     /// Held-out shrink of the expected (visible injected) effect(s), if ranked.
     pub true_shrink: Option<f64>,
     /// The same on the gap beyond noise: 1 − √(after² − noise²)/√(before² − noise²) in
@@ -217,6 +220,13 @@ impl Outcome {
     /// Some injected effect is visible in the data.
     pub fn observable(&self) -> bool {
         self.expected != "none"
+    }
+
+    /// The verdict is `unexplained` and names the expected single effect as the part of the
+    /// gap it explains: not counted as correct (the spec's criterion is the verdict or the
+    /// confounded set), reported beside it.
+    pub fn unexplained_naming_truth(&self) -> bool {
+        self.verdict == "unexplained" && self.partial.as_deref() == Some(self.expected.as_str())
     }
 
     /// An effect was claimed where none was injected.
@@ -307,6 +317,7 @@ pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
         verdict_shrink: shrink_of(&verdict),
         verdict,
         confounded,
+        partial: v["partial"].as_str().map(String::from),
         baseline_nrmse: v["gap"]["baseline_heldout_nrmse"].as_f64().unwrap_or(f64::NAN),
         noise_nrmse: v["gap"]["noise_nrmse"].as_f64().unwrap_or(f64::NAN),
         rows: v["n_rows"].as_u64().unwrap_or(0) as usize,
@@ -465,6 +476,9 @@ pub struct Summary {
     pub median_true_excess_shrink: f64,
     /// Median spec shrink of the true motor itself over the same cases: the ceiling.
     pub median_oracle_shrink: f64,
+    /// Of the non-null cases: `unexplained` verdicts naming the truth as what explains
+    /// part of the gap (not in `hit_rate`).
+    pub unexplained_naming_truth: usize,
 }
 
 pub fn summarise(outcomes: &[Outcome]) -> Summary {
@@ -479,6 +493,7 @@ pub fn summarise(outcomes: &[Outcome]) -> Summary {
         median_true_shrink: median(non_null.iter().filter_map(|o| o.true_shrink).collect()),
         median_true_excess_shrink: median(non_null.iter().filter_map(|o| o.true_excess_shrink).collect()),
         median_oracle_shrink: median(non_null.iter().map(|o| o.oracle_shrink).collect()),
+        unexplained_naming_truth: non_null.iter().filter(|o| o.unexplained_naming_truth()).count(),
     }
 }
 
@@ -497,12 +512,12 @@ pub fn confusion_markdown(outcomes: &[Outcome]) -> String {
     for v in &verdicts {
         let _ = write!(s, " {} |", v.replace('_', "\\_"));
     }
-    let _ = writeln!(s, " cases | not visible (signal χ² < 25) | correct | truth in confounded set | median shrink of truth | median shrink beyond noise |");
+    let _ = writeln!(s, " cases | not visible (signal χ² < 25) | correct | truth in confounded set | unexplained, truth explains part | median shrink of truth | median shrink beyond noise |");
     let _ = write!(s, "|---|");
     for _ in &verdicts {
         let _ = write!(s, "---|");
     }
-    let _ = writeln!(s, "---|---|---|---|---|---|");
+    let _ = writeln!(s, "---|---|---|---|---|---|---|");
     for t in &truths {
         let rows: Vec<&Outcome> = outcomes.iter().filter(|o| &o.case.truth() == t).collect();
         let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
@@ -522,12 +537,13 @@ pub fn confusion_markdown(outcomes: &[Outcome]) -> String {
         }
         let correct = rows.iter().filter(|o| o.correct()).count();
         let conf = rows.iter().filter(|o| !o.correct() && o.correct_or_confounded()).count();
+        let part = rows.iter().filter(|o| o.unexplained_naming_truth()).count();
         let hidden = rows.iter().filter(|o| !o.case.effects.is_empty() && o.expected != o.case.truth()).count();
         let shrink = median(rows.iter().filter(|o| o.observable()).filter_map(|o| o.true_shrink).collect());
         let shrink = if t == "none" || !shrink.is_finite() { "–".to_string() } else { format!("{shrink:.2}") };
         let ex = median(rows.iter().filter(|o| o.observable()).filter_map(|o| o.true_excess_shrink).collect());
         let ex = if t == "none" || !ex.is_finite() { "–".to_string() } else { format!("{ex:.2}") };
-        let _ = writeln!(s, " {} | {hidden} | {correct} | {conf} | {shrink} | {ex} |", rows.len());
+        let _ = writeln!(s, " {} | {hidden} | {correct} | {conf} | {part} | {shrink} | {ex} |", rows.len());
     }
     s
 }
@@ -535,13 +551,13 @@ pub fn confusion_markdown(outcomes: &[Outcome]) -> String {
 /// One line per case, CSV.
 pub fn cases_csv(outcomes: &[Outcome]) -> String {
     let mut s = String::from(
-        "truth,factor,campaign,noise,seed,signal_chi2,expected,verdict,confounded_with,correct,correct_or_confounded,true_shrink,true_excess_shrink,oracle_shrink,verdict_shrink,baseline_heldout_nrmse,noise_nrmse,rows,diagnose_s\n",
+        "truth,factor,campaign,noise,seed,signal_chi2,expected,verdict,confounded_with,partial,correct,correct_or_confounded,true_shrink,true_excess_shrink,oracle_shrink,verdict_shrink,baseline_heldout_nrmse,noise_nrmse,rows,diagnose_s\n",
     );
     let f = |x: Option<f64>| x.map(|v| format!("{v:.4}")).unwrap_or_default();
     for o in outcomes {
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{},{:.4},{:.4},{},{:.2}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4},{},{:.4},{:.4},{},{:.2}",
             o.case.truth(),
             o.case.factor,
             o.case.campaign,
@@ -551,6 +567,7 @@ pub fn cases_csv(outcomes: &[Outcome]) -> String {
             o.expected,
             o.verdict,
             o.confounded.join("|"),
+            o.partial.as_deref().unwrap_or(""),
             o.correct(),
             o.correct_or_confounded(),
             f(o.true_shrink),

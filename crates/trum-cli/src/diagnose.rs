@@ -95,7 +95,14 @@ pub fn after_nrmse(d: &Diagnosis) -> Option<f64> {
 pub fn verdict_words(d: &Diagnosis) -> String {
     match d.verdict.as_str() {
         "none" => "none (the calibrated baseline is adequate within the noise)".into(),
-        "unexplained" => "unexplained (a real gap that no candidate effect closes)".into(),
+        "unexplained" => match d.partial.as_ref().and_then(|p| d.ranking.iter().find(|r| &r.effect == p)) {
+            Some(r) => format!(
+                "unexplained (a real gap that no candidate effect closes; {} explains part of it, {} % of the held-out gap)",
+                r.effect,
+                fmt_sig(100.0 * r.shrink, 2)
+            ),
+            None => "unexplained (a real gap that no candidate effect closes)".into(),
+        },
         v if v.contains('+') => format!("{v} (both effects together are needed to close the gap)"),
         v => v.to_string(),
     }

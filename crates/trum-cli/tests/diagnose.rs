@@ -174,6 +174,32 @@ fn calibrate_writes_a_motor_file_that_point_reads() {
     assert!(j["chi2_per_reading"].as_f64().expect("chi2") > 0.0);
 }
 
+/// Seed 001 Table 2 (docs/DIAGNOSIS.md): `unexplained`. The JSON's `partial` is null or a
+/// supported ranked effect, and the summary's verdict line names it with its shrink.
+#[test]
+fn an_unexplained_verdict_names_what_explains_part_of_the_gap() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let json = path(dir.path(), "t2.json");
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/good/measurements/sun2021_table2.csv");
+    let out = ok(&["diagnose", "--motor", "trum60-qut", "--data", data]);
+    ok(&["diagnose", "--motor", "trum60-qut", "--data", data, "--json", &json]);
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("JSON");
+    assert_eq!(j["verdict"], "unexplained");
+    let line = out.lines().find(|l| l.starts_with("verdict")).expect("verdict line");
+    match j["partial"].as_str() {
+        Some(p) => {
+            let entry = j["ranking"].as_array().expect("ranking").iter().find(|r| r["effect"] == p).expect("ranked");
+            assert!(entry["evidence"].as_f64().expect("evidence") > 5.0, "{entry}");
+            assert!(entry["shrink_interval"][0].as_f64().expect("interval") > 0.0, "{entry}");
+            assert!(line.contains(&format!("{p} explains part of it")), "{line}");
+        }
+        None => {
+            assert!(j["partial"].is_null(), "{}", j["partial"]);
+            assert!(!line.contains("explains part"), "{line}");
+        }
+    }
+}
+
 /// One diagnosis of a no-effect campaign: JSON fields and values, the report, the summary.
 #[test]
 fn diagnose_without_effect_says_none() {
@@ -189,6 +215,8 @@ fn diagnose_without_effect_says_none() {
     let j: serde_json::Value = serde_json::from_str(&raw).expect("JSON");
     assert_eq!(j["verdict"], "none");
     assert!(j["confounded_with"].as_array().expect("confounded_with").is_empty());
+    // present and null: only an `unexplained` verdict names a partial explanation
+    assert!(j.get("partial").is_some_and(|p| p.is_null()), "{}", j["partial"]);
     let before = j["gap"]["baseline_heldout_nrmse"].as_f64().expect("before");
     assert!(before >= 0.0 && j["gap"]["noise_nrmse"].as_f64().expect("noise") >= 0.0);
     for w in j["gap"]["where"].as_array().expect("where") {

@@ -124,6 +124,10 @@ pub struct Diagnosis {
     pub verdict: String,
     /// Effects that explain the data about as well as the verdict.
     pub confounded_with: Vec<String>,
+    /// With an `unexplained` verdict, the supported effect that explains part of the gap
+    /// (the strongest; its ranking entry says how much): present, but not all that is
+    /// missing. `None` for every other verdict, and when no effect is supported.
+    pub partial: Option<String>,
     /// Held-out NRMSE of the calibrated baseline.
     pub baseline_heldout_nrmse: f64,
     /// Held-out NRMSE the measurement noise alone would give, with the best noise levels
@@ -1080,14 +1084,27 @@ pub fn diagnose(
     // little above the noise can never lose half of its total NRMSE).
     let supported = |r: &RankEntry| r.evidence > 5.0 && r.shrink > 0.0 && r.shrink_interval.0 > 0.0;
     let excess = |x: f64| (x * x - noise_nrmse * noise_nrmse).max(0.0).sqrt();
+    // The noise of that last test: the weights' level, unless it puts the baseline's whole
+    // held-out NRMSE inside the noise. On `combined` campaigns it is 3-4 × what noise alone
+    // gives (`noise_best`), and a baseline with held-out χ² 5.4 per reading had no gap
+    // "beyond the noise" for half of it to go: every supported effect closed it, so a
+    // `radial_friction` that closed 18 % was the verdict for a truth of preload
+    // stiffening (blind benchmark, seed 136). The best estimate stands in there; where
+    // the baseline is within even that, this test says nothing.
+    let gap_noise = if base_nrmse > noise_nrmse { noise_nrmse } else { noise_best };
+    let beyond = |x: f64| (x * x - gap_noise * gap_noise).max(0.0).sqrt();
     let closes = |r: &RankEntry| {
-        r.heldout_chi2_after <= 2.0 || r.shrink >= 0.5 || excess(r.heldout_nrmse_after) <= 0.5 * excess(base_nrmse)
+        let before = beyond(base_nrmse);
+        r.heldout_chi2_after <= 2.0
+            || r.shrink >= 0.5
+            || (before > 0.0 && beyond(r.heldout_nrmse_after) <= 0.5 * before)
     };
     // The gap is real when the baseline misses held-out data beyond twice the noise
     // variance, or when some effect is supported (a small, consistent gap).
     let gap = base_z2 > 2.0 || ranking.iter().any(supported);
     let mut verdict = String::from("none");
     let mut confounded = Vec::new();
+    let mut partial = None;
     let mut screened_note = None;
     if gap {
         let best_single = ranking.iter().find(|r| supported(r)).cloned();
@@ -1284,12 +1301,13 @@ pub fn diagnose(
             None => verdict = "unexplained".into(),
         }
         if verdict == "unexplained" {
+            partial = best_single.as_ref().map(|b| b.effect.clone());
             if let Some(b) = best_single.as_ref() {
                 notes.push(format!(
-                    "{} is supported (evidence {:.1}) but closes only {:.0} % of the held-out gap; something else remains",
+                    "{} is supported (evidence {:.1}) but closes only {} % of the held-out gap; something else remains",
                     b.effect,
                     b.evidence,
-                    100.0 * b.shrink
+                    rounded(100.0 * b.shrink)
                 ));
             }
         } else if !verdict.contains('+') {
@@ -1361,6 +1379,7 @@ pub fn diagnose(
     Ok(Diagnosis {
         verdict,
         confounded_with: confounded,
+        partial,
         baseline_heldout_nrmse: base_nrmse,
         noise_nrmse: noise_best,
         noise_nrmse_weights: noise_nrmse,
@@ -1768,6 +1787,46 @@ mod tests {
             }
         }
         (rows, groups)
+    }
+
+    /// On a `combined` campaign the weights' noise levels put the whole held-out NRMSE of
+    /// the baseline inside the noise (noise NRMSE 0.116 against 0.072, where noise alone
+    /// gives 0.0225). The test "half of the NRMSE beyond the noise is gone" then held for
+    /// every supported effect, and `radial_friction`, closing 18 % of the gap with held-out
+    /// χ² 4.2 per reading left of 5.4, was the verdict for a truth of preload stiffening
+    /// (blind benchmark, 1 × typical, half noise, seed 136). With the best noise level in
+    /// that test nothing closes the gap: `unexplained`, and the supported effect is named as
+    /// the part it explains.
+    #[test]
+    fn a_gap_inside_the_weights_noise_is_not_closed_by_every_effect() {
+        let nominal = preset("trum60a").expect("preset");
+        let mut truth = nominal.clone();
+        truth.effects.set_strength(Effect::PreloadStiffening, 0.05);
+        let cfg = SynthConfig { campaign: Campaign::Combined, noise: 0.5, seed: 136, ..SynthConfig::default() };
+        let synth = synthesize(&truth, &cfg).expect("synth");
+        let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
+        let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+        let opts = DiagnoseOptions {
+            candidates: vec![Effect::RadialFriction, Effect::PreloadStiffening],
+            try_pairs: false,
+            bootstrap: 200,
+            ..DiagnoseOptions::default()
+        };
+        let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+        // the premise: the weights' noise is above the baseline's gap, the best estimate far below
+        assert!(
+            d.noise_nrmse_weights > d.baseline_heldout_nrmse,
+            "{} vs {}",
+            d.noise_nrmse_weights,
+            d.baseline_heldout_nrmse
+        );
+        assert!(d.noise_nrmse < 0.5 * d.baseline_heldout_nrmse, "{} vs {}", d.noise_nrmse, d.baseline_heldout_nrmse);
+        let rf = d.ranking.iter().find(|r| r.effect == "radial_friction").expect("ranked");
+        assert!(rf.evidence > 5.0 && rf.shrink_interval.0 > 0.0, "radial friction no longer supported: {rf:?}");
+        assert!(rf.shrink < 0.5 && rf.heldout_chi2_after > 2.0, "{rf:?}");
+        assert_eq!(d.verdict, "unexplained");
+        assert_eq!(d.partial.as_deref(), Some("radial_friction"));
+        assert!(d.notes.iter().any(|n| n.starts_with("radial_friction is supported")), "{:?}", d.notes);
     }
 
     /// One motor measured at four drive voltages (preload-torque runs, radial friction in its

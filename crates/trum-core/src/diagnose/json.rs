@@ -43,6 +43,7 @@ pub fn to_json(d: &Diagnosis, src: &Provenance<'_>) -> Value {
     json!({
         "verdict": d.verdict,
         "confounded_with": d.confounded_with,
+        "partial": d.partial,
         "gap": {
             "baseline_heldout_nrmse": num(d.baseline_heldout_nrmse),
             "noise_nrmse": num(d.noise_nrmse),
