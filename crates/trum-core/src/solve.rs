@@ -1380,32 +1380,46 @@ fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f6
     (settled && matches!(lower.status, Status::Stall | Status::Ok)).then_some(lower)
 }
 
-/// A sagging drive's steady state as the largest root of one scalar,
-/// h(W) = W − Θ·V_e(W)/|Z(W)|, for the points whose electrode-voltage passes and
-/// [`settle_lower_branch`] found none. The electrode voltage follows the amplitude at once:
-/// the phase admittance Y = I/V depends on W only, through Z(W) ([`stator::phase_current_a`]),
-/// so V_e(W) = V_set/|1 + Z_src·Y(W)| needs no passes, and each h(W) is one trial. A root
-/// satisfies both the amplitude map at its voltage and the sag at its amplitude. The largest
-/// root is found by stepping down from above the amplitude bound (h > 0 there) and refined
-/// in its sign change; h > 0 above it, so it is stable when the sag acts (dW/dt ∝ −h) even
-/// where, at its voltage held fixed, it is the amplitude map's unstable middle root, which
-/// the other routes never take (the review of stop 32: 150 Ω, 380 N, 0.2 N·m, 150 V). No
-/// root above W = 0: the clamped stator at its own voltage, which a tiny amplitude does not
-/// start. `rise` [K]: the temperature rise. `None` where a step or trial has no finite value.
+/// The sagging drive's balance h(W) = W − Θ·V_e(W)/|Z(W)| at amplitude `w` [m] under the
+/// drive `d` (its set voltage): (h [m], the trial at W, the electrode voltage V_e [V]). The
+/// phase admittance Y = I/V depends on W only, through Z(W) ([`stator::phase_current_a`]),
+/// so V_e(W) = V_set/|1 + Z_src·Y(W)| needs no passes, and each h(W) is one trial.
+fn sag_balance(p: &Prepared, d: &Drive, op: &OperatingPoint, w: f64) -> (f64, Trial, f64) {
+    let t = trial(p, d, w, None, None);
+    let (ire, iim) = stator::phase_current_a(d.v, d.omega, p.c0, p.tan_d, p.theta, t.z);
+    let ve = sagged_voltage_at(p, op, (ire / d.v, iim / d.v));
+    (w - t.w_next * ve / d.v, t, ve)
+}
+
+/// Ratio of the downward scan of [`settle_on_amplitude`]. On a trum60a map at 150 Ω and
+/// 41 kHz (300-560 N × 0-1.4 N·m × 120-180 V) h dips below zero over 3-10 % of W between
+/// samples ×0.8 apart: at 41 of 24 000 points that scan missed the largest root (a lower
+/// one, 42 instead of 172 rpm); ×0.9 missed 9, ×0.97 none (against ×0.999), at the same
+/// map time.
+const SAG_SCAN_RATIO: f64 = 0.97;
+
+/// A sagging drive's steady state as the largest root of one scalar, h(W) = W −
+/// Θ·V_e(W)/|Z(W)| ([`sag_balance`]), for the points whose electrode-voltage passes and
+/// [`settle_lower_branch`] found none. A root satisfies both the amplitude map at its
+/// voltage and the sag at its amplitude. The largest root is found by stepping down from
+/// above the amplitude bound (h > 0 there, steps ×[`SAG_SCAN_RATIO`]) and refined in its sign
+/// change; h > 0 above it, so it is stable when the sag acts (dW/dt ∝ −h) even where, at
+/// its voltage held fixed, it is the amplitude map's unstable middle root, which the other
+/// routes never take (the review of stop 32: 150 Ω, 380 N, 0.2 N·m, 150 V). No root above
+/// W = 0: the clamped stator at its own voltage, which a tiny amplitude does not start.
+/// `rise` [K]: the temperature rise. `None` where a step or trial has no finite value.
 ///
-/// The descent's steps (×0.8, at most ~95 down to 1e-9 of the bound) can pass over a pair
-/// of roots closer than a step; the root then found is a lower one, still a steady state.
+/// A dip of h below zero narrower than a step can lie between two samples. Where a sample
+/// is a local minimum of the positive samples, the dip around it is searched
+/// ([`dip_below_zero`]); one whose minimum falls between samples without showing as a local
+/// minimum, narrower than about 3 % of W, is still passed over, and the root found is then
+/// a lower one, also a steady state.
 fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<Solution> {
     let mut d = Drive::at(p, op);
     if rise != 0.0 {
         d.warm(p, rise);
     }
-    let h = |w: f64| {
-        let t = trial(p, &d, w, None, None);
-        let (ire, iim) = stator::phase_current_a(d.v, d.omega, p.c0, p.tan_d, p.theta, t.z);
-        let ve = sagged_voltage_at(p, op, (ire / d.v, iim / d.v));
-        (w - t.w_next * ve / d.v, t, ve)
-    };
+    let h = |w: f64| sag_balance(p, &d, op, w);
     let bound = p.theta * d.v / (d.omega * d.c);
     // A partly reactive source can raise the electrode voltage above the set one: grow the
     // top until h > 0.
@@ -1422,8 +1436,10 @@ fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<S
     }
     let tiny = 1e-9 * bound;
     let mut lo = None;
+    // the sample above `hi`, once there is one
+    let mut above: Option<(f64, f64)> = None;
     while hi > tiny {
-        let w = (0.8 * hi).max(tiny);
+        let w = (SAG_SCAN_RATIO * hi).max(tiny);
         let e = h(w);
         let hw = e.0;
         if !hw.is_finite() {
@@ -1433,6 +1449,23 @@ fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<S
             lo = Some((w, e));
             break;
         }
+        if let Some((wa, ha)) = above {
+            if h_hi < ha && h_hi < hw {
+                if let Some(((wn, (_, en)), pos)) = dip_below_zero(
+                    |x| {
+                        let e = h(x);
+                        (e.0, e)
+                    },
+                    w,
+                    (wa, ha),
+                ) {
+                    lo = Some((wn, en));
+                    (hi, h_hi) = pos;
+                    break;
+                }
+            }
+        }
+        above = Some((hi, h_hi));
         (hi, h_hi) = (w, hw);
     }
     let Some((lo_w, lo_eval)) = lo else {
@@ -1468,6 +1501,53 @@ fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<S
     d.v = ve;
     let s = finish(p, &d, op, &t, if t.stalled { Status::Stall } else { Status::Ok }, evals);
     s.status.is_valid().then_some(s)
+}
+
+/// What [`dip_below_zero`] finds: (W, (h, payload)) with h ≤ 0, and (W, h) with h > 0 above it.
+type Dip<E> = ((f64, (f64, E)), (f64, f64));
+
+/// A dip of a scalar `h` below zero inside [a, b] (a < b, h > 0 at both ends, `b` = (b, h(b)),
+/// and at a sample between them lower than both; `h` returns its value and what came with
+/// it): golden-section search for the least h, stopped at the first h ≤ 0, at most 40
+/// evaluations, to a relative width of 1e-7. Returns the highest evaluation with h ≤ 0 and
+/// the lowest point above it with h > 0 (b at worst): the largest root of the dip lies
+/// between them. `None` when the least h found stays above 0.
+fn dip_below_zero<E: Clone>(h: impl Fn(f64) -> (f64, E), a: f64, b: (f64, f64)) -> Option<Dip<E>> {
+    const INV_PHI: f64 = 0.618_033_988_749_894_9;
+    let (top, mut a, mut b) = (b, a, b.0);
+    let mut seen: Vec<(f64, (f64, E))> = Vec::new();
+    let mut probe = |w: f64| {
+        let e = h(w);
+        let v = e.0;
+        seen.push((w, e));
+        v
+    };
+    let (mut x1, mut x2) = (b - INV_PHI * (b - a), a + INV_PHI * (b - a));
+    let (mut h1, mut h2) = (probe(x1), probe(x2));
+    for _ in 0..38 {
+        if h1 <= 0.0 || h2 <= 0.0 || b - a < 1e-7 * b || !(h1.is_finite() && h2.is_finite()) {
+            break;
+        }
+        if h1 < h2 {
+            (b, x2, h2) = (x2, x1, h1);
+            x1 = b - INV_PHI * (b - a);
+            h1 = probe(x1);
+        } else {
+            (a, x1, h1) = (x1, x2, h2);
+            x2 = a + INV_PHI * (b - a);
+            h2 = probe(x2);
+        }
+    }
+    // the highest point with h ≤ 0, and the lowest one above it with h > 0
+    let neg = seen.iter().filter(|x| x.1 .0 <= 0.0).max_by(|x, y| x.0.total_cmp(&y.0))?.clone();
+    let pos = seen.iter().filter(|x| x.0 > neg.0 && x.1 .0 > 0.0).map(|x| (x.0, x.1 .0)).fold(top, |m, x| {
+        if x.0 < m.0 {
+            x
+        } else {
+            m
+        }
+    });
+    Some((neg, pos))
 }
 
 /// Which solution-dependent inputs [`solve_effects`] iterates on at `op`: (the temperature
@@ -2852,6 +2932,44 @@ mod tests {
         let (ire, iim) = stator::phase_current_a(d.v, d.omega, p.c0, p.tan_d, p.theta, t.z);
         let ve = sagged_voltage_at(&p, &op, (ire / d.v, iim / d.v));
         assert!(t.w_next * ve / d.v < up, "W = {up} m at {ve} V maps to {} m", t.w_next * ve / d.v);
+    }
+
+    /// Where the passes find no state, a sagging drive takes the largest root of its balance
+    /// h(W) = W − Θ·V_e(W)/|Z(W)| (the upper-branch convention). A point of the trum60a map
+    /// at 150 Ω and 41 kHz (grid 300-560 N × 120-180 V: 458.6 N, 0 N·m, 166.7 V): there h
+    /// dips below zero at 3.45 µm over less than one step ×0.8, and the scan of stop 33
+    /// passed over it to a root at 1.35 µm, 31.9 rpm, where its neighbours at lower preload
+    /// run at 174-227 rpm. A dense scan (×0.999) finds no root above the answer.
+    #[test]
+    fn a_sagging_drive_takes_the_largest_root_of_its_balance() {
+        let op = OperatingPoint::new(300.0 + 260.0 * 36.0 / 59.0, 0.0, 120.0 + 60.0 * 7.0 / 9.0, 41_000.0);
+        let (p, op, s) = sagging_trum60a(150.0, op);
+        assert_eq!(s.status, Status::Ok, "{s:?}");
+        assert!((145.0..157.0).contains(&s.speed_rpm), "{s:?}");
+        assert!(fixed_point_problem(&p, &op, &s).is_none(), "{:?}", fixed_point_problem(&p, &op, &s));
+        let d = Drive::at(&p, &op);
+        let h = |w: f64| sag_balance(&p, &d, &op, w).0;
+        assert!(h(s.amplitude_m).abs() < 1e-6 * s.amplitude_m, "h = {} m at the answer", h(s.amplitude_m));
+        let mut w = p.theta * d.v / (d.omega * d.c);
+        while w > 1.0005 * s.amplitude_m {
+            assert!(h(w) > 0.0, "a root above the answer {} m: h({w}) = {}", s.amplitude_m, h(w));
+            w *= 0.999;
+        }
+    }
+
+    /// The dip search on a known function: h = 1 − 1.2·exp(−((w − 2)/0.02)²) is below zero
+    /// only within 2 ± 0.0085, far narrower than the samples around it (1.9 and 2.15); its
+    /// top root is bracketed. With 0.8 in place of 1.2 it has no root: `None`.
+    #[test]
+    fn the_dip_search_brackets_the_top_root_of_a_narrow_dip() {
+        let f = |depth: f64| move |w: f64| (1.0 - depth * (-((w - 2.0) / 0.02).powi(2)).exp(), ());
+        let h = f(1.2);
+        let ((neg, (hn, ())), (pos, hp)) = dip_below_zero(h, 1.9, (2.15, h(2.15).0)).expect("a dip below zero");
+        let root = 2.0 + 0.02 * 1.2f64.ln().sqrt();
+        assert!(hn <= 0.0 && hp > 0.0 && neg < root && root < pos, "[{neg}, {pos}] around {root}");
+        assert!((hp - h(pos).0).abs() == 0.0 && pos <= 2.15);
+        let shallow = f(0.8);
+        assert!(dip_below_zero(shallow, 1.9, (2.15, shallow(2.15).0)).is_none());
     }
 
     /// Every point of a sagging trum60a near resonance has a steady state that is a fixed
