@@ -468,6 +468,20 @@ fn chi2_excess(x: f64, n: usize) -> f64 {
     }
 }
 
+/// The fraction of what the single effect's entry `single` leaves beyond the noise on
+/// held-out data that the pair's entry `pair` removes: (in NRMSE, excess √(NRMSE² −
+/// noise²); in χ² per reading, the single's excess [`chi2_excess`] against the pair's plain
+/// √(χ² − 1)); 0 where the single leaves nothing beyond the noise. `pair_beats_single`
+/// asks for PAIR_GAIN in either.
+fn pair_gains(single: &RankEntry, pair: &RankEntry, n_read: usize, noise_nrmse: f64) -> (f64, f64) {
+    let excess = |x: f64| (x * x - noise_nrmse * noise_nrmse).max(0.0).sqrt();
+    let gain = |s: f64, p: f64| if s > 1e-12 { 1.0 - p / s } else { 0.0 };
+    (
+        gain(excess(single.heldout_nrmse_after), excess(pair.heldout_nrmse_after)),
+        gain(chi2_excess(single.heldout_chi2_after, n_read), (pair.heldout_chi2_after - 1.0).max(0.0).sqrt()),
+    )
+}
+
 /// What a pair must remove, summed over the readings, to beat the single `b` on held-out
 /// data by PAIR_GAIN of its excess beyond the noise (`pair_beats_single`): in Σ z² (the
 /// excess [`chi2_excess`] per reading) and in Σ e² (the excess √(NRMSE² − noise²)), each
@@ -1083,7 +1097,6 @@ pub fn diagnose(
     // truth may differ in form from the candidate and leave a remainder; and a gap only a
     // little above the noise can never lose half of its total NRMSE).
     let supported = |r: &RankEntry| r.evidence > 5.0 && r.shrink > 0.0 && r.shrink_interval.0 > 0.0;
-    let excess = |x: f64| (x * x - noise_nrmse * noise_nrmse).max(0.0).sqrt();
     // The noise of that last test: the weights' level, unless it puts the baseline's whole
     // held-out NRMSE inside the noise. On `combined` campaigns it is 3-4 × what noise alone
     // gives (`noise_best`), and a baseline with held-out χ² 5.4 per reading had no gap
@@ -1272,10 +1285,7 @@ pub fn diagnose(
             {
                 return false;
             }
-            let excess_chi2 = |x: f64| (x - 1.0).max(0.0).sqrt();
-            let gain = |s: f64, p: f64| if s > 1e-12 { 1.0 - p / s } else { 0.0 };
-            let gain_nrmse = gain(excess(single.heldout_nrmse_after), excess(bp.heldout_nrmse_after));
-            let gain_chi2 = gain(chi2_excess(single.heldout_chi2_after, n_read), excess_chi2(bp.heldout_chi2_after));
+            let (gain_nrmse, gain_chi2) = pair_gains(single, bp, n_read, noise_nrmse);
             let held = |name: &str| cv_preds.iter().find(|(n, _)| same_set(n, name)).map(|(_, p)| errors(rows, p, &sc));
             let (Some(hs), Some(hp)) = (held(&single.effect), held(&bp.effect)) else { return false };
             let real =
@@ -1925,12 +1935,13 @@ mod tests {
             heldout_in_sample_folds: 0,
         };
         let (chi2, e2) = held_out_need(&single, n, noise);
-        let pair_chi2 = single.heldout_chi2_after - chi2 / n as f64;
-        let pair_nrmse = (single.heldout_nrmse_after.powi(2) - e2 / n as f64).sqrt();
-        let gain = |s: f64, p: f64| 1.0 - p / s;
-        let g_chi2 = gain(chi2_excess(single.heldout_chi2_after, n), (pair_chi2 - 1.0).sqrt());
-        let excess = |x: f64| (x * x - noise * noise).sqrt();
-        let g_nrmse = gain(excess(single.heldout_nrmse_after), excess(pair_nrmse));
+        let pair = RankEntry {
+            effect: "radial_friction+voltage_sag".into(),
+            heldout_chi2_after: single.heldout_chi2_after - chi2 / n as f64,
+            heldout_nrmse_after: (single.heldout_nrmse_after.powi(2) - e2 / n as f64).sqrt(),
+            ..single.clone()
+        };
+        let (g_nrmse, g_chi2) = pair_gains(&single, &pair, n, noise);
         assert!((g_chi2 - PAIR_GAIN).abs() < 1e-12 && (g_nrmse - PAIR_GAIN).abs() < 1e-12, "{g_chi2} {g_nrmse}");
         // at the noise level nothing is left to gain
         let quiet = RankEntry { heldout_chi2_after: 0.8, heldout_nrmse_after: 0.1, ..single.clone() };
@@ -1938,8 +1949,44 @@ mod tests {
         // nor within two standard errors of the noise's mean z² (2·√(2/1000) = 0.089)
         let close = RankEntry { heldout_chi2_after: 1.085, heldout_nrmse_after: 0.1, ..single.clone() };
         assert_eq!(held_out_need(&close, n, noise), (0.0, 0.0));
-        let beyond = RankEntry { heldout_chi2_after: 1.095, heldout_nrmse_after: 0.1, ..single };
+        let beyond = RankEntry { heldout_chi2_after: 1.095, heldout_nrmse_after: 0.1, ..single.clone() };
         assert!(held_out_need(&beyond, n, noise).0 > 0.0);
+    }
+
+    /// `pair_beats_single`'s gains: a single within the noise tolerance leaves nothing to gain
+    /// in χ², however far below it the pair goes (the blind `hertz_softening` at 3 × typical,
+    /// 1.03 per reading at 679 readings, and `voltage_sag` polishing it to 0.90), while the
+    /// pair's own excess is never zeroed: a pair ending at 1.03 removes √0.03 less than all
+    /// of a single's excess of 2 (χ² 5). And the NRMSE gain is of the part beyond the noise.
+    #[test]
+    fn a_pair_gains_nothing_on_a_single_within_the_noise() {
+        let entry = |effect: &str, chi2: f64, nrmse: f64| RankEntry {
+            effect: effect.into(),
+            evidence: 100.0,
+            heldout_nrmse_after: nrmse,
+            heldout_chi2_after: chi2,
+            shrink: 0.5,
+            shrink_interval: (0.4, 0.6),
+            params: Vec::new(),
+            signature_match: None,
+            linear_chi2_drop: None,
+            signature_overlap: None,
+            heldout_in_sample_folds: 0,
+        };
+        let n = 679;
+        let within = entry("hertz_softening", 1.03, 0.05);
+        let polished = entry("hertz_softening+voltage_sag", 0.90, 0.05);
+        assert_eq!(pair_gains(&within, &polished, n, 0.05).1, 0.0);
+        let far = entry("hertz_softening", 5.0, 0.05);
+        let g = pair_gains(&far, &entry("hertz_softening+voltage_sag", 1.03, 0.05), n, 0.05).1;
+        assert!((g - (1.0 - 0.03f64.sqrt() / 2.0)).abs() < 1e-12, "{g}");
+        // NRMSE: 0.05 beyond a noise of 0.03 is an excess of 0.04; a pair at 0.0427 (excess
+        // 0.0222) removes 0.445 of it
+        let (gn, _) = pair_gains(&entry("a", 2.0, 0.05), &entry("a+b", 2.0, 0.0427), n, 0.03);
+        let expect = 1.0 - (0.0427f64.powi(2) - 0.0009).sqrt() / 0.04;
+        assert!((gn - expect).abs() < 1e-12, "{gn} vs {expect}");
+        // nothing beyond the noise: nothing to gain
+        assert_eq!(pair_gains(&entry("a", 2.0, 0.02), &entry("a+b", 2.0, 0.01), n, 0.03).0, 0.0);
     }
 
     #[test]
