@@ -24,7 +24,7 @@ def diagnose(
     ``motor`` is the nominal motor (a ``trum.Motor`` or a preset name); ``data`` a
     measurement CSV in the layout of shared/spec/measurements.md, as a path or as the
     file's bytes. Returns the JSON document of ``trum diagnose --json`` as a dict
-    (``verdict``, ``confounded_with``, ``gap``, ``ranking``, ``notes``, ...; method and
+    (``verdict``, ``confounded_with``, ``partial``, ``gap``, ``ranking``, ``notes``, ...; method and
     scales in docs/DIAGNOSIS.md). Columns the reader ignores are reported with
     ``warnings.warn``. A bad file, or data that cannot support a held-out test, raises
     ``trum.InputError`` naming the file, line and column. The GIL is released while it runs.
