@@ -21,6 +21,8 @@ def test_finds_the_injected_effect_and_says_how_far_the_gap_shrinks():
     d = trum.diagnose("trum60a", DATA)
     assert d["verdict"] == "eccentricity"
     assert d["confounded_with"] == []
+    # only an `unexplained` verdict names a partial explanation
+    assert "partial" in d and d["partial"] is None
     top = d["ranking"][0]
     assert top["effect"] == "eccentricity" and top["evidence"] > 5
     # held-out gap: the baseline misses far beyond the noise, the effect closes most of it
@@ -53,6 +55,7 @@ def test_matches_trum_diagnose_json():
     # the same core builds the same document; only float printing could differ
     assert cli.keys() == py.keys()
     assert cli["verdict"] == py["verdict"] and cli["confounded_with"] == py["confounded_with"]
+    assert cli["partial"] == py["partial"]
     assert [r["effect"] for r in cli["ranking"]] == [r["effect"] for r in py["ranking"]]
     for rc, rp in zip(cli["ranking"], py["ranking"]):
         assert rc["evidence"] == pytest.approx(rp["evidence"], rel=1e-12)
