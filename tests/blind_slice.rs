@@ -49,6 +49,10 @@ fn blind_slice_meets_the_issue_criteria() {
     assert!(sum.non_null >= 4, "too few visible cases to judge:\n{report}");
     assert!(sum.hit_rate >= 0.9, "hit rate {:.2} < 0.9:\n{report}", sum.hit_rate);
     assert_eq!(sum.false_claims, 0, "an effect was claimed on null data:\n{report}");
+    // a partial explanation is named with an `unexplained` verdict only
+    for o in &outcomes {
+        assert!(o.partial.is_none() || o.verdict == "unexplained", "{} with partial {:?}", o.verdict, o.partial);
+    }
     assert!(
         sum.median_true_excess_shrink >= 0.7,
         "median shrink beyond noise {:.2} < 0.7:\n{report}",

@@ -175,14 +175,19 @@ fn calibrate_writes_a_motor_file_that_point_reads() {
 }
 
 /// Seed 001 Table 2 (docs/DIAGNOSIS.md): `unexplained`. The JSON's `partial` is null or a
-/// supported ranked effect, and the summary's verdict line names it with its shrink.
+/// supported ranked effect, and the summary's and the report's verdict lines name it with
+/// its shrink. (Today it is `eccentricity`, supported by a hair: its shrink interval's
+/// lower end is just above zero, and moved there by rounding at stop 30; so either is
+/// accepted.)
 #[test]
 fn an_unexplained_verdict_names_what_explains_part_of_the_gap() {
     let dir = tempfile::tempdir().expect("tempdir");
     let json = path(dir.path(), "t2.json");
     let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/good/measurements/sun2021_table2.csv");
+    let html = path(dir.path(), "t2.html");
     let out = ok(&["diagnose", "--motor", "trum60-qut", "--data", data]);
-    ok(&["diagnose", "--motor", "trum60-qut", "--data", data, "--json", &json]);
+    ok(&["diagnose", "--motor", "trum60-qut", "--data", data, "--json", &json, "--report", &html]);
+    let report = std::fs::read_to_string(&html).expect("report");
     let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("JSON");
     assert_eq!(j["verdict"], "unexplained");
     let line = out.lines().find(|l| l.starts_with("verdict")).expect("verdict line");
@@ -192,10 +197,11 @@ fn an_unexplained_verdict_names_what_explains_part_of_the_gap() {
             assert!(entry["evidence"].as_f64().expect("evidence") > 5.0, "{entry}");
             assert!(entry["shrink_interval"][0].as_f64().expect("interval") > 0.0, "{entry}");
             assert!(line.contains(&format!("{p} explains part of it")), "{line}");
+            assert!(report.contains(&format!("{p} explains part of it")), "the report's verdict");
         }
         None => {
             assert!(j["partial"].is_null(), "{}", j["partial"]);
-            assert!(!line.contains("explains part"), "{line}");
+            assert!(!line.contains("explains part") && !report.contains("explains part"), "{line}");
         }
     }
 }

@@ -1097,14 +1097,15 @@ pub fn diagnose(
     // truth may differ in form from the candidate and leave a remainder; and a gap only a
     // little above the noise can never lose half of its total NRMSE).
     let supported = |r: &RankEntry| r.evidence > 5.0 && r.shrink > 0.0 && r.shrink_interval.0 > 0.0;
-    // The noise of that last test: the weights' level, unless it puts the baseline's whole
-    // held-out NRMSE inside the noise. On `combined` campaigns it is 3-4 × what noise alone
-    // gives (`noise_best`), and a baseline with held-out χ² 5.4 per reading had no gap
-    // "beyond the noise" for half of it to go: every supported effect closed it, so a
-    // `radial_friction` that closed 18 % was the verdict for a truth of preload
-    // stiffening (blind benchmark, seed 136). The best estimate stands in there; where
-    // the baseline is within even that, this test says nothing.
-    let gap_noise = if base_nrmse > noise_nrmse { noise_nrmse } else { noise_best };
+    // The noise of that last test is the best estimate of what noise alone gives
+    // (`noise_best`, the reported `noise_nrmse`), not the weights' level: on `combined`
+    // campaigns that is 3-4 × higher, often above the baseline's whole held-out NRMSE, and
+    // then there was no gap "beyond the noise" for half of it to go. Every supported effect
+    // closed it: a `radial_friction` that closed 18 % with χ² 4.2 per reading left was the
+    // verdict for a truth of preload stiffening (blind benchmark, seed 136). Just above that
+    // level the same test let a 1.4 % shrink close (a review's `thermal_drift` on
+    // `voltage_sag` data, χ² 8.1 left), so no switch between the two levels will do.
+    let gap_noise = noise_best;
     let beyond = |x: f64| (x * x - gap_noise * gap_noise).max(0.0).sqrt();
     let closes = |r: &RankEntry| {
         let before = beyond(base_nrmse);
@@ -1837,6 +1838,45 @@ mod tests {
         assert_eq!(d.verdict, "unexplained");
         assert_eq!(d.partial.as_deref(), Some("radial_friction"));
         assert!(d.notes.iter().any(|n| n.starts_with("radial_friction is supported")), "{:?}", d.notes);
+    }
+
+    /// Just above the weights' noise level the "half beyond the noise" test measured against
+    /// that level let almost any shrink close the gap (a review of stop 34): with the truth
+    /// left out of the candidates, `thermal_drift` closing 1.4 % of a `voltage_sag` gap (χ²
+    /// 8.1 per reading left) and `hertz_softening` closing 9 % of a `radial_friction` gap
+    /// (χ² 7.5 left) were verdicts. Against the best noise estimate neither closes it.
+    #[test]
+    fn an_effect_that_closes_a_sliver_of_the_gap_is_no_verdict() {
+        let nominal = preset("trum60a").expect("preset");
+        let cases = [
+            (Effect::VoltageSag, 150.0, Campaign::Combined, 1.0, 158, [Effect::RadialFriction, Effect::ThermalDrift]),
+            (
+                Effect::RadialFriction,
+                0.3,
+                Campaign::PreloadTorque,
+                0.5,
+                101,
+                [Effect::HertzSoftening, Effect::PreloadStiffening],
+            ),
+        ];
+        for (truth_effect, strength, campaign, noise, seed, candidates) in cases {
+            let mut truth = nominal.clone();
+            truth.effects.set_strength(truth_effect, strength);
+            let cfg = SynthConfig { campaign, noise, seed, ..SynthConfig::default() };
+            let synth = synthesize(&truth, &cfg).expect("synth");
+            let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
+            let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+            let opts = DiagnoseOptions {
+                candidates: candidates.to_vec(),
+                try_pairs: false,
+                bootstrap: 200,
+                ..DiagnoseOptions::default()
+            };
+            let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+            let best = &d.ranking[0];
+            assert!(best.shrink < 0.2 && best.heldout_chi2_after > 5.0, "{truth_effect:?}: {best:?}");
+            assert_eq!(d.verdict, "unexplained", "{truth_effect:?}: {:?}", d.ranking);
+        }
     }
 
     /// One motor measured at four drive voltages (preload-torque runs, radial friction in its
