@@ -18,6 +18,7 @@ pub mod dynamics;
 pub mod effects;
 pub mod error;
 pub mod fluctuation;
+mod golden;
 pub mod interface;
 pub mod losses;
 pub mod measurements;

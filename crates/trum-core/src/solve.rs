@@ -1518,12 +1518,12 @@ type Dip<E> = ((f64, (f64, E)), (f64, f64));
 
 /// A dip of a scalar `h` below zero about a sampled local minimum: `a` < `b` < `c` as (W, h)
 /// with h(b) > 0 below both h(a) and h(c) (`h` returns its value and what came with it).
-/// Golden-section search of that bracketing triple for the least h, stopped at the first
-/// h ≤ 0, at most 40 evaluations, to a relative width of 1e-7. `Ok(Some)`: the highest
-/// evaluation with h ≤ 0 and the lowest point above it with h > 0 (c at worst), between
-/// which the dip's largest root lies; `Ok(None)`: the least h found stays above 0; `Err`:
-/// a non-finite h. The search follows the triple's least point: a dip elsewhere in [a, c],
-/// narrower than the probes around it, is not found.
+/// Golden-section search of that bracketing triple for the least h ([`crate::golden`]),
+/// stopped at the first h ≤ 0, at most 40 evaluations, to a relative width of 1e-7.
+/// `Ok(Some)`: the highest evaluation with h ≤ 0 and the lowest point above it with h > 0
+/// (c at worst), between which the dip's largest root lies; `Ok(None)`: the least h found
+/// stays above 0; `Err`: a non-finite h. The search follows the triple's least point: a dip
+/// elsewhere in [a, c], narrower than the probes around it, is not found.
 #[allow(clippy::result_unit_err)]
 fn dip_below_zero<E: Clone>(
     h: impl Fn(f64) -> (f64, E),
@@ -1531,43 +1531,23 @@ fn dip_below_zero<E: Clone>(
     b: (f64, f64),
     c: (f64, f64),
 ) -> Result<Option<Dip<E>>, ()> {
-    const GOLD: f64 = 0.381_966_011_250_105_2;
-    let (mut a, mut b, mut c) = (a, b, c);
-    let mut seen: Vec<(f64, (f64, Option<E>))> = vec![(b.0, (b.1, None)), (c.0, (c.1, None))];
-    for _ in 0..40 {
-        if c.0 - a.0 < 1e-7 * c.0 {
-            break;
-        }
-        // probe the larger side of b at the golden fraction from b
-        let x = if c.0 - b.0 > b.0 - a.0 { b.0 + GOLD * (c.0 - b.0) } else { b.0 - GOLD * (b.0 - a.0) };
+    let mut seen: Vec<(f64, (f64, E))> = Vec::new();
+    let probe = |x: f64| {
         let e = h(x);
-        let hx = e.0;
-        if !hx.is_finite() {
-            return Err(());
-        }
-        seen.push((x, (hx, Some(e.1))));
-        if hx <= 0.0 {
-            break;
-        }
-        if hx < b.1 {
-            // x is the new least point
-            if x > b.0 {
-                (a, b) = (b, (x, hx));
-            } else {
-                (c, b) = (b, (x, hx));
-            }
-        } else if x > b.0 {
-            c = (x, hx);
-        } else {
-            a = (x, hx);
-        }
-    }
-    // the highest probe with h ≤ 0, and the lowest point above it with h > 0
-    let probes = seen.iter().filter_map(|(w, (hv, e))| e.as_ref().map(|e| (*w, *hv, e)));
-    let Some((wn, hn, en)) = probes.filter(|x| x.1 <= 0.0).max_by(|x, y| x.0.total_cmp(&y.0)) else {
-        return Ok(None);
+        let v = e.0;
+        seen.push((x, e));
+        v
     };
-    let en = en.clone();
+    let ((_, _, c), end) = crate::golden::minimise(probe, (a, b, c), 1e-7 * c.0, 40, |v| v <= 0.0);
+    let (wn, (hn, en)) = match end {
+        crate::golden::End::NonFinite => return Err(()),
+        crate::golden::End::Stopped(_) => {
+            // the probe that stopped it is the highest with h ≤ 0 (the only one)
+            seen.iter().rev().find(|x| x.1 .0 <= 0.0).cloned().ok_or(())?
+        }
+        _ => return Ok(None),
+    };
+    // the lowest point above it with h > 0: a probe, or the triple's top end
     let pos =
         seen.iter()
             .filter(|x| x.0 > wn && x.1 .0 > 0.0)
