@@ -1956,16 +1956,13 @@ mod tests {
         assert!(ecc.evidence < 3.0, "evidence {}", ecc.evidence);
     }
 
-    /// The held-out need is the pair that gains exactly PAIR_GAIN of the single's excess in
-    /// `pair_beats_single`'s terms: √(χ² − 1) and √(NRMSE² − noise²) per reading.
-    #[test]
-    fn the_held_out_need_is_a_pair_gain_of_exactly_a_third() {
-        let (n, noise) = (1000, 0.12);
-        let single = RankEntry {
-            effect: "radial_friction".into(),
+    /// A supported ranking entry with the given held-out χ² per reading and NRMSE.
+    fn ranked(effect: &str, chi2: f64, nrmse: f64) -> RankEntry {
+        RankEntry {
+            effect: effect.into(),
             evidence: 100.0,
-            heldout_nrmse_after: 0.2,
-            heldout_chi2_after: 40.0,
+            heldout_nrmse_after: nrmse,
+            heldout_chi2_after: chi2,
             shrink: 0.5,
             shrink_interval: (0.4, 0.6),
             params: Vec::new(),
@@ -1973,7 +1970,15 @@ mod tests {
             linear_chi2_drop: None,
             signature_overlap: None,
             heldout_in_sample_folds: 0,
-        };
+        }
+    }
+
+    /// The held-out need is the pair that gains exactly PAIR_GAIN of the single's excess in
+    /// `pair_beats_single`'s terms: √(χ² − 1) and √(NRMSE² − noise²) per reading.
+    #[test]
+    fn the_held_out_need_is_a_pair_gain_of_exactly_a_third() {
+        let (n, noise) = (1000, 0.12);
+        let single = ranked("radial_friction", 40.0, 0.2);
         let (chi2, e2) = held_out_need(&single, n, noise);
         let pair = RankEntry {
             effect: "radial_friction+voltage_sag".into(),
@@ -2000,19 +2005,7 @@ mod tests {
     /// of a single's excess of 2 (χ² 5). And the NRMSE gain is of the part beyond the noise.
     #[test]
     fn a_pair_gains_nothing_on_a_single_within_the_noise() {
-        let entry = |effect: &str, chi2: f64, nrmse: f64| RankEntry {
-            effect: effect.into(),
-            evidence: 100.0,
-            heldout_nrmse_after: nrmse,
-            heldout_chi2_after: chi2,
-            shrink: 0.5,
-            shrink_interval: (0.4, 0.6),
-            params: Vec::new(),
-            signature_match: None,
-            linear_chi2_drop: None,
-            signature_overlap: None,
-            heldout_in_sample_folds: 0,
-        };
+        let entry = ranked;
         let n = 679;
         let within = entry("hertz_softening", 1.03, 0.05);
         let polished = entry("hertz_softening+voltage_sag", 0.90, 0.05);
