@@ -812,7 +812,7 @@ pub fn diagnose(
     let opts = &DiagnoseOptions { exact_cv: opts.exact_cv || reduced, ..opts.clone() };
     let sc = scales(rows);
     // noise level as NRMSE, with the weights' noise levels
-    let noise_nrmse = {
+    let noise_weights = {
         let mut acc = 0.0;
         for r in rows {
             for &(o, _, s) in &r.readings {
@@ -1180,7 +1180,7 @@ pub fn diagnose(
                 best_single
                     .as_ref()
                     .filter(|b| single_closes && b.effect == lead.name())
-                    .map(|b| held_out_need(b, n_read, noise_nrmse))
+                    .map(|b| held_out_need(b, n_read, noise_weights))
             };
             let mut lead_starts: Vec<(Effect, Motor)> = Vec::new();
             let mut skipped_notes: Vec<String> = Vec::new();
@@ -1286,7 +1286,7 @@ pub fn diagnose(
             {
                 return false;
             }
-            let (gain_nrmse, gain_chi2) = pair_gains(single, bp, n_read, noise_nrmse);
+            let (gain_nrmse, gain_chi2) = pair_gains(single, bp, n_read, noise_weights);
             let held = |name: &str| cv_preds.iter().find(|(n, _)| same_set(n, name)).map(|(_, p)| errors(rows, p, &sc));
             let (Some(hs), Some(hp)) = (held(&single.effect), held(&bp.effect)) else { return false };
             let real =
@@ -1393,7 +1393,7 @@ pub fn diagnose(
         partial,
         baseline_heldout_nrmse: base_nrmse,
         noise_nrmse: noise_best,
-        noise_nrmse_weights: noise_nrmse,
+        noise_nrmse_weights: noise_weights,
         baseline_heldout_chi2_per_reading: base_z2,
         noise_scale,
         gap_where,
