@@ -54,7 +54,15 @@ pub fn effects(out: &mut dyn Write) -> Result<i32> {
             .enumerate()
             .map(|(j, p)| {
                 vec![
-                    format!("  {}{}", p.name, if j == 0 { " (strength)" } else { "" }),
+                    format!(
+                        "  {}{}",
+                        p.name,
+                        match (j, p.shape) {
+                            (0, _) => " (strength)",
+                            (_, true) => " (shape)",
+                            _ => "",
+                        }
+                    ),
                     format!("[{}, {}]", p.min, p.max),
                     format!("{}", p.typical),
                     squash(p.doc),

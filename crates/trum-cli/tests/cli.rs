@@ -340,10 +340,20 @@ fn effects_lists_the_registry() {
     let out = ok(&["effects"]);
     for e in trum_core::effects::EFFECTS.iter() {
         assert!(out.contains(e.name) && out.contains(e.source), "{}", e.name);
-        for p in e.params {
+        for (i, p) in e.params.iter().enumerate() {
             assert!(out.contains(p.name), "{}", p.name);
+            // the primary is marked a strength, a shape parameter as such
+            let tag = if i == 0 {
+                " (strength)"
+            } else if p.shape {
+                " (shape)"
+            } else {
+                ""
+            };
+            assert!(out.contains(&format!("  {}{tag} ", p.name)), "{}: {tag:?}", p.name);
         }
     }
+    assert!(out.contains("modal_fraction (shape)"));
 }
 
 #[test]

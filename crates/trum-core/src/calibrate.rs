@@ -244,7 +244,8 @@ pub fn effect_params(effect: Effect) -> Vec<FitParam> {
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let span = 8.0 * p.typical.abs();
+            // a strength within 8 × its typical value; a shape parameter over its whole range
+            let span = if p.shape { f64::INFINITY } else { 8.0 * p.typical.abs() };
             FitParam { param: ParamRef::Effect(effect, i), lo: p.min.max(-span), hi: p.max.min(span), log: false }
         })
         .collect()
@@ -1131,6 +1132,28 @@ pub(crate) mod tests {
         assert!(cal.warnings.is_empty(), "{:?}", cal.warnings);
     }
 
+    /// `preload_stiffening`'s shape parameter is identified: noise-free readings of a
+    /// blend of seed 001 eq. 8 and seed 002's modal projection (modal fraction 0.8) over
+    /// preloads from narrow to full contact and two frequencies give back the fraction and
+    /// the strength from the middle of the fraction's range (its start in a diagnosis).
+    #[test]
+    fn the_stiffening_forms_blend_is_recovered_from_its_readings() {
+        let e = Effect::PreloadStiffening;
+        let mut truth = preset("trum60a").unwrap();
+        truth.effects.set(e, &[0.2, 0.8]);
+        let ops = [100.0, 200.0, 300.0, 400.0, 500.0].into_iter().flat_map(|f| {
+            [(0.0, 43e3), (0.3, 43e3), (0.0, 44e3), (0.3, 44e3)].map(|(t, hz)| OperatingPoint::new(f, t, 200.0, hz))
+        });
+        let rows = rows_at(&truth, ops);
+        let mut start = truth.clone();
+        start.effects.set(e, &[0.1, e.info().params[1].start()]);
+        let params = effect_params(e);
+        assert_eq!((params[1].lo, params[1].hi), (0.0, 1.0), "a shape parameter spans its range");
+        let cal = calibrate(&start, &rows, &params, &FitOptions::default()).unwrap();
+        let (s, lam) = (cal.motor.effects.value(e, 0), cal.motor.effects.value(e, 1));
+        assert!((s / 0.2 - 1.0).abs() < 1e-3 && (lam - 0.8).abs() < 1e-3, "scale {s}, fraction {lam}");
+    }
+
     /// A fixed-weight fit keeps the weights it was given (no reweighting pass), refits to
     /// the weighted optimum from a perturbed start, and is the unweighted fit when the
     /// weights are all one; a weight vector of the wrong length is an input error.
@@ -1430,7 +1453,9 @@ pub(crate) mod tests {
             let mut m = preset("trum60a").unwrap();
             let mut params = Vec::new();
             if let Some(e) = e {
-                let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
+                // (a shape parameter mid-range: on its bound the transformed column vanishes)
+                let typical: Vec<f64> =
+                    e.info().params.iter().map(|p| if p.shape { p.start() } else { p.typical }).collect();
                 m.effects.set(e, &typical);
             }
             // every observable read at `op`, 1 % and 0.01 off the model

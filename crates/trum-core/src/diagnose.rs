@@ -633,7 +633,7 @@ fn strong_start(motor: &Motor, effects: &[Effect], params: &[FitParam], times: f
             .iter()
             .enumerate()
             .map(|(i, p)| {
-                let x = times * p.typical;
+                let x = if p.shape { p.start() } else { times * p.typical };
                 match params.iter().find(|fp| matches!(fp.param, ParamRef::Effect(f, j) if f == e && j == i)) {
                     Some(fp) => {
                         let margin = 0.05 * (fp.hi - fp.lo);
@@ -650,6 +650,27 @@ fn strong_start(motor: &Motor, effects: &[Effect], params: &[FitParam], times: f
         m.effects.set(e, &v);
     }
     m
+}
+
+/// `start` with the shape parameters of the `added` effects at their typical values, or
+/// `None` when none has a shape parameter away from it.
+fn at_typical_shape(start: &Motor, added: &[Effect]) -> Option<Motor> {
+    let mut m = start.clone();
+    let mut moved = false;
+    for &e in added {
+        for (i, p) in e.info().params.iter().enumerate().filter(|(_, p)| p.shape) {
+            if m.effects.value(e, i) != p.typical {
+                *m.effects.value_mut(e, i) = p.typical;
+                moved = true;
+            }
+        }
+    }
+    moved.then_some(m)
+}
+
+/// True when `fp` is a shape parameter of one of the `added` effects.
+fn is_shape_of(fp: &FitParam, added: &[Effect]) -> bool {
+    matches!(fp.param, ParamRef::Effect(e, i) if added.contains(&e) && e.info().params[i].shape)
 }
 
 /// Start point and parameters of a fit: bounds around the nominal `motor`, starting from
@@ -684,7 +705,7 @@ fn fit_params(
                 .params
                 .iter()
                 .enumerate()
-                .map(|(i, p)| if i == 0 { info.fit_start * p.typical } else { p.typical })
+                .map(|(i, p)| if i == 0 { info.fit_start * p.typical } else { p.start() })
                 .collect();
             m.effects.set(e, &start);
         }
@@ -949,11 +970,36 @@ pub fn diagnose(
         let added = if nested.is_some() { &effects[1..] } else { effects };
         // a pair led by a fitted single starts at that fit's optimum (a parameter within
         // 1e-3 of a bound moved to 1e-3 from it, `calibrate::fit`)
-        let mut cal = if nested.is_some() {
-            calibrate_nested(&s0, rows, &params, &opts.fit, added, Start::Extending(IRLS_START_RTOL))
-        } else {
-            calibrate_adding(&s0, rows, &params, &opts.fit, added)
+        let first = |s: &Motor| {
+            if nested.is_some() {
+                calibrate_nested(s, rows, &params, &opts.fit, added, Start::Extending(IRLS_START_RTOL))
+            } else {
+                calibrate_adding(s, rows, &params, &opts.fit, added)
+            }
         };
+        let mut cal = first(&s0);
+        // An added effect with a shape parameter is fitted from a second first start too,
+        // the shape at its typical value (on its bound: `preload_stiffening` by seed 001
+        // eq. 8 alone, moved just inside by the fit), and the better fit is kept. From the
+        // shape's middle alone, fits of a wrong stiffening were pushed onto zero strength
+        // where the typical shape finds a valley (1000-row radial-friction benchmark: evidence
+        // 26 453 from the typical shape, collapsed from the middle), and a shape the data
+        // want away from the typical one is reached from the middle (blind benchmark).
+        if let Some(typical_shape) = at_typical_shape(&s0, added) {
+            // the shape held (not fitted: a free shape column on its bound still changed the
+            // path enough to collapse), then freed from that fit's optimum
+            let held: Vec<FitParam> = params.iter().filter(|fp| !is_shape_of(fp, added)).cloned().collect();
+            let alt = match calibrate_adding(&typical_shape, rows, &held, &opts.fit, added) {
+                Ok(c) if !c.abandoned => {
+                    calibrate_nested(&c.motor, rows, &params, &opts.fit, added, Start::Extending(IRLS_START_RTOL))
+                }
+                other => other,
+            };
+            let fitted = |c: &Result<Calibration, _>| c.as_ref().ok().filter(|c| !c.abandoned).map(|c| c.chi2);
+            if fitted(&alt).is_some_and(|a| fitted(&cal).is_none_or(|c| a < c)) {
+                cal = alt;
+            }
+        }
         // The second start is needed only when the first did not reach the noise level and
         // found no clear evidence (a supported effect is not rejected for a shallower valley).
         // A first fit that collapsed onto the nested model (or ended next to it,
@@ -969,7 +1015,13 @@ pub fn diagnose(
         if second_start {
             let mut s1 = motor.clone();
             for &e in effects {
-                let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
+                let typical: Vec<f64> = e
+                    .info()
+                    .params
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| if i == 0 { p.typical } else { p.start() })
+                    .collect();
                 s1.effects.set(e, &typical);
             }
             if let Ok(c1) = calibrate_nested(&s1, rows, &params, &opts.fit, added, Start::Restart) {
@@ -1807,7 +1859,8 @@ mod tests {
     /// χ² 4.2 per reading left of 5.4, was the verdict for a truth of preload stiffening
     /// (blind benchmark, 1 × typical, half noise, seed 136). With the best noise level in
     /// that test nothing closes the gap: `unexplained`, and the supported effect is named as
-    /// the part it explains.
+    /// the part it explains. (The truth is left out of the candidates: since stop 35 the
+    /// `preload_stiffening` candidate spans the truth form's projection and closes the gap.)
     #[test]
     fn a_gap_inside_the_weights_noise_is_not_closed_by_every_effect() {
         let nominal = preset("trum60a").expect("preset");
@@ -1818,7 +1871,7 @@ mod tests {
         let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
         let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
         let opts = DiagnoseOptions {
-            candidates: vec![Effect::RadialFriction, Effect::PreloadStiffening],
+            candidates: vec![Effect::RadialFriction],
             try_pairs: false,
             bootstrap: 200,
             ..DiagnoseOptions::default()

@@ -23,6 +23,22 @@ pub struct EffectParam {
     pub min: f64,
     /// Largest valid value.
     pub max: f64,
+    /// A shape parameter, not a strength: strength factors (`NAME=STRENGTH`, "3 × typical")
+    /// leave it at its typical value, and a fit spans its whole range from the middle.
+    pub shape: bool,
+}
+
+impl EffectParam {
+    /// Where a fit or a sensitivity probe places a further (non-primary) parameter: its
+    /// typical value, or the middle of its range for a shape parameter (whose typical value
+    /// may sit on a bound, where a fit's transformed gradient vanishes).
+    pub fn start(&self) -> f64 {
+        if self.shape {
+            0.5 * (self.min + self.max)
+        } else {
+            self.typical
+        }
+    }
 }
 
 /// Registry entry of one effect.
@@ -84,6 +100,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
             typical: 1.0,
             min: 0.0,
             max: 3.0,
+            shape: false,
         }],
         fit_start: 0.5,
     },
@@ -92,13 +109,26 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         summary: "the pressed friction layer adds stiffness to the stator mode: resonance moves up \
                   and amplitude changes with preload",
         source: "seed 001 eq. 8 and 14; seed 002 section 5.3",
-        params: &[EffectParam {
-            name: "stiffness_scale",
-            doc: "multiplier of the contact stiffness of seed 001 eq. 8 added to the mode [-]",
-            typical: 0.05,
-            min: 0.0,
-            max: 5.0,
-        }],
+        params: &[
+            EffectParam {
+                name: "stiffness_scale",
+                doc: "multiplier of the contact stiffness added to the mode [-]",
+                typical: 0.05,
+                min: 0.0,
+                max: 5.0,
+                shape: false,
+            },
+            EffectParam {
+                name: "modal_fraction",
+                doc: "how the pressure becomes modal stiffness [-]: 0 the axial force over the \
+                      amplitude (seed 001 eq. 8), 1 its projection on the mode shape (seed 002 \
+                      section 5.3), between a blend of the two",
+                typical: 0.0,
+                min: 0.0,
+                max: 1.0,
+                shape: true,
+            },
+        ],
         fit_start: 0.5,
     },
     EffectInfo {
@@ -113,6 +143,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 typical: 1.0e18,
                 min: 0.0,
                 max: 1.0e23,
+                shape: false,
             },
             EffectParam {
                 name: "preload_gain_per_n",
@@ -120,6 +151,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 typical: 0.004,
                 min: 0.0,
                 max: 1.0,
+                shape: false,
             },
         ],
         fit_start: 0.5,
@@ -137,6 +169,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 typical: -4.0e-4,
                 min: -0.05,
                 max: 0.05,
+                shape: false,
             },
             EffectParam {
                 name: "friction_coefficient_per_k",
@@ -144,6 +177,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 typical: -2.0e-3,
                 min: -0.05,
                 max: 0.05,
+                shape: false,
             },
             EffectParam {
                 name: "damping_coefficient_per_k",
@@ -152,6 +186,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 typical: 2.0e-3,
                 min: -0.05,
                 max: 0.05,
+                shape: false,
             },
         ],
         fit_start: 0.5,
@@ -167,6 +202,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
             typical: 150.0,
             min: 0.0,
             max: 1.0e5,
+            shape: false,
         }],
         fit_start: 0.5,
     },
@@ -181,6 +217,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
             typical: 20.0e-6,
             min: 0.0,
             max: 1.0e-3,
+            shape: false,
         }],
         fit_start: 0.5,
     },
@@ -195,6 +232,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
             typical: 1.0,
             min: 0.0,
             max: 20.0,
+            shape: false,
         }],
         // Weak: from half its typical strength a fit can stick in a basin beyond a barrier
         // from zero, neither fitting the data nor reaching the baseline it nests (on the
