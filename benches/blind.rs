@@ -1,13 +1,14 @@
-//! The blind benchmark of `trum diagnose` (issue 5): every effect × two strengths × two
-//! noise levels × two campaign kinds, null cases and two-effect cases, each synthesised
-//! with `trum synth` (truth forms) and diagnosed without being told the effect.
+//! The blind benchmark of `trum diagnose` (issue 5): every effect × three strengths (0.3,
+//! 1 and 3 × typical) × two noise levels × two campaign kinds, null cases and two-effect
+//! cases, each synthesised with `trum synth` (truth forms) and diagnosed without being
+//! told the effect.
 //!
 //! `cargo bench --bench blind` runs all cases (7 s wall on 2 cores at stop 32, after the build) and
 //! rewrites the confusion matrix in docs/DIAGNOSIS.md (between the `blind:begin` and
 //! `blind:end` markers) and the per-case table docs/data/blind_cases.csv.
 //! `cargo bench --bench blind -- --slice` runs only the test suite's slice, `--strong` its
-//! strong-effect cases, `--factors 3` the full run's single effects at 3 × typical
-//! strength, `--seed-offset 1000` the full run with every seed moved by 1000 (these print
+//! strong-effect cases, `--factors 0.3,1` the full run's design with the
+//! single effects at those strengths only (as before stop 35), `--seed-offset 1000` the full run with every seed moved by 1000 (these print
 //! only); `--no-write`
 //! prints without touching the docs; `--signals` prints only each case's signal χ² and the χ²
 //! the candidate forms leave on the truth forms' noise-free readings;
@@ -47,7 +48,8 @@ fn main() {
     let mut cases = match (&factors, slice, strong) {
         (_, _, true) => blind::strong_cases(),
         (_, true, _) => blind::slice_cases(),
-        (f, _, _) => blind::cases_at(f.as_deref().unwrap_or(&blind::FACTORS), seed_offset),
+        (Some(f), _, _) => blind::cases_at(f, seed_offset),
+        (None, _, _) => blind::full_cases_at(seed_offset),
     };
     // `--only NAME`: the cases whose injected set contains NAME (`+` for the pairs)
     if let Some(only) = args.iter().position(|a| a == "--only").and_then(|i| args.get(i + 1)) {
@@ -126,6 +128,16 @@ fn main() {
         sum.median_true_excess_shrink,
         sum.median_oracle_shrink
     );
+    let strengths: Vec<String> = blind::by_strength(&outcomes)
+        .iter()
+        .map(|(f, hits, n, shrink, oracle)| {
+            format!(
+                "{f} × typical: {:.0} % of {n}, median shrink {shrink:.2} (true motor {oracle:.2})",
+                100.0 * *hits as f64 / (*n).max(1) as f64
+            )
+        })
+        .collect();
+    let summary = format!("{summary}* by strength (pairs at 1 ×): {}\n", strengths.join("; "));
     println!("{table}\n{summary}");
     if write {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
