@@ -496,15 +496,20 @@ fn preset_toml(py: Python<'_>, name: &str) -> PyResult<String> {
     presets::find(name).map(|p| p.to_toml()).map_err(|e| param_err(py, &e))
 }
 
-type EffectRow = (&'static str, &'static str, &'static str, Vec<(&'static str, &'static str, f64, f64, f64)>);
+type EffectRow = (&'static str, &'static str, &'static str, Vec<(&'static str, &'static str, f64, f64, f64, bool)>);
 
-/// `(name, summary, source, [(param, doc, typical, min, max)])` of every effect.
+/// `(name, summary, source, [(param, doc, typical, min, max, shape)])` of every effect.
 #[pyfunction]
 fn effects_list() -> Vec<EffectRow> {
     EFFECTS
         .iter()
         .map(|e| {
-            (e.name, e.summary, e.source, e.params.iter().map(|p| (p.name, p.doc, p.typical, p.min, p.max)).collect())
+            (
+                e.name,
+                e.summary,
+                e.source,
+                e.params.iter().map(|p| (p.name, p.doc, p.typical, p.min, p.max, p.shape)).collect(),
+            )
         })
         .collect()
 }

@@ -101,6 +101,17 @@ def test_registries():
     assert "preset 'trum60a'" in trum.preset_toml("trum60a")
     fx = {e.name: e for e in trum.effects()}
     assert fx["radial_friction"].params[0].name == "radial_velocity_ratio"
+    # preload_stiffening's second parameter is a shape, not a strength, as `trum effects` says
+    ps = fx["preload_stiffening"].params
+    assert [(p.name, p.shape) for p in ps] == [("stiffness_scale", False), ("modal_fraction", True)]
+    assert (ps[1].typical, ps[1].min, ps[1].max) == (0.0, 0.0, 1.0)
+    # NAME=STRENGTH keeps seed 001 eq. 8 (fraction 0) bit for bit; the modal projection differs
+    speed = lambda spec: trum.Motor("trum60a").with_effects(spec).solve(
+        preload_n=400.0, voltage_v=200.0, frequency_hz=43e3
+    ).speed_rpm.tolist()
+    eq8 = speed("preload_stiffening:stiffness_scale=0.5,modal_fraction=0")
+    assert speed("preload_stiffening=0.5") == eq8
+    assert speed("preload_stiffening:stiffness_scale=0.5,modal_fraction=1") != eq8
     q = trum.quantities()
     assert [x.name for x in q] == list(trum.QUANTITY_NAMES) and q[0].name == "speed_rpm" and q[0].unit == "rpm"
     assert [p.key for p in trum.parameters()] == trum.Motor("trum60a").keys()

@@ -15,13 +15,19 @@ class PresetInfo(NamedTuple):
 
 
 class EffectParam(NamedTuple):
-    """One strength parameter of an effect (name carries its unit)."""
+    """One parameter of an effect (name carries its unit).
+
+    ``shape`` marks a shape parameter, not a strength (``preload_stiffening``'s
+    ``modal_fraction``): ``NAME=STRENGTH`` leaves it at ``typical``, and the diagnosis
+    fits it over ``[min, max]``.
+    """
 
     name: str
     doc: str
     typical: float
     min: float
     max: float
+    shape: bool = False
 
 
 class EffectInfo(NamedTuple):
