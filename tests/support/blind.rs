@@ -413,7 +413,8 @@ pub fn by_strength(outcomes: &[Outcome]) -> Vec<(f64, usize, usize, f64, f64)> {
 }
 
 /// The full benchmark's cases with the single effects at `factors` × typical strength
-/// (`cargo bench --bench blind -- --factors 3`: the strong-effect run of docs/DIAGNOSIS.md)
+/// (`cargo bench --bench blind -- --factors 0.3,1`: the two-strength design of stop 34;
+/// `--factors 3`: the strong-effect run of stop 33, docs/DIAGNOSIS.md)
 /// and every seed moved by `seed_offset` (`--seed-offset 1000`: another draw of the same
 /// design).
 pub fn cases_at(factors: &[f64], seed_offset: u64) -> Vec<Case> {

@@ -622,7 +622,8 @@ fn added_near_zero(params: &[FitParam], fitted: &[FittedParam], added: &[Effect]
 const PROBE_LEFT: f64 = 0.1;
 
 /// The nominal `motor` with `effects` at `times` × their typical strengths (every
-/// parameter), each kept a twentieth of its fit range inside its bounds in `params`:
+/// strength; a shape parameter mid-range), each kept a twentieth of its fit range inside
+/// its bounds in `params`:
 /// the starts probed for a strong effect in the diagnosis.
 fn strong_start(motor: &Motor, effects: &[Effect], params: &[FitParam], times: f64) -> Motor {
     let mut m = motor.clone();
@@ -952,8 +953,12 @@ pub fn diagnose(
         .collect();
     if !turning.is_empty() {
         let pb = Prepared::new(&base_cal.motor);
-        let at_rest =
-            turning.iter().filter(|r| solve_prepared(&pb, &base_cal.motor, &r.op, None).status != Status::Ok).count();
+        let at_rest = turning
+            .iter()
+            .filter(|r| {
+                matches!(solve_prepared(&pb, &base_cal.motor, &r.op, None).status, Status::Stall | Status::Clamped)
+            })
+            .count();
         if at_rest == turning.len() {
             notes.push(format!(
                 "the calibrated baseline has the rotor at rest (clamped or stalled) at all {at_rest} operating \
@@ -963,8 +968,13 @@ pub fn diagnose(
             ));
         }
     }
-    let base_sigs: BTreeMap<Effect, signature::Signature> =
-        probed.into_iter().filter(|(e, _)| !untestable.contains(e)).filter_map(|(e, s)| s.map(|s| (e, s))).collect();
+    // (a zero probe, of an effect testable only at the nominal motor, is no signature: its
+    // match, score and overlap are not reported as zeros)
+    let base_sigs: BTreeMap<Effect, signature::Signature> = probed
+        .into_iter()
+        .filter(|(e, _)| !untestable.contains(e))
+        .filter_map(|(e, s)| s.filter(|s| s.columns.iter().any(|&x| x != 0.0)).map(|s| (e, s)))
+        .collect();
     let single_sig = |effects: &[Effect]| match effects {
         [e] => base_sigs.get(e),
         _ => None,

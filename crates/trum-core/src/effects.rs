@@ -23,8 +23,9 @@ pub struct EffectParam {
     pub min: f64,
     /// Largest valid value.
     pub max: f64,
-    /// A shape parameter, not a strength: strength factors (`NAME=STRENGTH`, "3 × typical")
-    /// leave it at its typical value, and a fit spans its whole range from the middle.
+    /// A shape parameter, not a strength: `NAME=STRENGTH` and a motor-file table that
+    /// leaves it out keep its typical value, and the diagnosis fits it over its whole range
+    /// from the middle (and probes it there).
     pub shape: bool,
 }
 
@@ -478,6 +479,14 @@ impl Effects {
                             num(x).ok_or_else(|| err("expected a number".into(), format!("effects.{name}.{k}")))?;
                         seen[idx] = true;
                     }
+                    // a shape parameter left out keeps its typical value (files written before
+                    // `preload_stiffening` had one stay valid, with seed 001 eq. 8); a strength
+                    // left out is an error
+                    for ((p, x), s) in info.params.iter().zip(v.iter_mut()).zip(seen.iter_mut()) {
+                        if p.shape && !*s {
+                            (*x, *s) = (p.typical, true);
+                        }
+                    }
                     if let Some(i) = seen.iter().position(|s| !s) {
                         return Err(err(
                             format!("missing parameter '{}' ({})", info.params[i].name, info.params[i].doc),
@@ -609,5 +618,28 @@ mod tests {
         assert_eq!(fx.to_string(), "radial_friction(radial_velocity_ratio=0.3) + thermal_drift(stiffness_coefficient_per_k=-0.0001, friction_coefficient_per_k=0, damping_coefficient_per_k=0.002)");
         fx.parse_assignment("none").unwrap();
         assert!(fx.is_none());
+    }
+
+    /// A motor file's effect table may leave out a shape parameter (files written before
+    /// `preload_stiffening` had `modal_fraction` stay valid, with seed 001 eq. 8), not a
+    /// strength; `to_toml` writes every parameter and reads back the same.
+    #[test]
+    fn a_table_may_leave_out_a_shape_parameter_not_a_strength() {
+        let read = |text: &str| {
+            let t: toml::Table = text.parse().expect("toml");
+            let fx = t.get("effects").and_then(|v| v.as_table()).expect("[effects]");
+            Effects::from_toml_table(fx, text, "m.toml")
+        };
+        let fx = read("[effects]\npreload_stiffening = { stiffness_scale = 0.1 }\n").expect("valid");
+        assert_eq!(fx.get(Effect::PreloadStiffening), Some(&[0.1, 0.0][..]));
+        let back = read(&fx.to_toml()).expect("round trip");
+        assert_eq!(back, fx);
+        let err =
+            read("[effects]\nthermal_drift = { stiffness_coefficient_per_k = 1e-4, friction_coefficient_per_k = 0 }\n")
+                .unwrap_err()
+                .to_string();
+        assert!(err.contains("missing parameter 'damping_coefficient_per_k'"), "{err}");
+        let err = read("[effects]\npreload_stiffening = { modal_fraction = 1 }\n").unwrap_err().to_string();
+        assert!(err.contains("missing parameter 'stiffness_scale'"), "{err}");
     }
 }

@@ -2657,8 +2657,10 @@ mod tests {
 
     /// `stiffness_crossing`, which both the solver's spike probe and `amplitude_branches`'
     /// dense scan rely on, checked on its own: where it reports an amplitude the elastic
-    /// detuning Re Z (friction left out) changes sign within 1e-6 of it in W (Re Z carries
-    /// rounding of ~10 N/m, 1e-8 of the stiffness), and where it reports none
+    /// detuning Re Z (friction left out) changes sign within 1e-6 of it in W, or is there
+    /// within the search's stop, 1e-8 of m·ω² (Re Z carries rounding of ~10 N/m; where Re Z
+    /// is flat that stop is a few 1e-6 in W: 1.5e-6 at trum60a, truth-form stiffening and
+    /// softening, 435 N, 147 V, 44.92 kHz), and where it reports none
     /// Re Z keeps one sign over a fine scan of (1e-9·top, top). Every configuration of
     /// the multi-branch test, random drives and preloads.
     #[test]
@@ -2682,7 +2684,8 @@ mod tests {
                         found += 1;
                         let (a, b) =
                             (elastic_detuning(&p, &d, w * (1.0 - 1e-6)), elastic_detuning(&p, &d, w * (1.0 + 1e-6)));
-                        assert!(a >= 0.0 && b <= 0.0, "{name} {fx} {op:?}: Re Z {a:e}, {b:e} about {w:e} m");
+                        let at = elastic_detuning(&p, &d, w).abs() <= 1e-8 * p.m * d.omega * d.omega;
+                        assert!((a >= 0.0 && b <= 0.0) || at, "{name} {fx} {op:?}: Re Z {a:e}, {b:e} about {w:e} m");
                     }
                     None => {
                         none += 1;
@@ -3120,9 +3123,12 @@ mod tests {
         assert!(s.amplitude_m < 2.9e-6, "{s:?}");
     }
 
-    const MULTI_BRANCH_CONFIGS: [(&str, &str, bool); 10] = [
+    const MULTI_BRANCH_CONFIGS: [(&str, &str, bool); 12] = [
         ("generic60", "preload_stiffening=0.504", false),
         ("trum60a", "preload_stiffening=1", false),
+        // the candidate's other forms: seed 002's projection, and a blend
+        ("generic60", MODAL_3_3, false),
+        ("trum60a", "preload_stiffening:stiffness_scale=1,modal_fraction=0.5", false),
         ("trum60a", "hertz_softening=1e18", false),
         ("generic60", "hertz_softening=3e17", false),
         ("generic60", "preload_stiffening=3.3", true),

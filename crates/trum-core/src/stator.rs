@@ -148,7 +148,7 @@ mod tests {
     /// (c ≤ 0.5, φ0 ≥ 60°, where the bench campaigns of trum60a run; 1.0e-4 at most today,
     /// at −0.8 and −1.1, where the outer strips reach full contact), and it differs in form
     /// from every blend of seed 001 eq. 8 and the modal projection (the strips reach full
-    /// contact one by one): 2.2 % today, at λ = 1.
+    /// contact one by one): by 3.5 % at best today, at λ = 1.
     #[test]
     fn the_width_integrated_projection_is_its_two_dimensional_integral() {
         let exact = |c: f64| {
@@ -170,19 +170,22 @@ mod tests {
             let (g, e) = (width_integrated_modal_projection(c), exact(c));
             assert!((g / e - 1.0).abs() < 5e-4, "c = {c}: rule {g}, integral {e}");
         }
-        // no blend s·[(1 − λ)·χ + λ·M] matches it at both a wide partial and a full contact
-        // and in between: the best λ on two of the points misses the third
+        // no blend s·[(1 − λ)·χ + λ·M] follows it from a wide partial to a full contact: for
+        // each λ the scale s that minimises the largest relative miss over the points (the
+        // ratios' midrange) still misses by 3.5 % (at λ = 1)
         let m = |c: f64| if c <= -1.0 { PI } else { modal_projection(c.acos(), c) };
         let chi = |c: f64| if c <= -1.0 { -2.0 * PI * c } else { 2.0 * (c.acos().sin() - c.acos() * c) };
         let t = width_integrated_modal_projection;
-        let mut worst = 0.0_f64;
-        for lam in (0..=100).map(|i| i as f64 / 100.0) {
-            let b = |c: f64| (1.0 - lam) * chi(c) + lam * m(c);
-            let s = t(-1.2) / b(-1.2);
-            let miss = [0.3, -0.5, -0.95].iter().map(|&c| (s * b(c) / t(c) - 1.0).abs()).fold(0.0, f64::max);
-            worst = if lam == 0.0 { miss } else { worst.min(miss) };
-        }
-        assert!(worst > 0.01, "a blend follows the truth form within {worst}");
+        let best = (0..=100)
+            .map(|i| {
+                let lam = i as f64 / 100.0;
+                let ratios =
+                    [0.5, 0.3, 0.0, -0.5, -0.95, -1.2, -1.5].map(|c| ((1.0 - lam) * chi(c) + lam * m(c)) / t(c));
+                let (lo, hi) = ratios.iter().fold((f64::INFINITY, 0.0_f64), |(l, h), &r| (l.min(r), h.max(r)));
+                (hi - lo) / (hi + lo)
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(best > 0.03, "a blend follows the truth form within {best}");
     }
 
     #[test]

@@ -71,7 +71,8 @@ pub(crate) fn signature(cal: &Calibration, rows: &[ObservedRow], e: Effect) -> O
     }
     let j = &cal.lin.jacobian;
     let st = &s - j * (pseudo_inverse(&(j.transpose() * j)) * (j.transpose() * &s));
-    let (linear_chi2_drop, linear_change) = one_sided_drop(&st, r, info.params[0].min >= 0.0);
+    let shape: Vec<bool> = info.params.iter().map(|p| p.shape).collect();
+    let (linear_chi2_drop, linear_change) = one_sided_drop(&st, r, info.params[0].min >= 0.0, &shape);
     let s0 = st.column(0);
     let denom = s0.norm() * r.norm();
     let matched = if denom > 0.0 { -s0.dot(r) / denom } else { 0.0 };
@@ -85,7 +86,8 @@ pub(crate) fn signature(cal: &Calibration, rows: &[ObservedRow], e: Effect) -> O
 /// the other columns remove anything (nothing for a one-parameter effect). Without the
 /// bound a fit would be screened in on a residual only a negative strength removes, and
 /// collapse onto the model it nests.
-fn one_sided_drop(st: &DMatrix<f64>, r: &DVector<f64>, bounded: bool) -> (f64, DVector<f64>) {
+/// A shape column (`shape[i]`) changes nothing at zero strength, so on a₀ = 0 it goes too.
+fn one_sided_drop(st: &DMatrix<f64>, r: &DVector<f64>, bounded: bool, shape: &[bool]) -> (f64, DVector<f64>) {
     // (drop, change, a₀) of the least-squares a over the columns `s`
     let drop = |s: &DMatrix<f64>| -> (f64, DVector<f64>, f64) {
         if s.ncols() == 0 {
@@ -98,7 +100,10 @@ fn one_sided_drop(st: &DMatrix<f64>, r: &DVector<f64>, bounded: bool) -> (f64, D
     };
     let (full, change, a0) = drop(st);
     if bounded && a0 < 0.0 {
-        let (d, c, _) = drop(&st.columns(1, st.ncols() - 1).into_owned());
+        let kept: Vec<_> =
+            (1..st.ncols()).filter(|&i| !shape.get(i).copied().unwrap_or(false)).map(|i| st.column(i)).collect();
+        let (d, c, _) =
+            if kept.is_empty() { drop(&DMatrix::zeros(r.len(), 0)) } else { drop(&DMatrix::from_columns(&kept)) };
         (d, c)
     } else {
         (full, change)
@@ -194,8 +199,8 @@ mod tests {
         for sign in [1.0, -1.0] {
             // a residual that a₀ = ∓4 (with some a₁) removes, plus a part neither column has
             let r = (st.column(0) * (-4.0 * sign) + st.column(1) * 0.7) + &noise;
-            let (bounded, change) = one_sided_drop(&st, &r, true);
-            let (free, free_change) = one_sided_drop(&st, &r, false);
+            let (bounded, change) = one_sided_drop(&st, &r, true, &[]);
+            let (free, free_change) = one_sided_drop(&st, &r, false, &[]);
             // the change is the one at the minimum: r + change is what is left
             for (d, c) in [(bounded, &change), (free, &free_change)] {
                 assert!((d - (r.norm_squared() - (&r + c).norm_squared())).abs() < 1e-9 * free, "{sign}: {d}");
@@ -207,8 +212,11 @@ mod tests {
                 assert!(bounded < 0.5 * free, "{bounded} vs {free}");
             }
             let one = st.columns(0, 1).into_owned();
-            let single = one_sided_drop(&one, &r, true).0;
+            let single = one_sided_drop(&one, &r, true, &[]).0;
             assert!(if sign > 0.0 { single > 0.5 * free } else { single == 0.0 }, "{sign}: {single}");
+            // a shape column (nothing at zero strength) goes with the primary on its bound
+            let shaped = one_sided_drop(&st, &r, true, &[false, true]).0;
+            assert!(if sign > 0.0 { (shaped - free).abs() < 1e-9 * free } else { shaped == 0.0 }, "{sign}: {shaped}");
         }
     }
 

@@ -36,7 +36,7 @@
 //! Q_A = N·Σ f_j·h0·k·sin kx_j, Q_B = −N·Σ f_j·h0·k·cos kx_j, torque T_c = N·R0·Σ f_j,
 //! axial force F_c = N·Σ p_j. The normal forces' modal projection −N·Σ p_j·(cos, sin) is
 //! left out by default, as in the steady model (it is a contact stiffening, the
-//! `preload_stiffening` effect); [`TransientConfig::normal_modal_coupling`] adds it.
+//! `preload_stiffening` effect with `modal_fraction = 1`); [`TransientConfig::normal_modal_coupling`] adds it.
 //!
 //! Integrator: see [`sim`](self) (kick-drift-kick Verlet with implicit linear damping and
 //! exact kinematic slip increments). Effects in `Motor::effects` are not modelled here.
