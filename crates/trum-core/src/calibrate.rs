@@ -1139,7 +1139,7 @@ pub(crate) mod tests {
     #[test]
     fn the_stiffening_forms_blend_is_recovered_from_its_readings() {
         let e = Effect::PreloadStiffening;
-        let mut truth = preset("trum60a").unwrap();
+        let mut truth = preset("trum60a").expect("preset");
         truth.effects.set(e, &[0.2, 0.8]);
         let ops = [100.0, 200.0, 300.0, 400.0, 500.0].into_iter().flat_map(|f| {
             [(0.0, 43e3), (0.3, 43e3), (0.0, 44e3), (0.3, 44e3)].map(|(t, hz)| OperatingPoint::new(f, t, 200.0, hz))
@@ -1149,7 +1149,7 @@ pub(crate) mod tests {
         start.effects.set(e, &[0.1, e.info().params[1].start()]);
         let params = effect_params(e);
         assert_eq!((params[1].lo, params[1].hi), (0.0, 1.0), "a shape parameter spans its range");
-        let cal = calibrate(&start, &rows, &params, &FitOptions::default()).unwrap();
+        let cal = calibrate(&start, &rows, &params, &FitOptions::default()).expect("fit");
         let (s, lam) = (cal.motor.effects.value(e, 0), cal.motor.effects.value(e, 1));
         assert!((s / 0.2 - 1.0).abs() < 1e-3 && (lam - 0.8).abs() < 1e-3, "scale {s}, fraction {lam}");
     }

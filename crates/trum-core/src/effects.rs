@@ -636,10 +636,12 @@ mod tests {
         assert_eq!(back, fx);
         let err =
             read("[effects]\nthermal_drift = { stiffness_coefficient_per_k = 1e-4, friction_coefficient_per_k = 0 }\n")
-                .unwrap_err()
+                .expect_err("a strength left out")
                 .to_string();
         assert!(err.contains("missing parameter 'damping_coefficient_per_k'"), "{err}");
-        let err = read("[effects]\npreload_stiffening = { modal_fraction = 1 }\n").unwrap_err().to_string();
+        let err = read("[effects]\npreload_stiffening = { modal_fraction = 1 }\n")
+            .expect_err("the strength left out")
+            .to_string();
         assert!(err.contains("missing parameter 'stiffness_scale'"), "{err}");
     }
 }
