@@ -78,9 +78,12 @@ where
     T: Into<OsString> + Clone,
 {
     let stdout = std::io::stdout();
-    let stderr = std::io::stderr();
     let mut out = stdout.lock();
-    let mut err = stderr.lock();
+    // Not stderr's lock for the whole run: a worker thread that writes to stderr (the panic
+    // hook of a bug in a rayon task) would wait for it forever while this thread waits for
+    // the worker, and the run would hang instead of ending with exit code 101. Stderr is
+    // unbuffered; each write takes the lock.
+    let mut err = std::io::stderr();
     run_with_io(args, &mut out, &mut err)
 }
 
