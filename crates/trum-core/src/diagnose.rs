@@ -1901,6 +1901,32 @@ mod tests {
         (rows, groups)
     }
 
+    /// `trum60a` with `effect` at `strength` (truth forms), synthesised on `campaign` at
+    /// `noise` with `seed`, diagnosed with single `candidates` only (no pairs).
+    fn diagnosed_single(
+        effect: Effect,
+        strength: f64,
+        campaign: Campaign,
+        noise: f64,
+        seed: u64,
+        candidates: &[Effect],
+    ) -> Diagnosis {
+        let nominal = preset("trum60a").expect("preset");
+        let mut truth = nominal.clone();
+        truth.effects.set_strength(effect, strength);
+        let cfg = SynthConfig { campaign, noise, seed, ..SynthConfig::default() };
+        let synth = synthesize(&truth, &cfg).expect("synth");
+        let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
+        let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+        let opts = DiagnoseOptions {
+            candidates: candidates.to_vec(),
+            try_pairs: false,
+            bootstrap: 200,
+            ..DiagnoseOptions::default()
+        };
+        diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis")
+    }
+
     /// On a `combined` campaign the weights' noise levels put the whole held-out NRMSE of
     /// the baseline inside the noise (noise NRMSE 0.116 against 0.072, where noise alone
     /// gives 0.0225). The test "half of the NRMSE beyond the noise is gone" then held for
@@ -1912,20 +1938,8 @@ mod tests {
     /// `preload_stiffening` candidate spans the truth form's projection and closes the gap.)
     #[test]
     fn a_gap_inside_the_weights_noise_is_not_closed_by_every_effect() {
-        let nominal = preset("trum60a").expect("preset");
-        let mut truth = nominal.clone();
-        truth.effects.set_strength(Effect::PreloadStiffening, 0.05);
-        let cfg = SynthConfig { campaign: Campaign::Combined, noise: 0.5, seed: 136, ..SynthConfig::default() };
-        let synth = synthesize(&truth, &cfg).expect("synth");
-        let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
-        let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
-        let opts = DiagnoseOptions {
-            candidates: vec![Effect::RadialFriction],
-            try_pairs: false,
-            bootstrap: 200,
-            ..DiagnoseOptions::default()
-        };
-        let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+        let d =
+            diagnosed_single(Effect::PreloadStiffening, 0.05, Campaign::Combined, 0.5, 136, &[Effect::RadialFriction]);
         // the premise: the weights' noise is above the baseline's gap, the best estimate far below
         assert!(
             d.noise_nrmse_weights > d.baseline_heldout_nrmse,
@@ -1950,20 +1964,8 @@ mod tests {
     /// fitted, the strong-effect starts find ρ, and a note says what the baseline did.
     #[test]
     fn a_baseline_at_rest_everywhere_leaves_the_effects_testable() {
-        let nominal = preset("trum60a").expect("preset");
-        let mut truth = nominal.clone();
-        truth.effects.set_strength(Effect::RadialFriction, 3.0);
-        let cfg = SynthConfig { campaign: Campaign::PreloadTorque, noise: 0.5, seed: 1201, ..SynthConfig::default() };
-        let synth = synthesize(&truth, &cfg).expect("synth");
-        let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
-        let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
-        let opts = DiagnoseOptions {
-            candidates: vec![Effect::RadialFriction, Effect::ThermalDrift, Effect::TangentialCompliance],
-            try_pairs: false,
-            bootstrap: 200,
-            ..DiagnoseOptions::default()
-        };
-        let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+        let candidates = [Effect::RadialFriction, Effect::ThermalDrift, Effect::TangentialCompliance];
+        let d = diagnosed_single(Effect::RadialFriction, 3.0, Campaign::PreloadTorque, 0.5, 1201, &candidates);
         // the premise: the baseline has the rotor at rest wherever it was measured turning
         assert!(d.notes.iter().any(|n| n.contains("has the rotor at rest")), "{:?}", d.notes);
         assert_eq!(d.verdict, "radial_friction");
@@ -1982,7 +1984,6 @@ mod tests {
     /// (χ² 7.5 left) were verdicts. Against the best noise estimate neither closes it.
     #[test]
     fn an_effect_that_closes_a_sliver_of_the_gap_is_no_verdict() {
-        let nominal = preset("trum60a").expect("preset");
         let cases = [
             (Effect::VoltageSag, 150.0, Campaign::Combined, 1.0, 158, [Effect::RadialFriction, Effect::ThermalDrift]),
             (
@@ -1995,19 +1996,7 @@ mod tests {
             ),
         ];
         for (truth_effect, strength, campaign, noise, seed, candidates) in cases {
-            let mut truth = nominal.clone();
-            truth.effects.set_strength(truth_effect, strength);
-            let cfg = SynthConfig { campaign, noise, seed, ..SynthConfig::default() };
-            let synth = synthesize(&truth, &cfg).expect("synth");
-            let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
-            let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
-            let opts = DiagnoseOptions {
-                candidates: candidates.to_vec(),
-                try_pairs: false,
-                bootstrap: 200,
-                ..DiagnoseOptions::default()
-            };
-            let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+            let d = diagnosed_single(truth_effect, strength, campaign, noise, seed, &candidates);
             let best = &d.ranking[0];
             assert!(best.shrink < 0.2 && best.heldout_chi2_after > 5.0, "{truth_effect:?}: {best:?}");
             assert_eq!(d.verdict, "unexplained", "{truth_effect:?}: {:?}", d.ranking);
