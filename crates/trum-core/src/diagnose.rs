@@ -702,13 +702,7 @@ fn fit_params(
         // parameters are fitted.
         if !already.contains(&e) {
             let info = e.info();
-            let start: Vec<f64> = info
-                .params
-                .iter()
-                .enumerate()
-                .map(|(i, p)| if i == 0 { info.fit_start * p.typical } else { p.start() })
-                .collect();
-            m.effects.set(e, &start);
+            m.effects.set(e, &info.with_primary(info.fit_start * info.params[0].typical));
         }
         params.extend(effect_params(e));
     }
@@ -920,14 +914,7 @@ pub fn diagnose(
             Some(s) => {
                 s.columns.iter().all(|&x| x == 0.0) && {
                     let mut on = motor.clone();
-                    let typical: Vec<f64> = e
-                        .info()
-                        .params
-                        .iter()
-                        .enumerate()
-                        .map(|(i, p)| if i == 0 { p.typical } else { p.start() })
-                        .collect();
-                    on.effects.set(*e, &typical);
+                    on.effects.set(*e, &e.info().with_primary(e.info().params[0].typical));
                     residuals(&on, rows) == residuals(motor, rows)
                 }
             }
@@ -1064,14 +1051,7 @@ pub fn diagnose(
         if second_start {
             let mut s1 = motor.clone();
             for &e in effects {
-                let typical: Vec<f64> = e
-                    .info()
-                    .params
-                    .iter()
-                    .enumerate()
-                    .map(|(i, p)| if i == 0 { p.typical } else { p.start() })
-                    .collect();
-                s1.effects.set(e, &typical);
+                s1.effects.set(e, &e.info().with_primary(e.info().params[0].typical));
             }
             if let Ok(c1) = calibrate_nested(&s1, rows, &params, &opts.fit, added, Start::Restart) {
                 if !c1.abandoned && !cal.as_ref().is_ok_and(|c| !c.abandoned && c1.chi2 >= c.chi2) {

@@ -245,6 +245,14 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
     },
 ];
 
+impl EffectInfo {
+    /// Parameter values with the primary at `primary` and the others where fits and probes
+    /// place them ([`EffectParam::start`]).
+    pub fn with_primary(&self, primary: f64) -> Vec<f64> {
+        self.params.iter().enumerate().map(|(i, p)| if i == 0 { primary } else { p.start() }).collect()
+    }
+}
+
 impl Effect {
     /// The effect's fixed name.
     pub fn name(self) -> &'static str {

@@ -55,8 +55,7 @@ pub(crate) fn signature(cal: &Calibration, rows: &[ObservedRow], e: Effect) -> O
     // A small probe (a tenth of the typical strength): the shape of the effect's leading
     // term. It changes with strength (radial friction's at its typical strength matches
     // its own weak residual with cos 0.2 instead of 0.99), and the test is one of first order.
-    let typical: Vec<f64> =
-        info.params.iter().enumerate().map(|(i, p)| if i == 0 { PROBE * p.typical } else { p.start() }).collect();
+    let typical = info.with_primary(PROBE * info.params[0].typical);
     probe.effects.set(e, &typical);
     let on = weighted(cal, &probe, rows);
     let mut cols = vec![&on - r];
