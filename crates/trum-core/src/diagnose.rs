@@ -905,7 +905,8 @@ pub fn diagnose(
     let probed: Vec<(Effect, Option<signature::Signature>)> =
         opts.candidates.par_iter().map(|&e| (e, signature::signature(&base_cal, rows, e))).collect();
     // (an effect the motor already carries has no probe: switched off instead)
-    let base_res = || residuals(&start, rows);
+    // (each computed once, when a probe first needs it)
+    let (base_res, nominal_res) = (std::cell::OnceCell::new(), std::cell::OnceCell::new());
     let untestable: Vec<Effect> = probed
         .iter()
         .filter(|(e, s)| match s {
@@ -915,13 +916,13 @@ pub fn diagnose(
                 s.columns.iter().all(|&x| x == 0.0) && {
                     let mut on = motor.clone();
                     on.effects.set(*e, &e.info().with_primary(e.info().params[0].typical));
-                    residuals(&on, rows) == residuals(motor, rows)
+                    &residuals(&on, rows) == nominal_res.get_or_init(|| residuals(motor, rows))
                 }
             }
             None if start.effects.is_on(*e) => {
                 let mut off = start.clone();
                 off.effects.clear(*e);
-                residuals(&off, rows) == base_res()
+                &residuals(&off, rows) == base_res.get_or_init(|| residuals(&start, rows))
             }
             None => false,
         })
