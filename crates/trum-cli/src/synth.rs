@@ -9,7 +9,7 @@ use std::io::Write;
 use std::path::PathBuf;
 use trum_core::bench::to_measurements;
 use trum_core::calibrate::Observable;
-use trum_core::synth::{synthesize, Campaign, SynthConfig};
+use trum_core::synth::{synthesize, Artefacts, Campaign, SynthConfig};
 
 /// Campaign kinds (the names of `trum_core::synth::Campaign::NAMES`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -66,9 +66,18 @@ pub struct SynthArgs {
     /// a real motor would.
     #[arg(long)]
     candidate_forms: bool,
+    /// Simulate the effects in their second family of truth forms (docs/EFFECTS.md), which
+    /// differ from the first and from every candidate.
+    #[arg(long, conflicts_with = "candidate_forms")]
+    truth_forms_b: bool,
     /// Optional columns to leave out, comma-separated (to mimic a poorer bench), e.g. feedback_v,current_a.
     #[arg(long, value_name = "col1,col2")]
     omit: Option<String>,
+    /// Bench artefacts besides the reading noise, as `name=value,...` (docs/SYNTH.md):
+    /// readback_rel (voltage read back around its set point), speed_std_floor_rpm,
+    /// torque_offset_nm, speed_quantum_rpm, outlier_fraction.
+    #[arg(long, value_name = "name=value,...")]
+    artefacts: Option<String>,
     /// Output CSV file (`-` for stdout). Written to a temporary file and renamed at the end.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: PathBuf,
@@ -110,7 +119,9 @@ pub fn run(a: &SynthArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
         voltage_v: a.voltage_v,
         frequency_hz: a.frequency_hz,
         truth_forms: !a.candidate_forms,
+        truth_form_b: a.truth_forms_b,
         omit: parse_omit(a.omit.as_deref())?,
+        artefacts: Artefacts::parse(a.artefacts.as_deref().unwrap_or("")).map_err(|e| anyhow!("--artefacts: {e}"))?,
     };
     let rows = synthesize(&motor, &cfg).map_err(|e| anyhow!("{e}"))?;
     if rows.is_empty() {

@@ -6,7 +6,7 @@
 //! solved by linearisation about the row's converged state, crate::sensitivity), and
 //! parameter uncertainties from the Jacobian at the optimum.
 
-use crate::effects::Effect;
+use crate::effects::{Effect, Instrument};
 use crate::error::TrumError;
 use crate::params::Motor;
 use crate::sensitivity::{solve_kept, Solved};
@@ -131,6 +131,15 @@ pub enum ParamRef {
     Motor(String),
     /// Parameter `i` of an effect.
     Effect(Effect, usize),
+    /// A nuisance parameter of the bench's instruments ([`crate::effects::Instrument`]).
+    Instrument(InstrumentParam),
+}
+
+/// A nuisance parameter of the bench's instruments.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InstrumentParam {
+    /// [`crate::effects::Instrument::speed_std_floor_rpm`].
+    SpeedStdFloorRpm,
 }
 
 impl ParamRef {
@@ -139,6 +148,7 @@ impl ParamRef {
         match self {
             ParamRef::Motor(k) => k.clone(),
             ParamRef::Effect(e, i) => format!("effects.{}.{}", e.name(), e.info().params[*i].name),
+            ParamRef::Instrument(InstrumentParam::SpeedStdFloorRpm) => "bench.speed_std_floor_rpm".into(),
         }
     }
 
@@ -146,6 +156,7 @@ impl ParamRef {
         match self {
             ParamRef::Motor(k) => m.param(k).unwrap_or(f64::NAN),
             ParamRef::Effect(e, i) => m.effects.value(*e, *i),
+            ParamRef::Instrument(InstrumentParam::SpeedStdFloorRpm) => m.effects.instrument().speed_std_floor_rpm,
         }
     }
 
@@ -157,6 +168,9 @@ impl ParamRef {
                 }
             }
             ParamRef::Effect(e, i) => *m.effects.value_mut(*e, *i) = v,
+            ParamRef::Instrument(InstrumentParam::SpeedStdFloorRpm) => {
+                m.effects.instrument_mut().speed_std_floor_rpm = v
+            }
         }
     }
 }
@@ -172,6 +186,20 @@ pub struct FitParam {
     pub hi: f64,
     /// Transform through the logarithm (positive parameters spanning decades).
     pub log: bool,
+    /// Gaussian prior on the parameter in its fit coordinate (ln p when `log`, else p):
+    /// the fit is then a maximum a posteriori fit, and a parameter the data do not
+    /// determine stays near the prior's centre instead of wandering to a bound.
+    pub prior: Option<Prior>,
+}
+
+/// A Gaussian prior N(centre, sd²) on a fit parameter, in its fit coordinate (ln p for a
+/// logarithmic parameter: `sd` is then a relative tolerance, 0.03 ≈ ±3 %).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Prior {
+    /// Centre (ln of the nominal value for a logarithmic parameter).
+    pub centre: f64,
+    /// Standard deviation (> 0).
+    pub sd: f64,
 }
 
 impl FitParam {
@@ -189,6 +217,14 @@ impl FitParam {
             self.lo + t * (self.hi - self.lo)
         }
     }
+    /// The prior's normalised residual at transformed coordinate `u` and its derivative
+    /// with respect to `u`; `None` without a prior.
+    fn prior_residual(&self, u: f64) -> Option<(f64, f64)> {
+        let pr = self.prior?;
+        let p = self.from_u(u);
+        let (x, dx_dp) = if self.log { (p.max(1e-300).ln(), 1.0 / p.max(1e-300)) } else { (p, 1.0) };
+        Some(((x - pr.centre) / pr.sd, dx_dp * self.dp_du(u) / pr.sd))
+    }
     /// dp/du at u.
     fn dp_du(&self, u: f64) -> f64 {
         let t = 1.0 / (1.0 + (-u).exp());
@@ -201,37 +237,127 @@ impl FitParam {
     }
 }
 
-/// The uncertain baseline parameters of a motor and their bounds (docs/DIAGNOSIS.md):
-/// friction coefficient, friction-layer modulus, modal damping, force factor, free
-/// resonance; the feedback gain, the clamped capacitance and the thermal network's heat
-/// capacity and heat-transfer coefficient when the data can see them.
+/// How well a baseline parameter is known before the data are seen: the standard
+/// deviation of its logarithm (a relative tolerance) and the bounds of its fit, as
+/// factors on the nominal value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance {
+    /// Dotted motor key.
+    pub key: &'static str,
+    /// Prior standard deviation of ln(value / nominal) [-].
+    pub rel_sd: f64,
+    /// Lower bound of the fit as a factor on the nominal value.
+    pub lo: f64,
+    /// Upper bound of the fit as a factor on the nominal value.
+    pub hi: f64,
+    /// The readings that must be present for the data to see it.
+    pub needs: Needs,
+}
+
+/// Which readings a baseline parameter needs before it is fitted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Needs {
+    /// Any data (it moves the speed).
+    Always,
+    /// Feedback-electrode voltages.
+    Feedback,
+    /// Electrical readings (input power or current).
+    Electrical,
+    /// A temperature time series.
+    ThermalSeries,
+}
+
+/// Default tolerances of the baseline parameters, by class (docs/DIAGNOSIS.md,
+/// "Calibration"). Material and contact constants are known to a factor of a few (broad
+/// priors, bounds at about ±2σ); machined geometry to a few percent; the modal mass and
+/// the electrical constants in between. A real motor differs from its nominal file in all
+/// of them at once, so all are fitted: a parameter the data cannot determine stays at its
+/// prior instead of leaving a structured residual for an effect to fill.
+pub const TOLERANCES: &[Tolerance] = &[
+    Tolerance { key: "friction_layer.friction_coefficient", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::Always },
+    Tolerance { key: "friction_layer.youngs_modulus_pa", rel_sd: 1.15, lo: 0.1, hi: 10.0, needs: Needs::Always },
+    Tolerance { key: "stator.modal_damping_ns_per_m", rel_sd: 0.8, lo: 0.2, hi: 5.0, needs: Needs::Always },
+    Tolerance { key: "stator.force_factor_n_per_v", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::Always },
+    Tolerance { key: "stator.resonance_frequency_hz", rel_sd: 0.015, lo: 0.97, hi: 1.03, needs: Needs::Always },
+    Tolerance { key: "geometry.neutral_plane_distance_m", rel_sd: 0.05, lo: 0.8, hi: 1.25, needs: Needs::Always },
+    Tolerance { key: "geometry.mean_radius_m", rel_sd: 0.02, lo: 0.93, hi: 1.07, needs: Needs::Always },
+    Tolerance { key: "stator.modal_mass_kg", rel_sd: 0.1, lo: 0.7, hi: 1.4, needs: Needs::Always },
+    Tolerance { key: "electrical.feedback_gain_v_per_m", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::Feedback },
+    Tolerance { key: "electrical.clamped_capacitance_f", rel_sd: 0.35, lo: 0.5, hi: 2.0, needs: Needs::Electrical },
+    Tolerance { key: "electrical.dielectric_loss_tangent", rel_sd: 0.4, lo: 0.3, hi: 3.0, needs: Needs::Electrical },
+    Tolerance { key: "thermal.heat_capacity_j_per_k", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::ThermalSeries },
+    Tolerance {
+        key: "thermal.heat_transfer_coefficient_w_per_m2k",
+        rel_sd: 0.6,
+        lo: 0.3,
+        hi: 3.0,
+        needs: Needs::ThermalSeries,
+    },
+];
+
+/// The uncertain baseline parameters of a motor, their bounds and priors
+/// ([`TOLERANCES`]): every parameter the data can see. See [`baseline_params_with`].
 pub fn baseline_params(motor: &Motor, rows: &[ObservedRow]) -> Vec<FitParam> {
+    baseline_params_with(motor, rows, &std::collections::BTreeMap::new())
+}
+
+/// [`baseline_params`] with the relative tolerances of `overrides` (dotted key → prior
+/// standard deviation of the logarithm) in place of the defaults; a tolerance of zero
+/// holds that parameter at its nominal value, an infinite one fits it without a prior
+/// (uniform within its default bounds). A parameter whose nominal value is zero (a
+/// lossless dielectric) is left out: its relative tolerance has no scale.
+pub fn baseline_params_with(
+    motor: &Motor,
+    rows: &[ObservedRow],
+    overrides: &std::collections::BTreeMap<String, f64>,
+) -> Vec<FitParam> {
     let has = |o: Observable| rows.iter().any(|r| r.readings.iter().any(|x| x.0 == o));
-    let mut v = vec![
-        fit_rel(motor, "friction_layer.friction_coefficient", 0.3, 3.0),
-        fit_rel(motor, "friction_layer.youngs_modulus_pa", 0.1, 10.0),
-        fit_rel(motor, "stator.modal_damping_ns_per_m", 0.2, 5.0),
-        fit_rel(motor, "stator.force_factor_n_per_v", 0.3, 3.0),
-        fit_rel(motor, "stator.resonance_frequency_hz", 0.97, 1.03),
-    ];
-    if has(Observable::FeedbackV) {
-        v.push(fit_rel(motor, "electrical.feedback_gain_v_per_m", 0.3, 3.0));
+    let seen = |n: Needs| match n {
+        Needs::Always => true,
+        Needs::Feedback => has(Observable::FeedbackV),
+        Needs::Electrical => has(Observable::InputPowerW) || has(Observable::CurrentA),
+        // a temperature time series sees the thermal network itself (Chen et al. 2020
+        // eq. 11: time constant C/(αS), final rise P/(αS)), which the papers give only roughly
+        Needs::ThermalSeries => has(Observable::TemperatureC) && rows.iter().any(|r| r.op.elapsed_s > 0.0),
+    };
+    let mut out: Vec<FitParam> = TOLERANCES
+        .iter()
+        .filter(|t| seen(t.needs))
+        .filter_map(|t| {
+            let nominal = motor.param(t.key).filter(|v| *v > 0.0 && v.is_finite())?;
+            let sd = overrides.get(t.key).copied().unwrap_or(t.rel_sd);
+            // a finite tolerance wider than the default bounds widens the bounds to ±3σ
+            let wide = if sd.is_finite() { 3.0 * sd } else { 0.0 };
+            let (lo, hi) = (t.lo.min((-wide).exp()), t.hi.max(wide.exp()));
+            let mut fp = fit_rel(motor, t.key, lo, hi);
+            fp.prior = (sd > 0.0 && sd.is_finite()).then(|| Prior { centre: nominal.ln(), sd });
+            // a tolerance of zero holds the parameter at its nominal value
+            (sd > 0.0).then_some(fp)
+        })
+        .collect();
+    // The speed-stability instrument's noise floor (a bench nuisance): at most the
+    // quieter readings' level, which a floor cannot exceed.
+    let mut std_readings: Vec<f64> =
+        rows.iter().flat_map(|r| &r.readings).filter(|x| x.0 == Observable::SpeedStdRpm).map(|x| x.1).collect();
+    if std_readings.len() >= 3 && !overrides.get("bench.speed_std_floor_rpm").is_some_and(|v| *v == 0.0) {
+        std_readings.sort_by(f64::total_cmp);
+        let quiet = std_readings[std_readings.len() / 4];
+        if quiet > 0.0 {
+            out.push(FitParam {
+                param: ParamRef::Instrument(InstrumentParam::SpeedStdFloorRpm),
+                lo: 0.0,
+                hi: 1.5 * quiet,
+                log: false,
+                prior: None,
+            });
+        }
     }
-    if has(Observable::InputPowerW) || has(Observable::CurrentA) {
-        v.push(fit_rel(motor, "electrical.clamped_capacitance_f", 0.5, 2.0));
-    }
-    // A temperature time series sees the thermal network itself (seed 000 eq. 11: time
-    // constant C/(αS), final rise P/(αS)), which the papers give only roughly.
-    if has(Observable::TemperatureC) && rows.iter().any(|r| r.op.elapsed_s > 0.0) {
-        v.push(fit_rel(motor, "thermal.heat_capacity_j_per_k", 0.3, 3.0));
-        v.push(fit_rel(motor, "thermal.heat_transfer_coefficient_w_per_m2k", 0.3, 3.0));
-    }
-    v
+    out
 }
 
 fn fit_rel(motor: &Motor, key: &str, lo: f64, hi: f64) -> FitParam {
     let nominal = motor.param(key).unwrap_or(1.0);
-    FitParam { param: ParamRef::Motor(key.into()), lo: nominal * lo, hi: nominal * hi, log: true }
+    FitParam { param: ParamRef::Motor(key.into()), lo: nominal * lo, hi: nominal * hi, log: true, prior: None }
 }
 
 /// The fit parameters of an effect: all its strength parameters, bounded to eight times
@@ -246,7 +372,13 @@ pub fn effect_params(effect: Effect) -> Vec<FitParam> {
         .map(|(i, p)| {
             // a strength within 8 × its typical value; a shape parameter over its whole range
             let span = if p.shape { f64::INFINITY } else { 8.0 * p.typical.abs() };
-            FitParam { param: ParamRef::Effect(effect, i), lo: p.min.max(-span), hi: p.max.min(span), log: false }
+            FitParam {
+                param: ParamRef::Effect(effect, i),
+                lo: p.min.max(-span),
+                hi: p.max.min(span),
+                log: false,
+                prior: None,
+            }
         })
         .collect()
 }
@@ -299,8 +431,12 @@ pub struct FittedParam {
     pub std_error: f64,
     /// True when the value sits on (within 0.5 % of) a bound.
     pub at_bound: bool,
-    /// False when the data cannot determine it (near-singular Jacobian column).
+    /// False when the data cannot determine it (near-singular Jacobian column; for a
+    /// parameter with a prior: its standard error is not well inside the prior's width,
+    /// so the value rests on the prior).
     pub identifiable: bool,
+    /// Relative prior standard deviation (the tolerance), for parameters with a prior.
+    pub prior_rel_sd: Option<f64>,
 }
 
 /// Result of a calibration.
@@ -310,8 +446,11 @@ pub struct Calibration {
     pub motor: Motor,
     /// Fitted parameters.
     pub params: Vec<FittedParam>,
-    /// Σ of squared normalised residuals (unweighted) at the optimum.
+    /// Σ of squared normalised residuals (unweighted) at the optimum, the priors' terms
+    /// included ([`Calibration::prior_chi2`]).
     pub chi2: f64,
+    /// The priors' part of `chi2`: Σ ((x − centre)/sd)² over the parameters with a prior.
+    pub prior_chi2: f64,
     /// Number of readings used.
     pub n_readings: usize,
     /// Passes over the data: each residual vector and each Jacobian counts one.
@@ -366,6 +505,32 @@ fn motor_at(base: &Motor, params: &[FitParam], u: &DVector<f64>) -> Motor {
     m
 }
 
+/// The normalised residuals of the parameters' priors at transformed coordinates `u`, in
+/// parameter order (parameters without a prior have none).
+pub(crate) fn prior_residuals(params: &[FitParam], u: &DVector<f64>) -> Vec<f64> {
+    params.iter().zip(u.iter()).filter_map(|(fp, &ui)| fp.prior_residual(ui).map(|r| r.0)).collect()
+}
+
+/// `j` (data rows) with one row per prior appended: its residual's derivative with
+/// respect to its own parameter's coordinate.
+pub(crate) fn with_prior_rows(j: DMatrix<f64>, params: &[FitParam], u: &DVector<f64>) -> DMatrix<f64> {
+    let rows: Vec<(usize, f64)> = params
+        .iter()
+        .zip(u.iter())
+        .enumerate()
+        .filter_map(|(k, (fp, &ui))| fp.prior_residual(ui).map(|r| (k, r.1)))
+        .collect();
+    if rows.is_empty() {
+        return j;
+    }
+    let n = j.nrows();
+    let mut out = j.resize_vertically(n + rows.len(), 0.0);
+    for (i, (k, d)) in rows.into_iter().enumerate() {
+        out[(n + i, k)] = d;
+    }
+    out
+}
+
 /// Normalised residuals (prediction − measurement)/σ of every reading of `rows`, in
 /// order, the prediction being the expected reading ([`Observable::expected_reading`]: the
 /// model value but for a clipped speed std); a point the model cannot solve contributes a
@@ -373,23 +538,32 @@ fn motor_at(base: &Motor, params: &[FitParam], u: &DVector<f64>) -> Motor {
 pub fn residuals(motor: &Motor, rows: &[ObservedRow]) -> Vec<f64> {
     let p = Prepared::new(motor).without_stall_torque();
     // cold starts, as in `Problem::pass_at`
-    per_row(rows, |r| row_residuals(r, &solve_prepared(&p, motor, &r.op, None)))
+    let inst = motor.effects.instrument();
+    per_row(rows, |r| row_residuals(r, &solve_prepared(&p, motor, &r.op, None), inst))
+}
+
+/// The expected reading of `o` in row `r` for the solution `s` of its point, through the
+/// bench's instruments `inst`.
+pub(crate) fn expected(o: Observable, r: &ObservedRow, s: &Solution, inst: &Instrument, sigma: f64) -> f64 {
+    o.expected_reading(r, inst.reading(o, o.predict(s, r.ambient_c)), sigma)
 }
 
 /// The normalised residuals of one row's readings for the solution `s` of its point.
-fn row_residuals(r: &ObservedRow, s: &Solution) -> Vec<f64> {
-    row_residuals_iter(r, s).collect()
+fn row_residuals(r: &ObservedRow, s: &Solution, inst: &Instrument) -> Vec<f64> {
+    row_residuals_iter(r, s, inst).collect()
 }
 
 /// [`row_residuals`] without collecting them (the Jacobian writes each into its matrix).
-fn row_residuals_iter<'a>(r: &'a ObservedRow, s: &'a Solution) -> impl Iterator<Item = f64> + 'a {
-    r.readings.iter().map(|&(o, v, sigma)| {
-        if s.status.is_valid() {
-            (o.expected_reading(r, o.predict(s, r.ambient_c), sigma) - v) / sigma
-        } else {
-            50.0
-        }
-    })
+fn row_residuals_iter<'a>(r: &'a ObservedRow, s: &'a Solution, inst: &'a Instrument) -> impl Iterator<Item = f64> + 'a {
+    r.readings.iter().map(
+        move |&(o, v, sigma)| {
+            if s.status.is_valid() {
+                (expected(o, r, s, inst, sigma) - v) / sigma
+            } else {
+                50.0
+            }
+        },
+    )
 }
 
 /// `one` of every row, concatenated in row order. Large data sets in parallel chunks: a
@@ -437,8 +611,9 @@ pub(crate) fn residual_jacobian(
         };
         let lin = crate::sensitivity::linearise(&pb, known);
         let near = |p: &Prepared, m: &Motor| lin.as_ref().and_then(|b| crate::sensitivity::solve_near(b, p, m, &r.op));
-        let r_near = near(&pb, base).map(|s| row_residuals(r, &s));
-        let r_cold = row_residuals(r, &known.solution);
+        let inst = base.effects.instrument();
+        let r_near = near(&pb, base).map(|s| row_residuals(r, &s, inst));
+        let r_cold = row_residuals(r, &known.solution, inst);
         // row-major: reading i, then column k
         let mut out = vec![0.0; r.readings.len() * n];
         for k in 0..n {
@@ -446,7 +621,7 @@ pub(crate) fn residual_jacobian(
                 (Some(s), Some(r0)) => (s, r0),
                 _ => (solve_prepared(&pm[k], &moved[k], &r.op, None), &r_cold),
             };
-            for (i, (a, b)) in row_residuals_iter(r, &sk).zip(r0).enumerate() {
+            for (i, (a, b)) in row_residuals_iter(r, &sk, moved[k].effects.instrument()).zip(r0).enumerate() {
                 out[i * n + k] = (a - b) / steps[k];
             }
         }
@@ -555,16 +730,25 @@ impl<'a> Problem<'a> {
             // Cold starts: a warm start from a neighbouring row could settle on another fixed
             // point where the amplitude map has several, and the fit must see one model.
             let solved = per_row(self.rows, |r| vec![solve_kept(&p, &m, &r.op)]);
-            let raw: Vec<f64> =
-                self.rows.iter().zip(&solved).flat_map(|(r, s)| row_residuals(r, &s.solution)).collect();
+            let raw: Vec<f64> = self
+                .rows
+                .iter()
+                .zip(&solved)
+                .flat_map(|(r, s)| row_residuals(r, &s.solution, m.effects.instrument()))
+                .collect();
             let new = Some(Pass { u: u.clone(), raw, solved });
             *self.prev.borrow_mut() = std::mem::replace(&mut *self.last.borrow_mut(), new);
         }
         std::cell::Ref::map(self.last.borrow(), |p| p.as_ref().expect("set above"))
     }
+    /// The weighted data residuals at `u`, followed by the priors' residuals.
     fn weighted_at(&self, u: &DVector<f64>) -> DVector<f64> {
         let pass = self.pass_at(u);
-        DVector::from_iterator(pass.raw.len(), pass.raw.iter().zip(&self.weights).map(|(x, w)| x * w))
+        let prior = prior_residuals(self.params, u);
+        DVector::from_iterator(
+            pass.raw.len() + prior.len(),
+            pass.raw.iter().zip(&self.weights).map(|(x, w)| x * w).chain(prior),
+        )
     }
     /// The weighted Jacobian at the current point, remembered (see `jac`).
     fn weighted_jacobian(&self) -> DMatrix<f64> {
@@ -591,6 +775,7 @@ impl<'a> Problem<'a> {
         for (mut row, w) in j.row_iter_mut().zip(&self.weights) {
             row *= *w;
         }
+        let j = with_prior_rows(j, self.params, &self.u);
         *self.jac.borrow_mut() = Some((self.u.clone(), j.clone()));
         j
     }
@@ -997,7 +1182,10 @@ fn fit(
     }
     let fitted = problem.motor_at(&problem.u);
     let r = problem.pass_at(&problem.u).raw.clone();
-    let chi2: f64 = r.iter().map(|x| x * x).sum();
+    // the objective: the data's χ² and the priors' (a MAP fit's −2 ln posterior, up to a
+    // constant), so that models with the same priors compare by it
+    let prior_chi2: f64 = prior_residuals(params, &problem.u).iter().map(|x| x * x).sum();
+    let chi2: f64 = r.iter().map(|x| x * x).sum::<f64>() + prior_chi2;
     if r.iter().any(|x| *x == 50.0) {
         warnings.push("the model has no solution at some measured points (counted as 50-sigma misses)".into());
     }
@@ -1005,7 +1193,8 @@ fn fit(
     // parameters p/scale so that parameters of very different magnitude (E_f ~ 1e8 Pa,
     // C0 ~ 1e-9 F) do not make the matrix numerically singular.
     // (the Jacobian of the last LM step is usually this one; an abandoned fit has none)
-    let j = if abandoned { DMatrix::zeros(n_read, params.len()) } else { problem.weighted_jacobian() };
+    let n_prior = prior_residuals(params, &problem.u).len();
+    let j = if abandoned { DMatrix::zeros(n_read + n_prior, params.len()) } else { problem.weighted_jacobian() };
     let mut jp = j.clone();
     let mut scale = vec![1.0; params.len()];
     for (k, fp) in params.iter().enumerate() {
@@ -1043,9 +1232,19 @@ fn fit(
         };
         let at_bound = span < 0.005;
         let rel = se / value.abs().max(1e-300);
-        let identifiable = jtj[(k, k)] > 0.0 && se.is_finite() && rel < 1.0;
+        // With a prior, the data identify a parameter when they narrow it to well inside
+        // the prior's width; otherwise it is held by its prior, which is no fault.
+        let prior_sd = fp.prior.map(|p| p.sd);
+        let identifiable = jtj[(k, k)] > 0.0 && se.is_finite() && rel < prior_sd.map_or(1.0, |sd| (0.7 * sd).min(1.0));
         if abandoned {
-            out.push(FittedParam { name: fp.param.name(), value, std_error: f64::NAN, at_bound, identifiable: false });
+            out.push(FittedParam {
+                name: fp.param.name(),
+                value,
+                std_error: f64::NAN,
+                at_bound,
+                identifiable: false,
+                prior_rel_sd: prior_sd,
+            });
             continue;
         }
         if at_bound {
@@ -1057,14 +1256,26 @@ fn fit(
                 fp.hi
             ));
         }
-        if !identifiable {
+        if !identifiable && prior_sd.is_none() {
             warnings.push(format!(
                 "{} is not identifiable from these data (relative standard error {:.2})",
                 fp.param.name(),
                 rel
             ));
         }
-        out.push(FittedParam { name: fp.param.name(), value, std_error: se, at_bound, identifiable });
+        out.push(FittedParam {
+            name: fp.param.name(),
+            value,
+            std_error: se,
+            at_bound,
+            identifiable,
+            prior_rel_sd: prior_sd,
+        });
+    }
+    let held: Vec<String> =
+        out.iter().filter(|p| p.prior_rel_sd.is_some() && !p.identifiable).map(|p| p.name.clone()).collect();
+    if !held.is_empty() && !abandoned {
+        warnings.push(format!("held near their prior (the data do not narrow them): {}", held.join(", ")));
     }
     let evaluations = problem.evals.get();
     let lin = Linearisation {
@@ -1073,9 +1284,19 @@ fn fit(
         params: params.to_vec(),
         u: problem.u,
         weights: problem.weights,
-        jacobian: j,
+        jacobian: j.rows(0, n_read).into_owned(),
     };
-    Ok(Calibration { motor: fitted, params: out, chi2, n_readings: n_read, evaluations, warnings, abandoned, lin })
+    Ok(Calibration {
+        motor: fitted,
+        params: out,
+        chi2,
+        prior_chi2,
+        n_readings: n_read,
+        evaluations,
+        warnings,
+        abandoned,
+        lin,
+    })
 }
 
 #[cfg(test)]
@@ -1099,6 +1320,29 @@ pub(crate) mod tests {
                 ObservedRow { op, readings, ambient_c: 25.0, speed_std_clipped: false }
             })
             .collect()
+    }
+
+    /// The baseline of the five classic parameters (friction coefficient, layer modulus,
+    /// damping, force factor, resonance frequency; the feedback gain and capacitance where
+    /// seen) without priors: for tests of fitting mechanisms written on that baseline.
+    pub(crate) fn classic_tolerances() -> std::collections::BTreeMap<String, f64> {
+        let held = [
+            "geometry.neutral_plane_distance_m",
+            "geometry.mean_radius_m",
+            "stator.modal_mass_kg",
+            "electrical.dielectric_loss_tangent",
+            "bench.speed_std_floor_rpm",
+        ];
+        TOLERANCES
+            .iter()
+            .map(|t| (t.key.to_string(), if held.contains(&t.key) { 0.0 } else { f64::INFINITY }))
+            .chain(held.iter().map(|k| (k.to_string(), 0.0)))
+            .collect()
+    }
+
+    /// [`baseline_params`] with [`classic_tolerances`].
+    pub(crate) fn classic_params(m: &Motor, rows: &[ObservedRow]) -> Vec<FitParam> {
+        baseline_params_with(m, rows, &classic_tolerances())
     }
 
     /// [`rows_at`] a preload × torque grid at 200 V, 43 kHz.
@@ -1429,7 +1673,7 @@ pub(crate) mod tests {
         // The edge term by another route: in the parameter's own coordinate p (a bounded
         // FitParam, J_p = J_u/(dp/du)), moving p onto its lower bound changes χ² by
         // 2·(J_pᵀr)·(lo − p) to first order.
-        let fp = FitParam { param: ParamRef::Motor("x".into()), lo: 2.0, hi: 7.0, log: false };
+        let fp = FitParam { param: ParamRef::Motor("x".into()), lo: 2.0, hi: 7.0, log: false, prior: None };
         let p = fp.from_u(u0);
         let gp = j.column(0).dot(&r) / fp.dp_du(u0);
         let first_order = -2.0 * gp * (fp.lo - p);
@@ -1542,11 +1786,11 @@ pub(crate) mod tests {
 
     #[test]
     fn bound_transform_round_trips() {
-        let fp = FitParam { param: ParamRef::Motor("x".into()), lo: 0.1, hi: 10.0, log: true };
+        let fp = FitParam { param: ParamRef::Motor("x".into()), lo: 0.1, hi: 10.0, log: true, prior: None };
         for p in [0.11, 1.0, 9.0] {
             assert!((fp.from_u(fp.to_u(p)) - p).abs() < 1e-9 * p);
         }
-        let fp = FitParam { param: ParamRef::Motor("x".into()), lo: -1.0, hi: 2.0, log: false };
+        let fp = FitParam { param: ParamRef::Motor("x".into()), lo: -1.0, hi: 2.0, log: false, prior: None };
         let u = 0.3;
         let h = 1e-6;
         let fd = (fp.from_u(u + h) - fp.from_u(u - h)) / (2.0 * h);
@@ -1585,7 +1829,7 @@ pub(crate) mod tests {
             }
         }
         let rows = rows_at(&truth, ops);
-        let params = baseline_params(&nominal, &rows);
+        let params = classic_params(&nominal, &rows);
         let fit_with = |fold_rtol: f64| {
             let opts = FitOptions { irls_passes: 1, fold_rtol, ..FitOptions::default() };
             calibrate(&nominal, &rows, &params, &opts).expect("fit")

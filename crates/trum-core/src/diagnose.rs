@@ -21,13 +21,15 @@
 //!    its mean normalised residual is more than 3.5 standard errors from zero (z-test;
 //!    3.5 keeps the family-wise false-alarm rate near 1 % over ~50 groups).
 
+mod bench;
 pub mod json;
+mod scan;
 mod signature;
 
 use crate::calibrate::{
-    baseline_params, calibrate, calibrate_adding, calibrate_nested, calibrate_refitting_bounds, calibrate_weighted,
-    effect_params, residuals, Calibration, FitOptions, FitParam, FittedParam, Observable, ObservedRow, ParamRef, Start,
-    IRLS_START_RTOL,
+    baseline_params_with, calibrate, calibrate_adding, calibrate_nested, calibrate_refitting_bounds,
+    calibrate_weighted, effect_params, prior_residuals, residuals, with_prior_rows, Calibration, FitOptions, FitParam,
+    FittedParam, Observable, ObservedRow, ParamRef, Start, IRLS_START_RTOL,
 };
 use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
@@ -55,6 +57,10 @@ pub struct DiagnoseOptions {
     /// Refit every model on every training fold (slow) instead of the approximate
     /// leave-block-out refit from the full-data optimum (the default; docs/DIAGNOSIS.md).
     pub exact_cv: bool,
+    /// Relative tolerances of baseline parameters in place of the defaults
+    /// ([`crate::calibrate::baseline_params_with`]): dotted key → prior standard deviation
+    /// of the logarithm (0 holds a parameter at its nominal value).
+    pub tolerances: BTreeMap<String, f64>,
 }
 
 impl Default for DiagnoseOptions {
@@ -67,6 +73,7 @@ impl Default for DiagnoseOptions {
             seed: 7,
             fit: FitOptions { huber_k: 3.0, irls_passes: 1, max_evaluations: 300, ..FitOptions::default() },
             exact_cv: false,
+            tolerances: BTreeMap::new(),
         }
     }
 }
@@ -122,6 +129,10 @@ pub struct RankEntry {
 pub struct Diagnosis {
     /// One effect, several joined with `+`, `none` or `unexplained`.
     pub verdict: String,
+    /// True when the verdict leaves no held-out gap beyond the noise (`none`, or an effect
+    /// that closes the gap); false for `unexplained` and for an effect named because it
+    /// closes a material part of the gap but not all of it.
+    pub complete: bool,
     /// Effects that explain the data about as well as the verdict.
     pub confounded_with: Vec<String>,
     /// With an `unexplained` verdict, the supported effect that explains part of the gap
@@ -347,7 +358,7 @@ fn predict(motor: &Motor, rows: &[&ObservedRow]) -> Vec<Vec<f64>> {
                 .iter()
                 .map(|&(o, _, sigma)| {
                     if s.status.is_valid() {
-                        o.expected_reading(r, o.predict(&s, r.ambient_c), sigma)
+                        crate::calibrate::expected(o, r, &s, motor.effects.instrument(), sigma)
                     } else {
                         f64::NAN
                     }
@@ -397,15 +408,19 @@ fn approx_cv(cal: &Calibration, rows: &[ObservedRow], folds: &[usize], k: usize,
         }
         let train: Vec<usize> = (0..rows.len()).filter(|&i| folds[i] != f).collect();
         let idx: Vec<usize> = train.iter().flat_map(|&i| offset[i]..offset[i + 1]).collect();
-        let jt = lin.jacobian.select_rows(idx.iter());
+        // (the priors' rows belong to every training set)
+        let jt = with_prior_rows(lin.jacobian.select_rows(idx.iter()), &lin.params, &lin.u);
         let w: Vec<f64> = idx.iter().map(|&j| lin.weights[j]).collect();
         let train_rows: Vec<ObservedRow> = train.iter().map(|&i| rows[i].clone()).collect();
         let hinv = pseudo_inverse(&(jt.transpose() * &jt));
         let weighted = |u: &DVector<f64>| -> DVector<f64> {
             let r = residuals(&lin.motor_at(u), &train_rows);
-            DVector::from_iterator(r.len(), r.iter().zip(&w).map(|(x, w)| x * w))
+            let prior = prior_residuals(&lin.params, u);
+            DVector::from_iterator(r.len() + prior.len(), r.iter().zip(&w).map(|(x, w)| x * w).chain(prior))
         };
-        let mut r = DVector::from_iterator(idx.len(), idx.iter().map(|&j| lin.residuals[j]));
+        let prior0 = prior_residuals(&lin.params, &lin.u);
+        let mut r =
+            DVector::from_iterator(idx.len() + prior0.len(), idx.iter().map(|&j| lin.residuals[j]).chain(prior0));
         let mut best = (lin.u.clone(), r.norm_squared());
         for iteration in 0..2 {
             let step = &hinv * (jt.transpose() * &r);
@@ -682,9 +697,10 @@ fn fit_params(
     rows: &[ObservedRow],
     effects: &[Effect],
     reduced: bool,
+    tolerances: &BTreeMap<String, f64>,
 ) -> (Motor, Vec<FitParam>) {
     let mut m = start.clone();
-    let mut params = baseline_params(motor, rows);
+    let mut params = baseline_params_with(motor, rows, tolerances);
     if reduced {
         // few readings: keep friction, damping and force factor only
         params.retain(|fp| {
@@ -693,6 +709,13 @@ fn fit_params(
                 || n.ends_with("modal_damping_ns_per_m")
                 || n.ends_with("force_factor_n_per_v")
         });
+    }
+    // an instrument floor starts mid-range (at zero it would sit on its bound, where the
+    // transformed gradient vanishes)
+    for fp in params.iter().filter(|fp| matches!(fp.param, ParamRef::Instrument(_))) {
+        if m.effects.instrument().speed_std_floor_rpm == 0.0 {
+            m.effects.instrument_mut().speed_std_floor_rpm = 0.5 * (fp.lo + fp.hi);
+        }
     }
     let already = start.effects.active();
     for &e in effects {
@@ -727,12 +750,12 @@ fn cross_validate(
         if test_idx.is_empty() {
             continue;
         }
-        let (s0, params) = fit_params(motor, start, &train, effects, reduced);
+        let (s0, params) = fit_params(motor, start, &train, effects, reduced, &opts.tolerances);
         let mut fitted = calibrate(&s0, &train, &params, &opts.fit).ok();
         if !effects.is_empty() {
             // Nested models: the effect at zero strength is the baseline, so a fit that ends
             // worse than the baseline's is a local minimum; use the baseline fit instead.
-            let (b0, bp) = fit_params(motor, start, &train, &[], reduced);
+            let (b0, bp) = fit_params(motor, start, &train, &[], reduced, &opts.tolerances);
             let base = calibrate(&b0, &train, &bp, &opts.fit).ok();
             if let Some(b) = base {
                 if fitted.as_ref().is_none_or(|f| f.chi2 > b.chi2) {
@@ -775,6 +798,11 @@ pub fn diagnose(
     opts: &DiagnoseOptions,
 ) -> Result<Diagnosis, TrumError> {
     let n_read: usize = rows.iter().map(|r| r.readings.len()).sum();
+    // The bench model first: set points read back with noise are taken at their run's
+    // mean, quantised readings carry their rounding error (`bench`).
+    let (snapped, snap_note) = bench::snap_set_points(rows, groups);
+    let (bench_rows, quantum_note) = bench::account_for_quantisation(&snapped);
+    let rows = &bench_rows[..];
     // Noise levels from the data, so that χ² and the evidence are on the scale of the
     // actual noise; clamped to [1/4, 4] × the stated levels.
     let est = crate::noise::estimate(rows, groups);
@@ -806,7 +834,7 @@ pub fn diagnose(
     let k = opts.folds.clamp(2, uniq.len());
     let fold_of: BTreeMap<&String, usize> = uniq.iter().enumerate().map(|(i, key)| (*key, i % k)).collect();
     let folds: Vec<usize> = keys.iter().map(|key| fold_of[key]).collect();
-    let mut notes = Vec::new();
+    let mut notes: Vec<String> = snap_note.into_iter().chain(quantum_note).collect();
     if !noise_scale.is_empty() {
         let list: Vec<String> = noise_scale.iter().map(|(q, f, n)| format!("{q} ×{f:.2} ({n})")).collect();
         notes.push(format!(
@@ -815,7 +843,7 @@ pub fn diagnose(
             list.join(", ")
         ));
     }
-    let n_base = baseline_params(motor, rows).len();
+    let n_base = baseline_params_with(motor, rows, &opts.tolerances).len();
     let reduced = n_read < 4 * (n_base + 2);
     if reduced {
         notes.push(format!(
@@ -838,7 +866,7 @@ pub fn diagnose(
         (acc / n_read as f64).sqrt()
     };
     // full-data baseline fit (the start of every other fit; "where", BIC, reported parameters)
-    let (start0, bparams) = fit_params(motor, motor, rows, &[], reduced);
+    let (start0, bparams) = fit_params(motor, motor, rows, &[], reduced, &opts.tolerances);
     // A baseline that ends with a parameter on a bound is refitted from its own end
     // (`calibrate_refitting_bounds`). (1000-row benchmark, seeds 31-38: every single fit,
     // started from the baseline left on the damping bound, first refitted the baseline
@@ -973,6 +1001,8 @@ pub fn diagnose(
     // baseline when None), which stand in when the fit ends worse than it.
     // χ² of the nominal motor itself, for the strong-effect probes below (once, if needed)
     let nominal_chi2 = std::sync::OnceLock::<f64>::new();
+    // fits whose starts ended in different valleys (reported in the notes)
+    let start_notes = std::sync::Mutex::new(Vec::<String>::new());
     type Scored = (RankEntry, Vec<Vec<f64>>, Option<Calibration>);
     type Nested = Option<(f64, Vec<Vec<f64>>, Vec<FittedParam>)>;
     let score = |effects: &[Effect], from: &Motor, nested: &Nested| -> Scored {
@@ -981,7 +1011,7 @@ pub fn diagnose(
         // Two starts: the calibrated baseline with the effect weak (`EffectInfo::fit_start`),
         // and the nominal motor with the effect at its typical strength. The baseline calibration may have bent
         // its parameters to mimic part of the effect, a valley the first start can stay in.
-        let (s0, params) = fit_params(motor, from, rows, effects, reduced);
+        let (s0, params) = fit_params(motor, from, rows, effects, reduced, &opts.tolerances);
         let kpar = params.len();
         let name = effects.iter().map(|e| e.name()).collect::<Vec<_>>().join("+");
         if effects.iter().any(|e| untestable.contains(e)) {
@@ -1099,6 +1129,51 @@ pub fn diagnose(
                 }
             }
         }
+        // The search over the effect's whole documented range: a coarse scan of its
+        // strength (and shape), from the calibrated baseline and from the nominal motor,
+        // on a subsample of the rows. A valley the fits above did not reach — beyond their
+        // bounds, or simply lower on the scan's rows than where they ended — is fitted
+        // from, with the bounds widened to hold it (`scan`).
+        if nested.is_none() && effects.len() == 1 {
+            let fit_motor = match &cal {
+                Ok(c) if !c.abandoned => c.motor.clone(),
+                _ => start.clone(),
+            };
+            let valleys = scan::valleys(&[&start, motor], &fit_motor, rows, effects[0]);
+            let mut disagree = Vec::new();
+            for v in valleys {
+                let mut wide = params.clone();
+                scan::widen(&mut wide, effects[0], &v.values);
+                let mut s2 = v.base.clone();
+                s2.effects.set(effects[0], &v.values);
+                if let Ok(c2) = calibrate_nested(&s2, rows, &wide, &opts.fit, added, Start::Restart) {
+                    let current = match &cal {
+                        Ok(c) if !c.abandoned => c.chi2,
+                        _ => f64::INFINITY,
+                    };
+                    if !c2.abandoned {
+                        if (c2.chi2 - current).abs() > 10.0 && current.is_finite() {
+                            disagree.push(format!(
+                                "χ² {:.0} from {} = {:.3e} against {:.0}",
+                                c2.chi2,
+                                effects[0].info().params[0].name,
+                                v.values[0],
+                                current
+                            ));
+                        }
+                        if c2.chi2 < current {
+                            cal = Ok(c2);
+                        }
+                    }
+                }
+            }
+            if !disagree.is_empty() {
+                start_notes
+                    .lock()
+                    .map(|mut n| n.push(format!("{}: starts disagree ({})", effects[0], disagree.join("; "))))
+                    .ok();
+            }
+        }
         let mut in_sample = 0;
         let (evidence, fitted, preds, fitted_motor) = match cal {
             // Nested models: the effect at zero strength is the baseline, so a fit that ends
@@ -1201,7 +1276,20 @@ pub fn diagnose(
     let mut verdict = String::from("none");
     let mut confounded = Vec::new();
     let mut partial = None;
+    let mut complete = true;
     let mut screened_note = None;
+    // the fraction of the held-out gap beyond the noise an entry closes
+    let excess_shrink = |r: &RankEntry| {
+        let before = beyond(base_nrmse);
+        if before > 0.0 {
+            1.0 - beyond(r.heldout_nrmse_after) / before
+        } else {
+            0.0
+        }
+    };
+    // A material part of the gap: a fifth of the held-out NRMSE or a quarter of its part
+    // beyond the noise (with the supported test's bootstrap bound above zero).
+    let material = |r: &RankEntry| supported(r) && (r.shrink >= 0.2 || excess_shrink(r) >= 0.25);
     if gap {
         let best_single = ranking.iter().find(|r| supported(r)).cloned();
         let single_closes = best_single.as_ref().is_some_and(closes);
@@ -1391,9 +1479,27 @@ pub fn diagnose(
                 verdict = joined;
             }
             None if single_closes => verdict = best_single.as_ref().map(|b| b.effect.clone()).unwrap_or_default(),
-            None => verdict = "unexplained".into(),
+            // The best supported single that closes a material part of the gap is the
+            // verdict even when a gap remains (`complete: false`): the data's form of the
+            // effect may lie outside every form its candidate family can take.
+            None => match best_single.as_ref().filter(|b| material(b)) {
+                Some(b) => {
+                    verdict = b.effect.clone();
+                    complete = false;
+                    notes.push(format!(
+                        "{} closes {} % of the held-out gap ({} % of its part beyond the noise) but not all of it: \
+                         the data's form of the effect may differ from every form its candidate takes, or \
+                         something else remains",
+                        b.effect,
+                        rounded(100.0 * b.shrink),
+                        rounded(100.0 * excess_shrink(b))
+                    ));
+                }
+                None => verdict = "unexplained".into(),
+            },
         }
         if verdict == "unexplained" {
+            complete = false;
             partial = best_single.as_ref().map(|b| b.effect.clone());
             if let Some(b) = best_single.as_ref() {
                 notes.push(format!(
@@ -1419,8 +1525,15 @@ pub fn diagnose(
                 for r in &ranking {
                     let alike =
                         r.heldout_nrmse_after <= 1.15 * best.heldout_nrmse_after && best.evidence - r.evidence < 5.0;
-                    let one_shape = r.signature_overlap.is_some_and(|o| o >= 0.95) && closes(r);
-                    if r.effect != best.effect && !r.effect.contains('+') && supported(r) && (alike || one_shape) {
+                    // (for an incomplete verdict: any supported candidate the evidence does
+                    // not separate from it)
+                    let close_call = !complete && best.evidence - r.evidence < 5.0;
+                    let one_shape = r.signature_overlap.is_some_and(|o| o >= 0.95) && (closes(r) || !complete);
+                    if r.effect != best.effect
+                        && !r.effect.contains('+')
+                        && supported(r)
+                        && (alike || one_shape || close_call)
+                    {
                         confounded.push(r.effect.clone());
                     }
                 }
@@ -1432,6 +1545,7 @@ pub fn diagnose(
         ));
     }
     notes.extend(screened_note);
+    notes.extend(start_notes.into_inner().unwrap_or_default());
     // held-out figures that rest partly on in-sample predictions
     let stuck: Vec<String> = std::iter::once(("the calibrated baseline".to_string(), base_cv.in_sample))
         .chain(ranking.iter().map(|r| (r.effect.clone(), r.heldout_in_sample_folds)))
@@ -1471,6 +1585,7 @@ pub fn diagnose(
     }
     Ok(Diagnosis {
         verdict,
+        complete,
         confounded_with: confounded,
         partial,
         baseline_heldout_nrmse: base_nrmse,
@@ -1615,6 +1730,7 @@ pub fn status_ok(s: Status) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::calibrate::tests::classic_tolerances;
     use crate::presets::preset;
     use crate::synth::{synthesize, Campaign, SynthConfig};
 
@@ -1651,7 +1767,7 @@ mod tests {
     fn an_overshooting_fold_step_is_damped_not_dropped() {
         let (nominal, rows, _) = sag_data();
         let fit = FitOptions::default();
-        let (s0, params) = fit_params(&nominal, &nominal, &rows, &[], false);
+        let (s0, params) = fit_params(&nominal, &nominal, &rows, &[], false, &BTreeMap::new());
         let cal = calibrate(&s0, &rows, &params, &fit).expect("baseline");
         // folds by preload, so each held-out block moves the parameters
         let mut loads: Vec<f64> = rows.iter().map(|r| r.op.preload_n).collect();
@@ -1786,12 +1902,13 @@ mod tests {
         let loads = [100.0, 175.0, 250.0, 325.0, 400.0];
         let rows = crate::calibrate::tests::rows_on_grid(&truth, &loads, &[0.0, 0.15, 0.3, 0.45]);
         let fit = FitOptions::default();
-        let (s0, params) = fit_params(&nominal, &nominal, &rows, &[], false);
+        let (s0, params) = fit_params(&nominal, &nominal, &rows, &[], false, &classic_tolerances());
         let base = calibrate(&s0, &rows, &params, &fit).expect("baseline");
         let sig = signature::signature(&base, &rows, Effect::RadialFriction).expect("signature");
         let sc = scales(&rows);
         let (d_chi2, d_e2) = first_order_gains(&base, &rows, &sig, &sc);
-        let (s1, params) = fit_params(&nominal, &base.motor, &rows, &[Effect::RadialFriction], false);
+        let (s1, params) =
+            fit_params(&nominal, &base.motor, &rows, &[Effect::RadialFriction], false, &classic_tolerances());
         let with = calibrate_adding(&s1, &rows, &params, &fit, &[Effect::RadialFriction]).expect("refit");
         assert!(!with.abandoned);
         // Σ z² and Σ e² of a motor's residuals
@@ -1903,20 +2020,20 @@ mod tests {
             candidates: candidates.to_vec(),
             try_pairs: false,
             bootstrap: 200,
+            // (mechanism tests written on the classic baseline)
+            tolerances: classic_tolerances(),
             ..DiagnoseOptions::default()
         };
         diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis")
     }
 
     /// On a `combined` campaign the weights' noise levels put the whole held-out NRMSE of
-    /// the baseline inside the noise (noise NRMSE 0.116 against 0.072, where noise alone
-    /// gives 0.0225). The test "half of the NRMSE beyond the noise is gone" then held for
-    /// every supported effect, and `radial_friction`, closing 18 % of the gap with held-out
-    /// χ² 4.2 per reading left of 5.4, was the verdict for a truth of preload stiffening
-    /// (blind benchmark, 1 × typical, half noise, seed 136). With the best noise level in
-    /// that test nothing closes the gap: `unexplained`, and the supported effect is named as
-    /// the part it explains. (The truth is left out of the candidates: since stop 35 the
-    /// `preload_stiffening` candidate spans the truth form's projection and closes the gap.)
+    /// the baseline inside the noise, where noise alone gives a small fraction of it. The
+    /// test "half of the NRMSE beyond the noise is gone" measured against the weights'
+    /// level would then hold for every supported effect, and a `radial_friction` closing a
+    /// fifth of a preload-stiffening gap would pass for the whole answer. Against the best
+    /// noise estimate it closes only part: named, as the best partial explanation among the
+    /// candidates (the truth is left out of them), with `complete: false`.
     #[test]
     fn a_gap_inside_the_weights_noise_is_not_closed_by_every_effect() {
         let d =
@@ -1932,23 +2049,23 @@ mod tests {
         let rf = d.ranking.iter().find(|r| r.effect == "radial_friction").expect("ranked");
         assert!(rf.evidence > 5.0 && rf.shrink_interval.0 > 0.0, "radial friction no longer supported: {rf:?}");
         assert!(rf.shrink < 0.5 && rf.heldout_chi2_after > 2.0, "{rf:?}");
-        assert_eq!(d.verdict, "unexplained");
-        assert_eq!(d.partial.as_deref(), Some("radial_friction"));
-        assert!(d.notes.iter().any(|n| n.starts_with("radial_friction is supported")), "{:?}", d.notes);
+        assert_eq!(d.verdict, "radial_friction");
+        assert!(!d.complete, "a remaining gap is reported");
+        assert!(
+            d.notes.iter().any(|n| n.starts_with("radial_friction closes") && n.contains("not all")),
+            "{:?}",
+            d.notes
+        );
     }
 
-    /// A strong `radial_friction` (ρ = 3) stalls the rotor from 200 N on; the baseline
-    /// calibration then ends with the rotor at rest at every reading, the turning ones too,
-    /// and there six of the seven candidates move no prediction. They were ranked
-    /// untestable and the verdict was `unexplained` (blind benchmark, seed 1201, where the
-    /// true motor shrinks the gap by 0.97). Probed at the nominal motor as well, they are
-    /// fitted, the strong-effect starts find ρ, and a note says what the baseline did.
+    /// A strong `radial_friction` (ρ = 3) stalls the rotor from 200 N on. A baseline
+    /// calibration can end with the rotor at rest at every reading, the turning ones too,
+    /// where six of the seven candidates move no prediction; probed at the nominal motor as
+    /// well, they stay testable, and the strong-effect starts find ρ.
     #[test]
-    fn a_baseline_at_rest_everywhere_leaves_the_effects_testable() {
+    fn a_strong_radial_friction_that_stalls_the_rotor_is_found() {
         let candidates = [Effect::RadialFriction, Effect::ThermalDrift, Effect::TangentialCompliance];
         let d = diagnosed_single(Effect::RadialFriction, 3.0, Campaign::PreloadTorque, 0.5, 1201, &candidates);
-        // the premise: the baseline has the rotor at rest wherever it was measured turning
-        assert!(d.notes.iter().any(|n| n.contains("has the rotor at rest")), "{:?}", d.notes);
         assert_eq!(d.verdict, "radial_friction");
         let rf = d.ranking.iter().find(|r| r.effect == "radial_friction").expect("ranked");
         let rho = rf.params.first().map(|p| p.1).unwrap_or(0.0);
@@ -2001,11 +2118,12 @@ mod tests {
             candidates: vec![Effect::RadialFriction],
             try_pairs: false,
             bootstrap: 50,
+            tolerances: classic_tolerances(),
             ..DiagnoseOptions::default()
         };
         // (the rows as the diagnosis fits them: σ scaled by the estimated noise levels)
         let scaled = noise_scaled(&rows, &crate::noise::estimate(&rows, &groups));
-        let (s0, bp) = fit_params(&nominal, &nominal, &scaled, &[], false);
+        let (s0, bp) = fit_params(&nominal, &nominal, &scaled, &[], false, &classic_tolerances());
         let on_damping_bound =
             |c: &Calibration| c.params.iter().any(|p| p.name.ends_with("modal_damping_ns_per_m") && p.at_bound);
         let first = calibrate(&s0, &scaled, &bp, &opts.fit).expect("baseline");
@@ -2133,7 +2251,8 @@ mod tests {
         let (rows, _) = data(&nominal, 1.0, 3);
         let mut lead = nominal.clone();
         lead.effects.set_strength(Effect::RadialFriction, 0.8);
-        let (m, params) = fit_params(&nominal, &lead, &rows, &[Effect::RadialFriction, Effect::VoltageSag], false);
+        let (m, params) =
+            fit_params(&nominal, &lead, &rows, &[Effect::RadialFriction, Effect::VoltageSag], false, &BTreeMap::new());
         let names: Vec<String> = params.iter().map(|p| p.param.name()).collect();
         for e in [Effect::RadialFriction, Effect::VoltageSag] {
             assert!(
@@ -2157,7 +2276,7 @@ mod tests {
         let grid =
             |m: &Motor| crate::calibrate::tests::rows_on_grid(m, &[100.0, 200.0, 300.0, 400.0], &[0.0, 0.2, 0.4, 0.6]);
         let rows = grid(&nominal);
-        let (start, params) = fit_params(&nominal, &nominal, &rows, &[tc], false);
+        let (start, params) = fit_params(&nominal, &nominal, &rows, &[tc], false, &BTreeMap::new());
         let hi = params.iter().find(|fp| fp.param == ParamRef::Effect(tc, 0)).expect("strength").hi;
         let fitted = |v: f64| {
             params
@@ -2168,6 +2287,7 @@ mod tests {
                     std_error: 0.0,
                     at_bound: false,
                     identifiable: true,
+                    prior_rel_sd: None,
                 })
                 .collect::<Vec<_>>()
         };

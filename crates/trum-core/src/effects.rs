@@ -290,6 +290,33 @@ pub struct Effects {
     on: [bool; N_EFFECTS],
     values: [[f64; MAX_PARAMS]; N_EFFECTS],
     truth: bool,
+    /// With `truth`: the second family of bench-truth forms (docs/EFFECTS.md), held out of
+    /// every tuning of the diagnosis.
+    truth_b: bool,
+    instrument: Instrument,
+}
+
+/// The bench's own instrument artefacts, which calibration and the diagnosis estimate as
+/// nuisance parameters beside the motor's (docs/DIAGNOSIS.md, "The bench model"). They
+/// change what a reading shows, never the motor's state, and are never reported as an
+/// effect of the motor. Zero by default; not part of a motor file.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Instrument {
+    /// Noise floor of the speed-stability reading [rev/min]: the instrument reads
+    /// √(true² + floor²) of a speed standard deviation.
+    pub speed_std_floor_rpm: f64,
+}
+
+impl Instrument {
+    /// What the instrument shows of quantity `o` when the motor's value is `model`.
+    pub fn reading(&self, o: crate::calibrate::Observable, model: f64) -> f64 {
+        match o {
+            crate::calibrate::Observable::SpeedStdRpm if self.speed_std_floor_rpm > 0.0 => {
+                model.hypot(self.speed_std_floor_rpm)
+            }
+            _ => model,
+        }
+    }
 }
 
 impl Effects {
@@ -303,6 +330,31 @@ impl Effects {
     /// them by default so a diagnosis cannot pass by recognising its own formulas.
     pub fn set_truth_forms(&mut self, on: bool) {
         self.truth = on;
+        self.truth_b &= on;
+    }
+
+    /// Use the second family of bench-truth forms (`true`) or the first (`false`); either
+    /// switches the truth forms on. The second family differs in form from the first and
+    /// from every candidate; the blind benchmark keeps it, and its artefacts, out of every
+    /// tuning of the diagnosis (docs/DIAGNOSIS.md).
+    pub fn set_truth_form_b(&mut self, on: bool) {
+        self.truth = true;
+        self.truth_b = on;
+    }
+
+    /// True when the second family of bench-truth forms is in use.
+    pub fn truth_form_b(&self) -> bool {
+        self.truth && self.truth_b
+    }
+
+    /// The bench's instrument artefacts (nuisance parameters of a fit).
+    pub fn instrument(&self) -> &Instrument {
+        &self.instrument
+    }
+
+    /// Mutable access to the instrument artefacts.
+    pub fn instrument_mut(&mut self) -> &mut Instrument {
+        &mut self.instrument
     }
 
     /// True when the bench-truth forms are in use.
@@ -444,14 +496,15 @@ impl Effects {
         for (name, val) in t {
             if name == "form" {
                 match val.as_str() {
-                    Some("truth") => fx.truth = true,
-                    Some("candidate") => fx.truth = false,
+                    Some("truth") => fx.set_truth_form_b(false),
+                    Some("truth-b") => fx.set_truth_form_b(true),
+                    Some("candidate") => fx.set_truth_forms(false),
                     _ => {
                         return Err(ParamError {
                             source_name: source_name.into(),
                             line: line_of_key(text, "effects", "form"),
                             key: "effects.form".into(),
-                            reason: "must be \"candidate\" or \"truth\"".into(),
+                            reason: "must be \"candidate\", \"truth\" or \"truth-b\"".into(),
                         })
                     }
                 }
@@ -517,14 +570,16 @@ impl Effects {
 
     /// `[effects]` section in TOML (empty string when none is on).
     pub fn to_toml(&self) -> String {
+        let form = match (self.truth, self.truth_b) {
+            (true, true) => "form = \"truth-b\"\n",
+            (true, false) => "form = \"truth\"\n",
+            _ => "",
+        };
         if self.is_none() {
-            let form = if self.truth { "form = \"truth\"\n" } else { "" };
             return format!("\n[effects]  # none switched on; see `trum effects`\n{form}");
         }
         let mut s = String::from("\n[effects]\n");
-        if self.truth {
-            s.push_str("form = \"truth\"\n");
-        }
+        s.push_str(form);
         for e in self.active() {
             let parts: Vec<String> = e
                 .info()
@@ -560,7 +615,7 @@ impl fmt::Display for Effects {
             .collect();
         f.write_str(&parts.join(" + "))?;
         if self.truth {
-            f.write_str(" [truth forms]")?;
+            f.write_str(if self.truth_b { " [truth forms b]" } else { " [truth forms]" })?;
         }
         Ok(())
     }

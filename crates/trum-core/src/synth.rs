@@ -9,7 +9,7 @@ use crate::calibrate::{Observable, ObservedRow};
 use crate::error::TrumError;
 use crate::params::Motor;
 use crate::solve::{solve_prepared, OperatingPoint, Prepared, Status};
-use rand::SeedableRng;
+use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
@@ -70,8 +70,80 @@ pub struct SynthConfig {
     pub frequency_hz: f64,
     /// Use the truth forms of the effects (default) rather than the candidate forms.
     pub truth_forms: bool,
+    /// With `truth_forms`: the second family of truth forms (docs/EFFECTS.md).
+    pub truth_form_b: bool,
     /// Optional columns to leave out (to mimic a poorer bench).
     pub omit: Vec<Observable>,
+    /// What the bench adds to its readings besides their noise (none by default).
+    pub artefacts: Artefacts,
+}
+
+/// Bench artefacts: the ways a real test bench's readings differ from the motor's state
+/// besides random reading noise (docs/SYNTH.md). All zero by default. The diagnosis must
+/// recognise each as the bench's, never as an effect of the motor.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Artefacts {
+    /// Relative noise of the drive voltage as read back around its constant set point
+    /// (0.005: ±0.5 % standard deviation); the motor runs at the set point.
+    pub readback_rel: f64,
+    /// Noise floor of the speed-stability instrument [rev/min]: it reads
+    /// √(true² + floor²) (plus its noise).
+    pub speed_std_floor_rpm: f64,
+    /// Zero offset of the torque sensor [N·m]: the file records the true load minus it.
+    pub torque_offset_nm: f64,
+    /// Resolution of the speed readings [rev/min] (0: none): readings are rounded to it.
+    pub speed_quantum_rpm: f64,
+    /// Fraction of readings replaced by gross outliers (a reading off by 5-15 of its σ).
+    pub outlier_fraction: f64,
+}
+
+impl Artefacts {
+    /// Names of the artefacts as written in `name=value` lists.
+    pub const NAMES: [&'static str; 5] =
+        ["readback_rel", "speed_std_floor_rpm", "torque_offset_nm", "speed_quantum_rpm", "outlier_fraction"];
+
+    /// Parses `name=value,...` (e.g. `readback_rel=0.005,speed_std_floor_rpm=0.3`); the
+    /// error names the bad item and lists the valid names.
+    pub fn parse(spec: &str) -> Result<Artefacts, TrumError> {
+        let mut a = Artefacts::default();
+        for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let (k, v) = item.split_once('=').ok_or_else(|| {
+                TrumError::input(format!(
+                    "bench artefact '{item}': write name=value; names are {}",
+                    Self::NAMES.join(", ")
+                ))
+            })?;
+            let x: f64 =
+                v.trim().parse().ok().filter(|x: &f64| x.is_finite()).ok_or_else(|| {
+                    TrumError::input(format!("bench artefact '{item}': '{v}' is not a finite number"))
+                })?;
+            let slot = match k.trim() {
+                "readback_rel" => &mut a.readback_rel,
+                "speed_std_floor_rpm" => &mut a.speed_std_floor_rpm,
+                "torque_offset_nm" => &mut a.torque_offset_nm,
+                "speed_quantum_rpm" => &mut a.speed_quantum_rpm,
+                "outlier_fraction" => &mut a.outlier_fraction,
+                other => {
+                    return Err(TrumError::input(format!(
+                        "unknown bench artefact '{other}'; valid names are: {}",
+                        Self::NAMES.join(", ")
+                    )))
+                }
+            };
+            *slot = x;
+        }
+        let bad = |name: &str, why: &str| Err(TrumError::input(format!("bench artefact {name}: {why}")));
+        if !(0.0..0.2).contains(&a.readback_rel) {
+            return bad("readback_rel", "must be in [0, 0.2)");
+        }
+        if a.speed_std_floor_rpm < 0.0 || a.speed_quantum_rpm < 0.0 {
+            return bad("speed_std_floor_rpm / speed_quantum_rpm", "must be >= 0");
+        }
+        if !(0.0..0.5).contains(&a.outlier_fraction) {
+            return bad("outlier_fraction", "must be in [0, 0.5)");
+        }
+        Ok(a)
+    }
 }
 
 impl Default for SynthConfig {
@@ -85,7 +157,9 @@ impl Default for SynthConfig {
             voltage_v: 200.0,
             frequency_hz: 43_000.0,
             truth_forms: true,
+            truth_form_b: false,
             omit: Vec::new(),
+            artefacts: Artefacts::default(),
         }
     }
 }
@@ -117,28 +191,39 @@ impl SynthRow {
     }
 }
 
-/// The uncertain parameters perturbed in the true motor (relative std: `perturbation`,
-/// a tenth of it for the resonance frequency, whose absolute scale is much larger).
-pub const PERTURBED: [&str; 5] = [
-    "friction_layer.friction_coefficient",
-    "friction_layer.youngs_modulus_pa",
-    "stator.modal_damping_ns_per_m",
-    "stator.force_factor_n_per_v",
-    "stator.resonance_frequency_hz",
+/// The parameters perturbed in the true motor, each with its relative standard deviation
+/// as a multiple of `perturbation`: every parameter a real motor of the design differs in,
+/// the machined geometry less than the materials, the resonance frequency (whose absolute
+/// scale is much larger) least.
+pub const PERTURBED: [(&str, f64); 11] = [
+    ("friction_layer.friction_coefficient", 1.0),
+    ("friction_layer.youngs_modulus_pa", 1.0),
+    ("stator.modal_damping_ns_per_m", 1.0),
+    ("stator.force_factor_n_per_v", 1.0),
+    ("stator.resonance_frequency_hz", 0.1),
+    ("geometry.neutral_plane_distance_m", 0.7),
+    ("geometry.mean_radius_m", 0.3),
+    ("stator.modal_mass_kg", 1.0),
+    ("electrical.dielectric_loss_tangent", 2.0),
+    ("electrical.clamped_capacitance_f", 0.5),
+    ("electrical.feedback_gain_v_per_m", 1.0),
 ];
 
 /// The true motor: `motor` with its uncertain parameters perturbed.
 pub fn true_motor(motor: &Motor, cfg: &SynthConfig) -> Motor {
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.motor_seed.unwrap_or(cfg.seed) ^ 0x5eed_0f_7e57);
     let mut m = motor.clone();
-    for key in PERTURBED {
-        let rel = if key.ends_with("resonance_frequency_hz") { 0.1 * cfg.perturbation } else { cfg.perturbation };
+    for (key, factor) in PERTURBED {
+        let rel = factor * cfg.perturbation;
         let z: f64 = Normal::new(0.0, 1.0).map(|n| n.sample(&mut rng)).unwrap_or(0.0);
         if let Some(v) = m.param_mut(key) {
             *v *= (rel * z.clamp(-3.0, 3.0)).exp();
         }
     }
     m.effects.set_truth_forms(cfg.truth_forms);
+    if cfg.truth_forms && cfg.truth_form_b {
+        m.effects.set_truth_form_b(true);
+    }
     m
 }
 
@@ -182,6 +267,9 @@ pub fn synthesize(motor: &Motor, cfg: &SynthConfig) -> Result<Vec<SynthRow>, Tru
     let truth = true_motor(motor, cfg);
     let p = Prepared::new(&truth);
     let mut noise = Noise { rng: ChaCha8Rng::seed_from_u64(cfg.seed), level: cfg.noise };
+    // the artefacts draw from their own stream, so that data without them stay as they were
+    let mut bench = ChaCha8Rng::seed_from_u64(cfg.seed ^ 0xa47e_fac7);
+    let art = cfg.artefacts;
     let mut rows = Vec::new();
     let kinds: Vec<Campaign> = match cfg.campaign {
         Campaign::Combined => {
@@ -257,8 +345,18 @@ pub fn synthesize(motor: &Motor, cfg: &SynthConfig) -> Result<Vec<SynthRow>, Tru
             let readings = obs
                 .iter()
                 .map(|&o| {
-                    let v = o.predict(&s, ambient);
+                    let mut v = o.predict(&s, ambient);
+                    if o == Observable::SpeedStdRpm && art.speed_std_floor_rpm > 0.0 {
+                        v = v.hypot(art.speed_std_floor_rpm);
+                    }
                     let mut x = v + noise.gauss(reading_noise(o, v));
+                    if art.outlier_fraction > 0.0 && bench.random::<f64>() < art.outlier_fraction {
+                        let sign = if bench.random::<bool>() { 1.0 } else { -1.0 };
+                        x += sign * (5.0 + 10.0 * bench.random::<f64>()) * reading_noise(o, v);
+                    }
+                    if o == Observable::SpeedRpm && art.speed_quantum_rpm > 0.0 {
+                        x = (x / art.speed_quantum_rpm).round() * art.speed_quantum_rpm;
+                    }
                     if o != Observable::TemperatureC {
                         x = x.max(0.0);
                     }
@@ -273,6 +371,13 @@ pub fn synthesize(motor: &Motor, cfg: &SynthConfig) -> Result<Vec<SynthRow>, Tru
             m_op.preload_n = (op.preload_n + noise.gauss(1.0)).max(1.0);
             m_op.torque_nm = (op.torque_nm + noise.gauss(0.002)).max(0.0);
             m_op.voltage_v = (op.voltage_v + noise.gauss(0.3)).max(1.0);
+            if art.readback_rel > 0.0 {
+                let z: f64 = Normal::new(0.0, 1.0).map(|n| n.sample(&mut bench)).unwrap_or(0.0);
+                m_op.voltage_v = (m_op.voltage_v * (1.0 + art.readback_rel * z.clamp(-3.0, 3.0))).max(1.0);
+            }
+            if art.torque_offset_nm != 0.0 {
+                m_op.torque_nm = (m_op.torque_nm + art.torque_offset_nm).max(0.0);
+            }
             rows.push(SynthRow { op: m_op, time_series: ts, readings, ambient_c: ambient, run_id: run });
         }
     }

@@ -40,13 +40,21 @@ pub struct Provenance<'a> {
 pub fn to_json(d: &Diagnosis, src: &Provenance<'_>) -> Value {
     let pairs =
         |v: &[(String, f64)]| -> Vec<Value> { v.iter().map(|(n, x)| json!({"name": n, "value": num(*x)})).collect() };
+    // the held-out gap the verdict leaves (the baseline's for `none` and `unexplained`)
+    let remaining = d
+        .ranking
+        .iter()
+        .find(|r| super::same_set(&r.effect, &d.verdict))
+        .map_or(d.baseline_heldout_nrmse, |r| r.heldout_nrmse_after);
     json!({
         "verdict": d.verdict,
+        "complete": d.complete,
         "confounded_with": d.confounded_with,
         "partial": d.partial,
         "gap": {
             "baseline_heldout_nrmse": num(d.baseline_heldout_nrmse),
             "noise_nrmse": num(d.noise_nrmse),
+            "remaining_heldout_nrmse": num(remaining),
             "noise_nrmse_weights": num(d.noise_nrmse_weights),
             "baseline_heldout_chi2_per_reading": num(d.baseline_heldout_chi2_per_reading),
             "noise_scale": d.noise_scale.iter().map(|(q, f, n)| json!({"quantity": q, "factor": num(*f), "residuals": n})).collect::<Vec<_>>(),

@@ -142,7 +142,8 @@ mod tests {
         truth.effects.set(Effect::RadialFriction, &[0.3]);
         let rows = rows_of(&truth);
         let fit = FitOptions::default();
-        let base = calibrate(&nominal, &rows, &baseline_params(&nominal, &rows), &fit).unwrap();
+        let params = crate::calibrate::tests::classic_params(&nominal, &rows);
+        let base = calibrate(&nominal, &rows, &params, &fit).unwrap();
         let sig = signature(&base, &rows, Effect::RadialFriction).unwrap();
         assert!(sig.matched > 0.95, "match {}", sig.matched);
         for e in crate::effects::ALL.into_iter().filter(|&e| e != Effect::RadialFriction) {

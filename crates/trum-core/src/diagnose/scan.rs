@@ -1,0 +1,209 @@
+//! The coarse search of a candidate effect's whole documented range, before (and beside)
+//! its local fits (docs/DIAGNOSIS.md, "Fits that search").
+//!
+//! A local fit starts where it is told and is bounded to a few times the effect's typical
+//! strength, so that the solves stay easy; a real motor's effect need not be small, and a
+//! fit can end in a valley far from the effect's own. The scan evaluates the objective
+//! (nothing fitted) on a subsample of the rows at the effect's strengths on a logarithmic
+//! grid from a tenth of typical to the top of its valid range, at each end and the middle
+//! of every shape parameter, from each given base motor (the calibrated baseline and the
+//! nominal motor). A valley that lies beyond the fit's bounds, or lower on the scan's rows
+//! than where the fit ended, is handed back as a start.
+
+use crate::calibrate::{residuals, FitParam, ObservedRow, ParamRef};
+use crate::effects::Effect;
+use crate::params::Motor;
+
+/// Most rows the scan evaluates (evenly spaced through the data).
+const SCAN_ROWS: usize = 120;
+
+/// Most valleys handed back (each costs a fit).
+const MAX_VALLEYS: usize = 2;
+
+/// Ratio between neighbouring strengths of the grid (√10: two points a decade).
+const GRID_RATIO: f64 = 3.162_277_660_168_379;
+
+/// A start found by the scan.
+#[derive(Clone, Debug)]
+pub(crate) struct Valley {
+    /// The motor the effect is added to.
+    pub base: Motor,
+    /// The effect's parameters there.
+    pub values: Vec<f64>,
+    /// χ² on the scan's rows.
+    pub chi2: f64,
+}
+
+/// Strength factors (× typical) of the grid: from 0.1 up to the largest one within the
+/// valid range of every strength parameter.
+fn factors(e: Effect) -> Vec<f64> {
+    let top = e
+        .info()
+        .params
+        .iter()
+        .filter(|p| !p.shape && p.typical != 0.0)
+        .map(|p| if p.typical > 0.0 { p.max / p.typical } else { p.min / p.typical })
+        .fold(f64::INFINITY, f64::min);
+    let mut out = Vec::new();
+    let mut f = 0.1;
+    while f <= top * (1.0 + 1e-9) && out.len() < 16 {
+        out.push(f);
+        f *= GRID_RATIO;
+    }
+    out
+}
+
+/// The effect's parameter vectors of the grid: every strength at `factor` × typical,
+/// each shape parameter at its minimum, middle and maximum.
+fn grid(e: Effect) -> Vec<(f64, Vec<f64>)> {
+    let info = e.info();
+    let shapes: Vec<usize> = info.params.iter().enumerate().filter(|(_, p)| p.shape).map(|(i, _)| i).collect();
+    let mut shape_sets: Vec<Vec<f64>> = vec![info.params.iter().map(|p| p.start()).collect()];
+    for &i in &shapes {
+        let p = &info.params[i];
+        shape_sets = shape_sets
+            .into_iter()
+            .flat_map(|v| {
+                [p.min, 0.5 * (p.min + p.max), p.max].into_iter().map(move |x| {
+                    let mut w = v.clone();
+                    w[i] = x;
+                    w
+                })
+            })
+            .collect();
+    }
+    let mut out = Vec::new();
+    for f in factors(e) {
+        for set in &shape_sets {
+            let v: Vec<f64> =
+                info.params.iter().zip(set).map(|(p, &s)| if p.shape { s } else { f * p.typical }).collect();
+            out.push((f, v));
+        }
+    }
+    out
+}
+
+/// Valleys of the objective along the effect's strength, from each motor of `bases`, that
+/// the fit ending at `fitted` has not reached: lower than the fit on the scan's rows, or
+/// beyond eight times the typical strength (the fit's bounds) and lower than every
+/// strength within them. At most [`MAX_VALLEYS`], best first.
+pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e: Effect) -> Vec<Valley> {
+    use rayon::prelude::*;
+    let step = rows.len().div_ceil(SCAN_ROWS).max(1);
+    let sub: Vec<ObservedRow> = rows.iter().step_by(step).cloned().collect();
+    let chi2 = |m: &Motor| residuals(m, &sub).iter().map(|z| z * z).sum::<f64>();
+    let fit_chi2 = chi2(fitted);
+    let points = grid(e);
+    // (base index, factor, values, χ²)
+    let scored: Vec<(usize, f64, Vec<f64>, f64)> = bases
+        .iter()
+        .enumerate()
+        .flat_map(|(b, base)| points.iter().map(move |(f, v)| (b, base, *f, v.clone())))
+        .collect::<Vec<_>>()
+        .into_par_iter()
+        .map(|(b, base, f, v)| {
+            let mut m = (*base).clone();
+            m.effects.set(e, &v);
+            let c = chi2(&m);
+            (b, f, v, if c.is_finite() { c } else { f64::INFINITY })
+        })
+        .collect();
+    let mut found: Vec<Valley> = Vec::new();
+    for (b, base) in bases.iter().enumerate() {
+        // one series per shape set: the values with the same shape parameters
+        let mut series: Vec<Vec<&(usize, f64, Vec<f64>, f64)>> = Vec::new();
+        for p in scored.iter().filter(|p| p.0 == b) {
+            let shape_of = |v: &[f64]| -> Vec<u64> {
+                e.info().params.iter().zip(v).filter(|(q, _)| q.shape).map(|(_, x)| x.to_bits()).collect()
+            };
+            match series.iter_mut().find(|s| shape_of(&s[0].2) == shape_of(&p.2)) {
+                Some(s) => s.push(p),
+                None => series.push(vec![p]),
+            }
+        }
+        for s in &series {
+            let inside = s.iter().filter(|p| p.1 <= 8.0).map(|p| p.3).fold(f64::INFINITY, f64::min);
+            for (i, p) in s.iter().enumerate() {
+                let left = i == 0 || s[i - 1].3 > p.3;
+                let right = i + 1 == s.len() || s[i + 1].3 >= p.3;
+                if !(left && right) {
+                    continue;
+                }
+                let lower = p.3 < fit_chi2 - 4.0;
+                let fenced = p.1 > 8.0 && p.3 < inside - 4.0;
+                if lower || fenced {
+                    found.push(Valley { base: (*base).clone(), values: p.2.clone(), chi2: p.3 });
+                }
+            }
+        }
+    }
+    found.sort_by(|a, b| a.chi2.total_cmp(&b.chi2));
+    // distinct valleys only: not the same strength twice
+    let mut out: Vec<Valley> = Vec::new();
+    for v in found {
+        if !out.iter().any(|o| o.values == v.values) {
+            out.push(v);
+        }
+        if out.len() == MAX_VALLEYS {
+            break;
+        }
+    }
+    out
+}
+
+/// Widens the bounds of `e`'s strength parameters in `params` to hold `values` with room
+/// to move (three times the value, within the valid range).
+pub(crate) fn widen(params: &mut [FitParam], e: Effect, values: &[f64]) {
+    for fp in params.iter_mut() {
+        let ParamRef::Effect(f, i) = fp.param else { continue };
+        let p = &e.info().params[i];
+        if f != e || p.shape {
+            continue;
+        }
+        let v = values[i];
+        if v > 0.0 {
+            fp.hi = fp.hi.max((3.0 * v).min(p.max));
+        } else if v < 0.0 {
+            fp.lo = fp.lo.min((3.0 * v).max(p.min));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effects::ALL;
+
+    #[test]
+    fn the_grid_spans_each_effects_documented_range() {
+        for e in ALL {
+            let f = factors(e);
+            assert!(!f.is_empty(), "{e}");
+            assert!((f[0] - 0.1).abs() < 1e-12);
+            for p in e.info().params.iter().filter(|p| !p.shape && p.typical != 0.0) {
+                let top = f.last().copied().unwrap_or(0.0) * p.typical;
+                // within the range, and within one grid step of its end (or the grid's cap)
+                assert!(top.abs() <= p.max.abs().max(p.min.abs()) * (1.0 + 1e-9), "{e}: {top}");
+            }
+        }
+        // preload_stiffening reaches its documented scale of 5 (100 × typical), beyond the
+        // local fit's eight
+        let ps = factors(Effect::PreloadStiffening);
+        assert!(ps.last().copied().unwrap_or(0.0) * 0.05 > 3.0, "{ps:?}");
+        // a shape parameter at its ends and middle
+        assert_eq!(grid(Effect::PreloadStiffening).len(), 3 * ps.len());
+    }
+
+    #[test]
+    fn widening_holds_the_valley_within_the_valid_range() {
+        let e = Effect::PreloadStiffening;
+        let mut params = crate::calibrate::effect_params(e);
+        assert!((params[0].hi - 0.4).abs() < 1e-12);
+        widen(&mut params, e, &[1.0, 1.0]);
+        assert!((params[0].hi - 3.0).abs() < 1e-12);
+        widen(&mut params, e, &[4.0, 1.0]);
+        assert_eq!(params[0].hi, 5.0);
+        // the shape parameter keeps its whole range
+        assert_eq!((params[1].lo, params[1].hi), (0.0, 1.0));
+    }
+}
