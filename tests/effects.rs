@@ -25,9 +25,12 @@ fn at(m: &Motor, f: f64, t: f64) -> Solution {
 fn zero_strength_reproduces_the_baseline_exactly() {
     let base = preset("trum60a").unwrap();
     for e in ALL {
-        for truth in [false, true] {
+        for (truth, form_b) in [(false, false), (true, false), (true, true)] {
             let mut m = with(e, &[0.0, 0.0]);
             m.effects.set_truth_forms(truth);
+            if form_b {
+                m.effects.set_truth_form_b(true);
+            }
             for (f, t) in [(150.0, 0.0), (250.0, 0.4), (400.0, 0.2)] {
                 let mut op = OperatingPoint::new(f, t, 200.0, 43e3);
                 op.elapsed_s = 100.0;
@@ -291,9 +294,27 @@ fn truth_forms_differ_from_candidate_forms() {
         let cand = solve(&m, &op);
         m.effects.set_truth_forms(true);
         let truth = solve(&m, &op);
-        let differs = (cand.speed_rpm - truth.speed_rpm).abs() > 1e-6 * cand.speed_rpm
-            || (cand.speed_std_rpm - truth.speed_std_rpm).abs() > 1e-9
-            || (cand.electrode_voltage_v - truth.electrode_voltage_v).abs() > 1e-9;
-        assert!(differs, "{e}: truth form equals candidate form");
+        m.effects.set_truth_form_b(true);
+        let truth_b = solve(&m, &op);
+        let differs = |a: &Solution, b: &Solution| {
+            (a.speed_rpm - b.speed_rpm).abs() > 1e-6 * a.speed_rpm
+                || (a.speed_std_rpm - b.speed_std_rpm).abs() > 1e-9
+                || (a.electrode_voltage_v - b.electrode_voltage_v).abs() > 1e-9
+        };
+        assert!(differs(&cand, &truth), "{e}: truth form equals candidate form");
+        assert!(differs(&cand, &truth_b), "{e}: second truth form equals candidate form");
+        assert!(differs(&truth, &truth_b), "{e}: second truth form equals the first");
     }
+}
+
+/// The second truth forms are a motor-file setting too, and read back.
+#[test]
+fn the_second_truth_forms_read_back_from_a_motor_file() {
+    let mut m = typical(Effect::VoltageSag);
+    m.effects.set_truth_form_b(true);
+    let text = m.to_toml();
+    assert!(text.contains("form = \"truth-b\""), "{text}");
+    let back = Motor::from_toml_str(&text, "m.toml").expect("reads back");
+    assert!(back.effects.truth_form_b());
+    assert_eq!(back.effects, m.effects);
 }

@@ -12,11 +12,39 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-/// Nominal motor of every case.
-pub const MOTOR: &str = "trum60a";
+/// Nominal motor of every case: a frozen copy of the TRUM60A preset's values, so that a
+/// change of the built-in preset does not move the benchmark.
+pub const MOTOR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/motors/ring60.toml");
+
+/// The nominal motor.
+pub fn nominal() -> trum_core::Motor {
+    let text = std::fs::read_to_string(MOTOR).expect("reference motor file");
+    trum_core::Motor::from_toml_str(&text, MOTOR).expect("reference motor")
+}
+
+/// Which half of the benchmark a case belongs to: the development half (first truth
+/// forms, development artefacts), on which the diagnosis may be tuned, or the held-out
+/// half (second truth forms, other artefacts), which no tuning touches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Half {
+    /// Truth forms and artefacts the diagnosis was developed on.
+    Dev,
+    /// Truth forms and artefacts kept out of every tuning loop.
+    HeldOut,
+    /// The earlier design: first truth forms, no artefacts.
+    Plain,
+}
+
+/// Bench artefacts of the development half (`trum synth --artefacts`).
+pub const DEV_ARTEFACTS: &str = "readback_rel=0.004,speed_std_floor_rpm=0.3,outlier_fraction=0.01";
+
+/// Bench artefacts of the held-out half: other levels, and a quantised speed and a torque
+/// zero offset, which the development half never shows.
+pub const HELDOUT_ARTEFACTS: &str =
+    "readback_rel=0.006,speed_std_floor_rpm=0.5,speed_quantum_rpm=0.5,torque_offset_nm=0.002,outlier_fraction=0.005";
 
 /// One blind case: injected effects with their strength factor (× the typical strength,
-/// applied to every parameter of the effect), campaign, noise level and seed.
+/// applied to every parameter of the effect), campaign, noise level, seed and half.
 #[derive(Clone, Debug)]
 pub struct Case {
     pub effects: Vec<&'static str>,
@@ -24,6 +52,7 @@ pub struct Case {
     pub campaign: &'static str,
     pub noise: f64,
     pub seed: u64,
+    pub half: Half,
 }
 
 impl Case {
@@ -49,10 +78,37 @@ impl Case {
         out
     }
 
+    /// `trum synth` arguments of the case's half: truth-form family and artefacts.
+    pub fn half_args(&self) -> Vec<String> {
+        match self.half {
+            Half::Plain => vec![],
+            Half::Dev => vec!["--artefacts".into(), DEV_ARTEFACTS.into()],
+            Half::HeldOut => vec!["--truth-forms-b".into(), "--artefacts".into(), HELDOUT_ARTEFACTS.into()],
+        }
+    }
+
+    /// The synth configuration of the case (noise level `noise`).
+    fn synth_config(&self, noise: f64) -> trum_core::synth::SynthConfig {
+        use trum_core::synth::{Artefacts, Campaign, SynthConfig};
+        let artefacts = match self.half {
+            Half::Plain => Artefacts::default(),
+            Half::Dev => Artefacts::parse(DEV_ARTEFACTS).expect("artefacts"),
+            Half::HeldOut => Artefacts::parse(HELDOUT_ARTEFACTS).expect("artefacts"),
+        };
+        SynthConfig {
+            campaign: Campaign::from_name(self.campaign).expect("campaign"),
+            noise,
+            seed: self.seed,
+            truth_form_b: self.half == Half::HeldOut,
+            artefacts,
+            ..SynthConfig::default()
+        }
+    }
+
     /// The nominal motor with `names` injected at the case's strength (truth forms; the
     /// truth forms ignore shape parameters, which the form-error fits start mid-range).
     fn motor_with(&self, names: &[&str]) -> trum_core::Motor {
-        let mut m = trum_core::presets::preset(MOTOR).expect("preset");
+        let mut m = nominal();
         for name in names {
             let e = trum_core::effects::Effect::from_name(name).expect("effect name");
             let v: Vec<f64> = e.info().params.iter().map(|p| strength(p, self.factor)).collect();
@@ -76,13 +132,9 @@ impl Case {
     /// baseline parameters: the best any calibration could do.
     fn leftover_chi2(&self, injected: &[&str], fitted: &[&str]) -> f64 {
         use trum_core::calibrate::{baseline_params, calibrate, effect_params, FitOptions, ObservedRow};
-        use trum_core::synth::{reading_noise, synthesize, true_motor, Campaign, SynthConfig};
-        let cfg = SynthConfig {
-            campaign: Campaign::from_name(self.campaign).expect("campaign"),
-            noise: 0.0,
-            seed: self.seed,
-            ..SynthConfig::default()
-        };
+        use trum_core::synth::{reading_noise, synthesize, true_motor, Artefacts};
+        // the effect's signal in the motor's readings, without the bench's artefacts
+        let cfg = trum_core::synth::SynthConfig { artefacts: Artefacts::default(), ..self.synth_config(0.0) };
         let rows: Vec<ObservedRow> = synthesize(&self.motor_with(injected), &cfg)
             .expect("synth")
             .iter()
@@ -99,7 +151,7 @@ impl Case {
             .collect();
         let mut start = true_motor(&self.motor_with(fitted), &cfg);
         start.effects.set_truth_forms(false);
-        let mut params = baseline_params(&trum_core::presets::preset(MOTOR).expect("preset"), &rows);
+        let mut params = baseline_params(&nominal(), &rows);
         for name in fitted {
             params.extend(effect_params(trum_core::effects::Effect::from_name(name).expect("effect name")));
         }
@@ -119,14 +171,8 @@ impl Case {
         rows: &[trum_core::calibrate::ObservedRow],
         scale: &BTreeMap<trum_core::calibrate::Observable, f64>,
     ) -> f64 {
-        use trum_core::synth::{true_motor, Campaign, SynthConfig};
-        let cfg = SynthConfig {
-            campaign: Campaign::from_name(self.campaign).expect("campaign"),
-            noise: self.noise,
-            seed: self.seed,
-            ..SynthConfig::default()
-        };
-        let truth = true_motor(&self.motor_with(&self.effects), &cfg);
+        let cfg = self.synth_config(self.noise);
+        let truth = trum_core::synth::true_motor(&self.motor_with(&self.effects), &cfg);
         // residuals are (prediction − reading)/σ; a point without a solution counts 50 σ
         let z = trum_core::calibrate::residuals(&truth, rows);
         let sigmas = rows.iter().flat_map(|r| r.readings.iter().map(|x| (x.0, x.2)));
@@ -184,6 +230,8 @@ pub struct Outcome {
     /// Signal χ² of each injected effect.
     pub signal: Vec<f64>,
     pub verdict: String,
+    /// The JSON's `complete`.
+    pub complete: bool,
     pub confounded: Vec<String>,
     /// With an `unexplained` verdict, the supported effect the diagnosis says explains part
     /// of the gap (the JSON's `partial`).
@@ -247,12 +295,20 @@ fn trum(args: &[String]) -> String {
 
 /// Synthesises the case's data and diagnoses it blind.
 pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
-    let tag =
-        format!("{}-{}-{}-{}-{}", case.truth().replace('+', "_"), case.factor, case.campaign, case.noise, case.seed);
+    let tag = format!(
+        "{}-{}-{}-{}-{}-{:?}",
+        case.truth().replace('+', "_"),
+        case.factor,
+        case.campaign,
+        case.noise,
+        case.seed,
+        case.half
+    );
     let data = dir.join(format!("{tag}.csv"));
     let json = dir.join(format!("{tag}.json"));
     let mut args: Vec<String> = vec!["synth".into(), "--motor".into(), MOTOR.into()];
     args.extend(case.effect_args());
+    args.extend(case.half_args());
     for (k, v) in [
         ("--campaign", case.campaign.to_string()),
         ("--noise", case.noise.to_string()),
@@ -316,6 +372,7 @@ pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
         expected,
         signal,
         verdict_shrink: shrink_of(&verdict),
+        complete: v["complete"].as_bool().unwrap_or(false),
         verdict,
         confounded,
         partial: v["partial"].as_str().map(String::from),
@@ -334,7 +391,7 @@ fn oracle_shrink(case: &Case, data: &std::path::Path, v: &serde_json::Value, bef
     use trum_core::calibrate::Observable;
     let bytes = std::fs::read(data).expect("case CSV");
     let m = trum_core::measurements::parse_measurements(&bytes, &data.display().to_string()).expect("case CSV");
-    let bench = trum_core::bench::observations(&m, &trum_core::presets::preset(MOTOR).expect("preset"));
+    let bench = trum_core::bench::observations(&m, &nominal());
     let scale = trum_core::diagnose::nrmse_scales(&bench.rows, &bench.groups);
     let held = v["heldout"].as_array().expect("heldout");
     let sum: f64 = held
@@ -379,11 +436,64 @@ pub fn full_cases_at(seed_offset: u64) -> Vec<Case> {
         for noise in [0.5, 1.0] {
             for e in EFFECTS {
                 seed += 1;
-                out.push(Case { effects: vec![e], factor: STRONG_FACTOR, campaign, noise, seed });
+                out.push(Case { effects: vec![e], factor: STRONG_FACTOR, campaign, noise, seed, half: Half::Plain });
             }
         }
     }
     out
+}
+
+/// One half of the two-half benchmark (docs/DIAGNOSIS.md): every effect at 1 and 3 ×
+/// typical on the preload-torque and combined campaigns (28 cases), two null cases on each
+/// of the five campaign kinds (10) and two pairs at typical strength, all at the nominal
+/// bench noise, with the half's truth forms and artefacts; every seed moved by
+/// `seed_offset`. The halves draw different seeds.
+pub fn half_cases(half: Half, seed_offset: u64) -> Vec<Case> {
+    let mut seed = seed_offset + if half == Half::HeldOut { 5000 } else { 3000 };
+    let mut next = || {
+        seed += 1;
+        seed
+    };
+    let mut out = Vec::new();
+    for campaign in ["preload-torque", "combined"] {
+        for e in EFFECTS {
+            for factor in [1.0, STRONG_FACTOR] {
+                out.push(Case { effects: vec![e], factor, campaign, noise: 1.0, seed: next(), half });
+            }
+        }
+    }
+    for campaign in ["preload-torque", "combined", "frequency-sweep", "warm-up", "stability"] {
+        for _ in 0..2 {
+            out.push(Case { effects: vec![], factor: 0.0, campaign, noise: 1.0, seed: next(), half });
+        }
+    }
+    for pair in [["radial_friction", "thermal_drift"], ["voltage_sag", "eccentricity"]] {
+        out.push(Case { effects: pair.to_vec(), factor: 1.0, campaign: "combined", noise: 1.0, seed: next(), half });
+    }
+    out
+}
+
+/// The fast slice of the two-half benchmark in the test suite: for each half, four single
+/// effects on the preload-torque campaign (typical strength) and two null cases (one on a
+/// campaign without load torque). Seeds differ from the full run's.
+pub fn half_slice_cases(half: Half) -> Vec<Case> {
+    let base: u64 = if half == Half::HeldOut { 7000 } else { 6000 };
+    let one = |effects: Vec<&'static str>, campaign, seed: u64| Case {
+        factor: if effects.is_empty() { 0.0 } else { 1.0 },
+        effects,
+        campaign,
+        noise: 1.0,
+        seed: base + seed,
+        half,
+    };
+    vec![
+        one(vec!["radial_friction"], "preload-torque", 1),
+        one(vec!["voltage_sag"], "preload-torque", 2),
+        one(vec!["tangential_compliance"], "preload-torque", 3),
+        one(vec!["hertz_softening"], "preload-torque", 4),
+        one(vec![], "preload-torque", 5),
+        one(vec![], "frequency-sweep", 6),
+    ]
 }
 
 /// The full benchmark's first two strengths, × typical (with their nulls and pairs).
@@ -428,11 +538,11 @@ pub fn cases_at(factors: &[f64], seed_offset: u64) -> Vec<Case> {
         for noise in [0.5, 1.0] {
             for e in EFFECTS {
                 for &factor in factors {
-                    out.push(Case { effects: vec![e], factor, campaign, noise, seed: next() });
+                    out.push(Case { effects: vec![e], factor, campaign, noise, seed: next(), half: Half::Plain });
                 }
             }
             for _ in 0..2 {
-                out.push(Case { effects: vec![], factor: 0.0, campaign, noise, seed: next() });
+                out.push(Case { effects: vec![], factor: 0.0, campaign, noise, seed: next(), half: Half::Plain });
             }
         }
     }
@@ -442,7 +552,14 @@ pub fn cases_at(factors: &[f64], seed_offset: u64) -> Vec<Case> {
         ["preload_stiffening", "tangential_compliance"],
         ["hertz_softening", "radial_friction"],
     ] {
-        out.push(Case { effects: pair.to_vec(), factor: 1.0, campaign: "combined", noise: 1.0, seed: next() });
+        out.push(Case {
+            effects: pair.to_vec(),
+            factor: 1.0,
+            campaign: "combined",
+            noise: 1.0,
+            seed: next(),
+            half: Half::Plain,
+        });
     }
     out
 }
@@ -452,8 +569,14 @@ pub fn cases_at(factors: &[f64], seed_offset: u64) -> Vec<Case> {
 /// no time series, so `none` is right), one null case and one pair. Seeds differ from the
 /// full run's.
 pub fn slice_cases() -> Vec<Case> {
-    let one =
-        |e: &'static str, seed| Case { effects: vec![e], factor: 1.0, campaign: "preload-torque", noise: 1.0, seed };
+    let one = |e: &'static str, seed| Case {
+        effects: vec![e],
+        factor: 1.0,
+        campaign: "preload-torque",
+        noise: 1.0,
+        seed,
+        half: Half::Plain,
+    };
     vec![
         one("radial_friction", 901),
         one("preload_stiffening", 902),
@@ -461,13 +584,14 @@ pub fn slice_cases() -> Vec<Case> {
         one("voltage_sag", 904),
         one("tangential_compliance", 905),
         one("thermal_drift", 906),
-        Case { effects: vec![], factor: 0.0, campaign: "preload-torque", noise: 1.0, seed: 950 },
+        Case { effects: vec![], factor: 0.0, campaign: "preload-torque", noise: 1.0, seed: 950, half: Half::Plain },
         Case {
             effects: vec!["voltage_sag", "radial_friction"],
             factor: 1.0,
             campaign: "preload-torque",
             noise: 1.0,
             seed: 990,
+            half: Half::Plain,
         },
     ]
 }
@@ -478,7 +602,14 @@ pub fn slice_cases() -> Vec<Case> {
 /// `tangential_compliance` and `hertz_softening` cases are the strong-effect run's own
 /// (seeds 107 and 121), where those failures were found; the two others are new seeds.
 pub fn strong_cases() -> Vec<Case> {
-    let one = |e: &'static str, campaign, seed| Case { effects: vec![e], factor: 3.0, campaign, noise: 0.5, seed };
+    let one = |e: &'static str, campaign, seed| Case {
+        effects: vec![e],
+        factor: 3.0,
+        campaign,
+        noise: 0.5,
+        seed,
+        half: Half::Plain,
+    };
     vec![
         one("radial_friction", "preload-torque", 921),
         one("radial_friction", "combined", 922),
@@ -516,6 +647,10 @@ pub struct Summary {
     /// Of the non-null cases: `unexplained` verdicts naming the truth as what explains
     /// part of the gap (not in `hit_rate`).
     pub unexplained_naming_truth: usize,
+    /// Of the hits: verdicts with `complete: false`.
+    pub incomplete_hits: usize,
+    /// Null cases whose verdict is `unexplained`.
+    pub null_unexplained: usize,
 }
 
 pub fn summarise(outcomes: &[Outcome]) -> Summary {
@@ -531,6 +666,8 @@ pub fn summarise(outcomes: &[Outcome]) -> Summary {
         median_true_excess_shrink: median(non_null.iter().filter_map(|o| o.true_excess_shrink).collect()),
         median_oracle_shrink: median(non_null.iter().map(|o| o.oracle_shrink).collect()),
         unexplained_naming_truth: non_null.iter().filter(|o| o.unexplained_naming_truth()).count(),
+        incomplete_hits: non_null.iter().filter(|o| o.correct_or_confounded() && !o.complete).count(),
+        null_unexplained: outcomes.iter().filter(|o| o.case.effects.is_empty() && o.verdict == "unexplained").count(),
     }
 }
 

@@ -1322,6 +1322,14 @@ pub(crate) mod tests {
             .collect()
     }
 
+    /// The ring motor the calibration and diagnosis tests are built on: a frozen copy of
+    /// the TRUM60A preset's values (tests/data/motors/ring60.toml), so that a change of the
+    /// built-in preset does not move their reference data.
+    pub(crate) fn reference_motor() -> Motor {
+        Motor::from_toml_str(include_str!("../../../tests/data/motors/ring60.toml"), "ring60.toml")
+            .expect("reference motor")
+    }
+
     /// The baseline of the five classic parameters (friction coefficient, layer modulus,
     /// damping, force factor, resonance frequency; the feedback gain and capacitance where
     /// seen) without priors: for tests of fitting mechanisms written on that baseline.
@@ -1356,7 +1364,7 @@ pub(crate) mod tests {
 
     #[test]
     fn recovers_perturbed_parameters_from_noise_free_data() {
-        let truth = preset("trum60a").unwrap();
+        let truth = crate::calibrate::tests::reference_motor();
         let rows = rows_from(&truth);
         let mut start = truth.clone();
         start.friction_layer.friction_coefficient *= 1.3;
@@ -1383,7 +1391,7 @@ pub(crate) mod tests {
     #[test]
     fn the_stiffening_forms_blend_is_recovered_from_its_readings() {
         let e = Effect::PreloadStiffening;
-        let mut truth = preset("trum60a").expect("preset");
+        let mut truth = crate::calibrate::tests::reference_motor();
         truth.effects.set(e, &[0.2, 0.8]);
         let ops = [100.0, 200.0, 300.0, 400.0, 500.0].into_iter().flat_map(|f| {
             [(0.0, 43e3), (0.3, 43e3), (0.0, 44e3), (0.3, 44e3)].map(|(t, hz)| OperatingPoint::new(f, t, 200.0, hz))
@@ -1403,7 +1411,7 @@ pub(crate) mod tests {
     /// weights are all one; a weight vector of the wrong length is an input error.
     #[test]
     fn a_fixed_weight_fit_keeps_its_weights() {
-        let truth = preset("trum60a").unwrap();
+        let truth = crate::calibrate::tests::reference_motor();
         let mut rows = rows_from(&truth);
         // one gross outlier: the reweighted fit downweights it, a fixed-weight fit cannot
         rows[5].readings[0].1 *= 1.5;
@@ -1448,7 +1456,7 @@ pub(crate) mod tests {
         // An early stop of the unweighted first run, forced harder than the diagnosis's
         // (which stops where a step removes less than 1e-3 of χ²): the weighted runs end
         // where the plain fit's do.
-        let nominal = preset("trum60a").unwrap();
+        let nominal = crate::calibrate::tests::reference_motor();
         let sag = Effect::VoltageSag;
         let params = sag_fit_params(&nominal);
         let mut start = nominal.clone();
@@ -1483,7 +1491,7 @@ pub(crate) mod tests {
         // The damping starts on its upper bound (as after a nested fit that pressed it
         // there), the data want it inside: the fit comes back to the truth in a few passes
         // (59 from the transform's saturated end, t = 1 − 1e-9; 14 from t = 1 − BOUND_T).
-        let truth = preset("trum60a").unwrap();
+        let truth = crate::calibrate::tests::reference_motor();
         let rows = rows_from(&truth);
         let params = vec![
             fit_rel(&truth, "friction_layer.friction_coefficient", 0.3, 3.0),
@@ -1505,7 +1513,7 @@ pub(crate) mod tests {
         // threshold after the first step: the weights-only run, stopped there (rtol 1: any
         // step), leaves all-one weights, so its point would be the answer; the run is
         // finished as a full one and ends where the plain fit does.
-        let nominal = preset("trum60a").unwrap();
+        let nominal = crate::calibrate::tests::reference_motor();
         let sag = Effect::VoltageSag;
         let params = sag_fit_params(&nominal);
         let mut truth = nominal.clone();
@@ -1538,7 +1546,7 @@ pub(crate) mod tests {
     /// friction's, settles on the decrement instead).
     #[test]
     fn an_added_effect_collapses_only_when_the_data_lack_it() {
-        let nominal = preset("trum60a").unwrap();
+        let nominal = crate::calibrate::tests::reference_motor();
         let rf = Effect::VoltageSag;
         let with_rf = |m: &Motor, r: f64| {
             let mut m = m.clone();
@@ -1618,7 +1626,7 @@ pub(crate) mod tests {
     /// push it further down. Data with 300 Ω of voltage sag, the sag at 5e-4 of its range.
     #[test]
     fn a_second_start_collapses_at_zero_whatever_the_gradient() {
-        let nominal = preset("trum60a").expect("preset");
+        let nominal = crate::calibrate::tests::reference_motor();
         let sag = Effect::VoltageSag;
         let mut truth = nominal.clone();
         truth.effects.set(sag, &[300.0]);
@@ -1694,7 +1702,7 @@ pub(crate) mod tests {
     fn linearised_jacobian_matches_central_differences_of_whole_solves() {
         let (mut worst, mut stalled_rows, mut clamped_rows): (f64, usize, usize) = (0.0, 0, 0);
         for e in std::iter::once(None).chain(crate::effects::ALL.iter().copied().map(Some)) {
-            let mut m = preset("trum60a").unwrap();
+            let mut m = crate::calibrate::tests::reference_motor();
             let mut params = Vec::new();
             if let Some(e) = e {
                 // (a shape parameter mid-range: on its bound the transformed column vanishes)
@@ -1799,7 +1807,7 @@ pub(crate) mod tests {
 
     #[test]
     fn too_few_readings_is_an_error() {
-        let m = preset("trum60a").unwrap();
+        let m = crate::calibrate::tests::reference_motor();
         let rows = vec![ObservedRow {
             op: OperatingPoint::new(100.0, 0.0, 200.0, 43e3),
             readings: vec![(Observable::SpeedRpm, 100.0, 1.0)],
@@ -1817,7 +1825,7 @@ pub(crate) mod tests {
     /// 1e-3.
     #[test]
     fn a_fit_pressed_against_a_fold_stops_there() {
-        let nominal = preset("trum60a").expect("preset");
+        let nominal = crate::calibrate::tests::reference_motor();
         let mut truth = nominal.clone();
         truth.effects.set(Effect::RadialFriction, &[1.0]);
         let mut ops = Vec::new();

@@ -260,6 +260,8 @@ pub struct Prepared {
     pub(crate) sag_ohm: f64,
     pub(crate) runout_m: f64,
     pub(crate) truth: bool,
+    /// With `truth`: the second family of truth forms (docs/EFFECTS.md).
+    pub(crate) truth_b: bool,
     /// Whether solutions report the stall torque. For the generalised interface it costs a
     /// numerical integral per solve (the rotor at rest) that the speed solve itself rarely
     /// needs; calibration reads only the observables and leaves it out
@@ -305,6 +307,7 @@ impl Prepared {
             sag_ohm: fx.value(Effect::VoltageSag, 0),
             runout_m: fx.value(Effect::Eccentricity, 0),
             truth: fx.truth_forms(),
+            truth_b: fx.truth_form_b(),
             stall_torque: true,
         }
     }
@@ -422,7 +425,16 @@ impl Drive {
     /// linear ones (floored at 5 % of nominal so a large drift cannot make a stiffness,
     /// damping or friction coefficient non-physical) in the candidate.
     fn warm(&mut self, p: &Prepared, rise_k: f64) {
-        let law = |x: f64| if p.truth { (x * rise_k).exp() } else { (1.0 + x * rise_k).max(0.05) };
+        // (the second truth family: a sensitivity that saturates over about 25 K)
+        let law = |x: f64| {
+            if p.truth_b {
+                (1.0 + x * 25.0 * (rise_k / 25.0).tanh()).max(0.05)
+            } else if p.truth {
+                (x * rise_k).exp()
+            } else {
+                (1.0 + x * rise_k).max(0.05)
+            }
+        };
         let [a, b, g] = p.thermal;
         (self.ks, self.mu, self.c) = (p.ks * law(a), p.mu * law(b), p.c * law(g));
     }
@@ -437,7 +449,15 @@ fn sagged_voltage_v(p: &Prepared, op: &OperatingPoint, s: &Solution) -> f64 {
 
 /// [`sagged_voltage_v`] for the phase admittance (in phase, quadrature) [S].
 fn sagged_voltage_at(p: &Prepared, op: &OperatingPoint, (yr, yi): (f64, f64)) -> f64 {
-    let (zr, zi) = if p.truth { (p.sag_ohm, 0.5 * p.sag_ohm) } else { (p.sag_ohm, 0.0) };
+    // (the second truth family: an output resistance that grows with the load current, as
+    // a driver's saturating magnetics give)
+    let (zr, zi) = if p.truth_b {
+        (p.sag_ohm * (0.4 + 4.5 * p.sag_ohm * yr.hypot(yi)), 0.0)
+    } else if p.truth {
+        (p.sag_ohm, 0.5 * p.sag_ohm)
+    } else {
+        (p.sag_ohm, 0.0)
+    };
     let (re, im) = (1.0 + zr * yr - zi * yi, zr * yi + zi * yr);
     op.voltage_v / re.hypot(im)
 }
@@ -680,6 +700,15 @@ fn interface_law(p: &Prepared, d: &Drive, ct: &Contact) -> crate::interface::Law
         // its normal deflection W·(1 − c) before it slips, at the wave's frequency,
         // relative to the crest speed k·h0·ω·W.
         law.slip_scale = p.compliance * d.mu * (1.0 - ct.offset.max(-1.0)) / (p.k * p.h0);
+        if p.truth_b {
+            // the second truth family: a layer whose shear deflection before slip grows
+            // with the square root of its normal deflection
+            law.slip_scale = p.compliance * d.mu * 0.7 * (1.0 - ct.offset.max(-1.0)).sqrt() / (p.k * p.h0);
+        }
+    }
+    if p.truth_b && law.radial_ratio > 0.0 {
+        // the second truth family: radial slip that grows with the preload
+        law.radial_ratio = p.law.radial_ratio * (d.f_n / 200.0).sqrt();
     }
     law
 }
@@ -687,7 +716,13 @@ fn interface_law(p: &Prepared, d: &Drive, ct: &Contact) -> crate::interface::Law
 /// Seed 003: the softening cubic term by harmonic balance, k − (3/4)·β·W²; this returns
 /// (3/4)·β·(its growth with the preload) [N/m³].
 fn softening_per_w2(p: &Prepared, d: &Drive) -> f64 {
-    let growth = if p.truth { (1.0 + p.beta_gain * d.f_n).powf(1.3) } else { 1.0 + p.beta_gain * d.f_n };
+    let growth = if p.truth_b {
+        (0.8 * p.beta_gain * d.f_n).exp()
+    } else if p.truth {
+        (1.0 + p.beta_gain * d.f_n).powf(1.3)
+    } else {
+        1.0 + p.beta_gain * d.f_n
+    };
     0.75 * p.beta * growth
 }
 
@@ -699,7 +734,11 @@ fn modal_stiffness(p: &Prepared, d: &Drive, w: f64, ct: &Contact, a: f64) -> f64
     if p.stiffening != 0.0 {
         let layer = p.n * p.kf / p.k;
         k_eff += p.stiffening
-            * if p.truth {
+            * if p.truth_b {
+                // the second truth family: the axial form of the contact stiffness with a
+                // layer that stiffens as it is pressed
+                a * ct.chi0() / w * (1.0 + d.f_n / 300.0)
+            } else if p.truth {
                 layer * stator::width_integrated_modal_projection(ct.offset)
             } else {
                 // seed 001 eq. 8: k_s' = (2 n k_f / k)·[sin(kx0) − kx0·cos(kx0)] = A·χ(φ0)/W
@@ -1734,7 +1773,14 @@ pub(crate) fn eccentric_average_with(
     let mut prev = nominal.clone();
     for (j, sp) in speeds.iter_mut().enumerate() {
         let phi = 2.0 * PI * j as f64 / SAMPLES as f64;
-        let shape = if p.truth { (phi.cos() + 0.3 * (2.0 * phi).cos()) / 1.3 } else { phi.cos() };
+        let shape = if p.truth_b {
+            // the second truth family: a three-lobed runout besides the offset
+            (phi.cos() + 0.4 * (3.0 * phi).cos()) / 1.4
+        } else if p.truth {
+            (phi.cos() + 0.3 * (2.0 * phi).cos()) / 1.3
+        } else {
+            phi.cos()
+        };
         let count = if j == 0 || j == SAMPLES / 2 { 1.0 } else { 2.0 };
         let mut o = *op;
         o.preload_n = op.preload_n + ripple * shape;

@@ -391,7 +391,7 @@ mod tests {
 
     #[test]
     fn same_seed_same_data_and_zero_noise_is_exact() {
-        let m = preset("trum60a").unwrap();
+        let m = crate::calibrate::tests::reference_motor();
         let cfg = SynthConfig { campaign: Campaign::Combined, ..SynthConfig::default() };
         let a = synthesize(&m, &cfg).unwrap();
         let b = synthesize(&m, &cfg).unwrap();
@@ -405,7 +405,7 @@ mod tests {
 
     #[test]
     fn campaigns_have_the_expected_shape() {
-        let m = preset("trum60a").unwrap();
+        let m = crate::calibrate::tests::reference_motor();
         let rows =
             synthesize(&m, &SynthConfig { campaign: Campaign::PreloadTorque, ..SynthConfig::default() }).unwrap();
         assert_eq!(rows.len(), 56);

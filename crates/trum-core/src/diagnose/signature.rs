@@ -137,7 +137,7 @@ mod tests {
     /// removes; on baseline data it finds nothing.
     #[test]
     fn the_true_effect_matches_the_residual_and_its_score_is_of_the_fits_order() {
-        let nominal = preset("trum60a").unwrap();
+        let nominal = crate::calibrate::tests::reference_motor();
         let mut truth = nominal.clone();
         truth.effects.set(Effect::RadialFriction, &[0.3]);
         let rows = rows_of(&truth);
@@ -225,7 +225,7 @@ mod tests {
     /// no evidence for it, while sag's own data do.
     #[test]
     fn a_residual_only_a_negative_strength_removes_is_no_evidence() {
-        let nominal = preset("trum60a").unwrap();
+        let nominal = crate::calibrate::tests::reference_motor();
         let mut sag = nominal.clone();
         sag.effects.set(Effect::VoltageSag, &[300.0]);
         let with = rows_of(&sag);
