@@ -6,7 +6,7 @@ use crate::params::Motor;
 use std::f64::consts::PI;
 
 /// `eccentricity`: the preload varies once per revolution by ΔF = δ/(1/k_sp + 1/K_z)
-/// (crate::fluctuation); every additive quantity is averaged over the revolution with
+/// (crate::contact::contact_normal_stiffness_n_per_m); every additive quantity is averaged over the revolution with
 /// the time spent at each angle (∝ 1/Ω), so the energy balance still holds, and the
 /// speed's time-weighted standard deviation is reported. The truth form adds a
 /// twice-per-revolution component of 30 % (tilted as well as offset rotor).
@@ -28,7 +28,7 @@ pub(crate) fn eccentric_average_with(
     if nominal.status != Status::Ok {
         return nominal;
     }
-    let kz = crate::fluctuation::contact_normal_stiffness_n_per_m(motor, nominal.contact_half_angle_rad);
+    let kz = crate::contact::contact_normal_stiffness_n_per_m(motor, nominal.contact_half_angle_rad);
     let ripple =
         (p.runout_m / (1.0 / motor.assembly.axial_spring_stiffness_n_per_m + 1.0 / kz)).min(0.9 * op.preload_n);
     let mut acc: Option<Solution> = None;
