@@ -677,8 +677,11 @@ fn radii(law: &Law) -> impl Iterator<Item = (f64, f64)> + '_ {
 /// cosine carried by [`contact::sin_cos_step`].
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct AngleCarry {
+    /// The angle [rad].
     rad: f64,
+    /// Its (sine, cosine).
     sin_cos: (f64, f64),
+    /// Its derivative in the amplitude [rad/m].
     per_w: f64,
 }
 
@@ -695,12 +698,17 @@ impl AngleCarry {
 
 /// The baseline Coulomb interface's state at one trial amplitude.
 pub(crate) struct Coulomb {
+    /// Stick half-angle θs [rad].
     pub(crate) ts: f64,
+    /// Rotor surface speed v_r [m/s].
     pub(crate) vr: f64,
+    /// True when the rotor is at rest.
     pub(crate) stalled: bool,
-    /// Torque factor 2χ(θs) − χ(φ0), power factor 2E(θs) − E(φ0), stall torque factor.
+    /// Torque factor 2χ(θs) − χ(φ0) [-].
     pub(crate) tf: f64,
+    /// Power factor 2E(θs) − E(φ0) [-].
     pub(crate) pf: f64,
+    /// Torque factor with the rotor at rest [-].
     pub(crate) tf0: f64,
     /// d(power factor)/dW.
     pub(crate) pf_per_w: f64,

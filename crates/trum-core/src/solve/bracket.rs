@@ -8,8 +8,11 @@
 /// from its first step, the effects' fixed point after [`BRACKET_AFTER`] passes).
 #[derive(Default)]
 pub(crate) struct SignBracket {
+    /// The latest (x, h(x)) with h < 0.
     pub(crate) neg: Option<(f64, f64)>,
+    /// The latest (x, h(x)) with h > 0.
     pub(crate) pos: Option<(f64, f64)>,
+    /// Side of the latest recorded point: −1, +1, or 0 before the first.
     pub(crate) last_side: i8,
 }
 

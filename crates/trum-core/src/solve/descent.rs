@@ -30,10 +30,13 @@ pub(super) fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: O
 /// below the bound.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct WarmTop {
+    /// A proven upper bound of the largest fixed point [m].
     pub(super) bound: f64,
+    /// The amplitude extrapolated from the sweep's previous points [m], below the bound.
     pub(super) predicted: Option<f64>,
-    /// The contact and stick angles extrapolated to this point, for the first trial.
+    /// The contact half-angle φ0 extrapolated to this point [rad], for the first trial.
     pub(super) contact_rad: Option<f64>,
+    /// The stick half-angle θs extrapolated to this point [rad], for the first trial.
     pub(super) stick_rad: Option<f64>,
 }
 

@@ -9,33 +9,60 @@ use crate::stator;
 /// Motor constants the solver needs, computed once per motor.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Prepared {
+    /// Wave number N, wavelengths around the ring [-].
     pub(crate) n: f64,
+    /// Mean contact radius R0 [m].
     pub(crate) r0: f64,
+    /// Wave number per unit length k = N/R0 [1/m].
     pub(crate) k: f64,
+    /// Winkler stiffness of the friction layer k_f = E_f·b_f/h_f [N/m²].
     pub(crate) kf: f64,
+    /// Distance h0 of the stator surface from the neutral plane [m].
     pub(crate) h0: f64,
+    /// Friction coefficient μ of the layer [-].
     pub(crate) mu: f64,
+    /// Modal mass m [kg].
     pub(crate) m: f64,
+    /// Modal stiffness k_s = m·(2π·f_r)² [N/m].
     pub(crate) ks: f64,
+    /// Modal damping c [N·s/m].
     pub(crate) c: f64,
+    /// Force factor Θ of the piezoceramic [N/V].
     pub(crate) theta: f64,
+    /// Clamped capacitance C0 per phase [F].
     pub(crate) c0: f64,
+    /// Dielectric loss tangent tan δ [-].
     pub(crate) tan_d: f64,
+    /// Feedback-electrode gain [V/m].
     pub(crate) kfb: f64,
+    /// Rotor viscous damping d_r [N·m·s].
     pub(crate) dr: f64,
+    /// Heat transfer coefficient times surface, α·S [W/K].
     pub(crate) alpha_s: f64,
+    /// Heat capacity of the motor [J/K].
     pub(crate) heat_cap: f64,
+    /// `preload_stiffening`: scale s of the contact stiffness added to the mode [-] (0: off).
     pub(crate) stiffening: f64,
     /// `preload_stiffening`'s modal fraction: 0 seed 001 eq. 8, 1 seed 002's modal projection.
     pub(crate) modal_fraction: f64,
+    /// `hertz_softening`: cubic coefficient β at zero preload [N/m³] (0: off).
     pub(crate) beta: f64,
+    /// `hertz_softening`: relative growth of β per newton of preload [1/N].
     pub(crate) beta_gain: f64,
+    /// Friction law of the generalised interface: the `radial_friction` ratio (the slip
+    /// scale of `tangential_compliance` is set per contact by
+    /// [`crate::interface::interface_law`]).
     pub(crate) law: crate::interface::Law,
+    /// `tangential_compliance`: shear compliance κ of the layer relative to its normal
+    /// compliance [-] (0: off).
     pub(crate) compliance: f64,
-    /// `thermal_drift`: relative change per kelvin of (stiffness, friction, damping).
+    /// `thermal_drift`: relative change per kelvin of (stiffness, friction, damping) [1/K].
     pub(crate) thermal: [f64; 3],
+    /// `voltage_sag`: source resistance of the driver per phase [Ω] (0: off).
     pub(crate) sag_ohm: f64,
+    /// `eccentricity`: axial runout δ of the rotor [m] (0: off).
     pub(crate) runout_m: f64,
+    /// Effects in their truth forms (synthetic bench data) instead of the candidate forms.
     pub(crate) truth: bool,
     /// Whether solutions report the stall torque. For the generalised interface it costs a
     /// numerical integral per solve (the rotor at rest) that the speed solve itself rarely

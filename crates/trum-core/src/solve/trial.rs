@@ -11,24 +11,35 @@ use crate::stator::{self, modal_stiffness};
 /// Everything that follows from one trial amplitude.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Trial {
+    /// Trial amplitude W [m].
     pub(super) w: f64,
+    /// The contact zone at W.
     pub(super) contact: Contact,
     /// χ(φ0) = sin φ0 − φ0·c.
     pub(super) chi0: f64,
+    /// Stick half-angle θs [rad].
     pub(super) ts: f64,
     /// Rotor surface speed [m/s]: v0·cos θs, or below it when the whole contact drives.
     pub(super) vr: f64,
+    /// True when the rotor is at rest (the load torque is at or above the drive).
     pub(super) stalled: bool,
+    /// Force scale A = 2·N·k_f·W/k [N]: the axial force is A·χ(φ0).
     pub(super) a: f64,
+    /// Crest surface speed v0 = k·h0·ω·W [m/s].
     pub(super) v0: f64,
-    /// Interface factors: torque, power taken per v0, radial power per v0 (see crate::interface).
+    /// Torque factor 2χ(θs) − χ(φ0) or its generalisation ([`crate::interface::factors`]):
+    /// the drive torque is R0·μ·A·tf [-].
     pub(super) tf: f64,
+    /// Friction power taken from the wave per v0, in units of 2Nμk_f·W/k [-].
     pub(super) pf: f64,
+    /// Radial slip power per v0, same units as `pf` [-] (zero for the Coulomb interface).
     pub(super) rf: f64,
     /// Torque factor with the rotor at rest (stall torque = R0·μ·A·tf0); NaN when the
     /// generalised interface did not need it (computed in `finish`).
     pub(super) tf0: f64,
+    /// Modal impedance Z = (Re, Im) = (k_eff − m·ω², ω·(c + c_t)) [N/m].
     pub(super) z: (f64, f64),
+    /// Effective modal stiffness k_eff (with preload stiffening and Hertz softening) [N/m].
     pub(super) k_eff: f64,
     /// Θ·V/|Z|: the amplitude this trial implies.
     pub(super) w_next: f64,
@@ -49,11 +60,17 @@ impl Trial {
 /// Per-point inputs after effects that act on the drive (voltage sag, thermal state).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Drive {
+    /// Axial preload F [N].
     pub(crate) f_n: f64,
+    /// Load torque T [N·m].
     pub(crate) t_load: f64,
+    /// Electrode voltage amplitude V [V] (below the set voltage under `voltage_sag`).
     pub(crate) v: f64,
+    /// Drive angular frequency ω [rad/s].
     pub(crate) omega: f64,
+    /// Friction coefficient μ [-] (temperature dependent under `thermal_drift`).
     pub(crate) mu: f64,
+    /// Modal stiffness k_s [N/m] (temperature dependent under `thermal_drift`).
     pub(crate) ks: f64,
     /// Modal damping [N·s/m] (temperature dependent under `thermal_drift`).
     pub(crate) c: f64,
