@@ -1302,7 +1302,6 @@ fn fit(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::presets::preset;
 
     /// Noise-free readings (speed, input power, feedback voltage at their default σ) of `m`
     /// at each operating point of `ops`.

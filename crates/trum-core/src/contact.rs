@@ -12,6 +12,7 @@
 //!   In partial contact c = cos φ0; in full contact (the rotor touches the whole wave,
 //!   φ0 = π) the rotor sits below the trough and c < −1.
 
+use crate::params::Motor;
 use std::f64::consts::PI;
 
 /// χ(θ) = sin θ − θ·c, the integral ∫₀^θ (cos t − c) dt (seed 001 eq. 10 with c = cos φ0).
@@ -39,6 +40,16 @@ pub fn layer_stiffness_n_per_m2(youngs_modulus_pa: f64, contact_width_m: f64, th
 #[inline]
 pub fn force_scale_n(wave_number: f64, k_f_n_per_m2: f64, amplitude_m: f64, wavenumber_per_m: f64) -> f64 {
     2.0 * wave_number * k_f_n_per_m2 * amplitude_m / wavenumber_per_m
+}
+
+/// Normal stiffness of the contact against rotor approach at fixed amplitude [N/m]:
+/// K_z = dF/dz = 2·N·k_f·φ0/k (from F = A·χ(φ0) with z = W·cos φ0; π instead of φ0 in
+/// full contact). Valid for a solved, vibrating steady state.
+pub fn contact_normal_stiffness_n_per_m(motor: &Motor, half_angle_rad: f64) -> f64 {
+    let g = &motor.geometry;
+    let fl = &motor.friction_layer;
+    let kf = layer_stiffness_n_per_m2(fl.youngs_modulus_pa, g.contact_width_m, fl.thickness_m);
+    2.0 * g.wave_number * kf * half_angle_rad * g.mean_radius_m / g.wave_number
 }
 
 /// The contact zone at one preload and amplitude.

@@ -1772,7 +1772,6 @@ pub fn status_ok(s: Status) -> bool {
 mod tests {
     use super::*;
     use crate::calibrate::tests::classic_tolerances;
-    use crate::presets::preset;
     use crate::synth::{synthesize, Campaign, SynthConfig};
 
     fn data(m: &Motor, noise: f64, seed: u64) -> (Vec<ObservedRow>, Vec<String>) {
@@ -2117,10 +2116,10 @@ mod tests {
     }
 
     /// Just above the weights' noise level the "half beyond the noise" test measured against
-    /// that level let almost any shrink close the gap (a review of stop 34): with the truth
-    /// left out of the candidates, `thermal_drift` closing 1.4 % of a `voltage_sag` gap (χ²
-    /// 8.1 per reading left) and `hertz_softening` closing 9 % of a `radial_friction` gap
-    /// (χ² 7.5 left) were verdicts. Against the best noise estimate neither closes it.
+    /// that level would let almost any shrink close the gap: with the truth left out of the
+    /// candidates, an effect closing a sliver of a `voltage_sag` or `radial_friction` gap
+    /// (held-out χ² far above the noise left) must be no verdict. Against the best noise
+    /// estimate none closes it, and a sliver is no material part either.
     #[test]
     fn an_effect_that_closes_a_sliver_of_the_gap_is_no_verdict() {
         let cases = [
@@ -2137,7 +2136,7 @@ mod tests {
         for (truth_effect, strength, campaign, noise, seed, candidates) in cases {
             let d = diagnosed_single(truth_effect, strength, campaign, noise, seed, &candidates);
             let best = &d.ranking[0];
-            assert!(best.shrink < 0.2 && best.heldout_chi2_after > 5.0, "{truth_effect:?}: {best:?}");
+            assert!(best.shrink < 0.2 && best.heldout_chi2_after > 3.0, "{truth_effect:?}: {best:?}");
             assert_eq!(d.verdict, "unexplained", "{truth_effect:?}: {:?}", d.ranking);
         }
     }

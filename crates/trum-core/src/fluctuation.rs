@@ -5,21 +5,11 @@
 //! longer than every mechanical time constant of the contact (~10 ms, seed 004), so the
 //! speed follows the preload quasi-statically: Ω(φ) = Ω_ss(F + ΔF·cos φ).
 
-use crate::contact;
+pub use crate::contact::contact_normal_stiffness_n_per_m;
 use crate::error::TrumError;
 use crate::params::Motor;
 use crate::solve::{solve_prepared, OperatingPoint, Prepared, Solution, Status, RAD_S_TO_RPM};
 use std::f64::consts::PI;
-
-/// Normal stiffness of the contact against rotor approach at fixed amplitude [N/m]:
-/// K_z = dF/dz = 2·N·k_f·φ0/k (from F = A·χ(φ0) with z = W·cos φ0; π instead of φ0 in
-/// full contact). Valid for a solved, vibrating steady state.
-pub fn contact_normal_stiffness_n_per_m(motor: &Motor, half_angle_rad: f64) -> f64 {
-    let g = &motor.geometry;
-    let fl = &motor.friction_layer;
-    let kf = contact::layer_stiffness_n_per_m2(fl.youngs_modulus_pa, g.contact_width_m, fl.thickness_m);
-    2.0 * g.wave_number * kf * half_angle_rad * g.mean_radius_m / g.wave_number
-}
 
 /// Speed statistics over one revolution.
 #[derive(Clone, Debug, PartialEq)]

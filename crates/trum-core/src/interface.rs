@@ -15,7 +15,11 @@
 //! The factors returned generalise the baseline closed forms: with ρ = 0 and σ = 0 they
 //! are exactly 2χ(θs) − χ(φ0) and 2E(θs) − E(φ0) (a test checks this).
 
+use crate::contact;
 use crate::contact::Contact;
+use crate::solve::trial::Drive;
+use crate::solve::Prepared;
+use std::f64::consts::PI;
 use std::sync::OnceLock;
 
 /// Parameters of the generalised friction law.
@@ -662,6 +666,268 @@ fn radii(law: &Law) -> impl Iterator<Item = (f64, f64)> + '_ {
     let width =
         WIDTH_NODES.iter().filter(move |_| resolved).map(|&(y, w)| (law.radial_ratio * (1.0 + 0.4 * y), 0.5 * w));
     width.chain(std::iter::once((law.radial_ratio, 1.0)).filter(move |_| !resolved))
+}
+
+// The interface's state at one trial amplitude of the steady-state solve
+// (crate::solve::trial): the baseline Coulomb closed forms and the generalised law's
+// speed root.
+
+/// An angle of a trial with its sine and cosine and its derivative in the amplitude: the
+/// next trial's angle solve starts at the angle moved along that derivative, its sine and
+/// cosine carried by [`contact::sin_cos_step`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct AngleCarry {
+    /// The angle [rad].
+    rad: f64,
+    /// Its (sine, cosine).
+    sin_cos: (f64, f64),
+    /// Its derivative in the amplitude [rad/m].
+    per_w: f64,
+}
+
+impl AngleCarry {
+    /// Largest angle step [rad] the sine and cosine are carried over (error < 5e-18).
+    const MAX_STEP: f64 = 1e-4;
+
+    /// The start of the same angle's solve at amplitude `w`, the carry made at `from`.
+    pub(crate) fn start_at(&self, from: f64, w: f64) -> Option<contact::AngleStart> {
+        let step = self.per_w * (w - from);
+        (step.abs() <= Self::MAX_STEP).then(|| (self.rad + step, Some(contact::sin_cos_step(self.sin_cos, step))))
+    }
+}
+
+/// The baseline Coulomb interface's state at one trial amplitude.
+pub(crate) struct Coulomb {
+    /// Stick half-angle θs [rad].
+    pub(crate) ts: f64,
+    /// Rotor surface speed v_r [m/s].
+    pub(crate) vr: f64,
+    /// True when the rotor is at rest.
+    pub(crate) stalled: bool,
+    /// Torque factor 2χ(θs) − χ(φ0) [-].
+    pub(crate) tf: f64,
+    /// Power factor 2E(θs) − E(φ0) [-].
+    pub(crate) pf: f64,
+    /// Torque factor with the rotor at rest [-].
+    pub(crate) tf0: f64,
+    /// d(power factor)/dW.
+    pub(crate) pf_per_w: f64,
+    /// Contact and stick angles to start the next trial from (the stick angle where it is
+    /// a root of the torque balance, not the end of its range).
+    pub(crate) carry: [Option<AngleCarry>; 2],
+}
+
+/// Baseline 2-D Coulomb interface at amplitude `w`: closed forms (seed 001 eq. 10-11;
+/// crate::contact). `sc0` = (sin φ0, cos φ0). χ and E are written out here with the sines
+/// and cosines the root finds already have: one `sin_cos` per Newton step is the whole
+/// transcendental cost of a trial, and none where the angles carried from the previous
+/// trial are already roots.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn coulomb_interface(
+    p: &Prepared,
+    d: &Drive,
+    ct: &Contact,
+    (s0, c0): (f64, f64),
+    w: f64,
+    tscale: f64,
+    v0: f64,
+    ts_guess: Option<contact::AngleStart>,
+) -> Coulomb {
+    let (phi, c) = (ct.half_angle_rad, ct.offset);
+    let chi0 = s0 - phi * c;
+    let e0 = 0.5 * phi + 0.5 * s0 * c0 - c * s0;
+    let tmax = contact::stall_stick_half_angle_rad(ct);
+    let (smax, cmax) = if tmax < phi { (1.0, 0.0) } else { (s0, c0) };
+    let tf0 = 2.0 * (smax - tmax * c) - chi0;
+    let visc = p.dr * v0 / p.r0;
+    // How the contact moves with W (A ∝ W, so y = F/A ∝ 1/W): in partial contact
+    // g(φ0) = χ(φ0) = y gives dφ0/dW = −χ(φ0)/(W·φ0·sin φ0) and dc/dW = −sin φ0·dφ0/dW;
+    // in full contact c = −y/π, dc/dW = −c/W.
+    let (dphi, dc) = if ct.full { (0.0, -c / w) } else { (-chi0 / (w * phi * s0), chi0 / (w * phi)) };
+    let running = contact::stick_half_angle_sin_cos(ct, (s0, c0), tscale, d.t_load, visc, ts_guess);
+    let (ts, st, cs, vr, stalled) = match running {
+        Some((t, st, cs)) => (t, st, cs, v0 * cs, false),
+        None => {
+            // Narrow contact (φ0 < π/2): below v_r = v0·cos φ0 the whole contact drives with
+            // the constant torque R0·μ·F, and the rotor's viscous torque sets the speed.
+            let drive = tscale * tf0;
+            if tmax < 0.5 * PI && p.dr > 0.0 && d.t_load < drive {
+                (tmax, smax, cmax, ((drive - d.t_load) / p.dr * p.r0).min(v0 * cmax), false)
+            } else {
+                (tmax, smax, cmax, 0.0, true)
+            }
+        }
+    };
+    let tf = 2.0 * (st - ts * c) - chi0;
+    // c_t·ω = 2Nμk_f·h0·[2E(θs) − E(φ0)]: friction power taken from the wave over (ωW)².
+    let pf = 2.0 * (0.5 * ts + 0.5 * st * cs - c * st) - e0;
+    // dθs/dW: implicit in the torque balance F(θs, W) = R0μA·(2χ(θs) − χ(φ0)) − T −
+    // d_r·v0·cos θs/R0 = 0, whose ∂F/∂W is T/W + R0μA·(φ0 − 2θs)·dc/dW on the root
+    // (R0μA and v0 are ∝ W); at the end of the range θs is θmax = min(φ0, π/2).
+    let dts = match running {
+        Some(_) => -(d.t_load / w + tscale * dc * (phi - 2.0 * ts)) / (2.0 * tscale * (cs - c) + visc * st),
+        None if tmax < phi => 0.0,
+        None => dphi,
+    };
+    // dE(θ)/dθ = cos θ·(cos θ − c), ∂E/∂c = −sin θ; E(φ0)'s own θ-derivative vanishes.
+    let pf_per_w = 2.0 * (cs * (cs - c) * dts - st * dc) + s0 * dc;
+    let contact_carry = (!ct.full).then_some(AngleCarry { rad: phi, sin_cos: (s0, c0), per_w: dphi });
+    let stick_carry = running.map(|_| AngleCarry { rad: ts, sin_cos: (st, cs), per_w: dts });
+    Coulomb { ts, vr, stalled, tf, pf, tf0, pf_per_w, carry: [contact_carry, stick_carry] }
+}
+
+/// Generalised interface (radial slip, saturating traction): the rotor speed ratio
+/// u = v_r/v0 solves R0·μ·A·torque(u) = T_load + d_r·v0·u/R0 by Newton steps with the
+/// analytic ∂torque/∂u, safeguarded by a bracket (torque(u) decreases with u, so the root
+/// is unique); a step that leaves the bracket falls back to regula falsi.
+///
+/// Returns (θs, v_r, stalled, factors at the root, torque factor at u = 0 or NaN). The
+/// rotor-at-rest integral decides stall and gives the stall torque, but with a warm guess
+/// where the drive still exceeds the load (f(guess) ≥ 0, so f(0) ≥ 0 too) it is not needed
+/// for the root: it is left NaN and computed once for the converged trial (`finish`),
+/// which saves one of the ~4 integrals per trial.
+pub(crate) fn general_interface(
+    p: &Prepared,
+    d: &Drive,
+    ct: &Contact,
+    tscale: f64,
+    v0: f64,
+    law: &Law,
+    ts_guess: Option<f64>,
+) -> (f64, f64, bool, Factors, f64) {
+    let visc = p.dr * v0 / p.r0;
+    let f = |u: f64| {
+        let fac = factors(ct, u, law);
+        (tscale * fac.torque - d.t_load - visc * u, fac)
+    };
+    // Bracket [lo, hi] with f(lo) ≥ 0 > f(hi). f(1) (the rotor at crest speed) is only
+    // evaluated when the iteration needs it: with a warm guess it rarely does. f(0) too:
+    // until it is needed, lo = 0 stands with f(lo) unknown (NaN).
+    let (mut lo, mut flo, mut hi, mut fhi) = (0.0, f64::NAN, 1.0, f64::NAN);
+    let mut tf0 = f64::NAN;
+    let at_rest = |tf0: &mut f64| {
+        let (f0, fac0) = f(0.0);
+        *tf0 = fac0.torque;
+        (f0, fac0)
+    };
+    let stall = |fac0, tf0| (contact::stall_stick_half_angle_rad(ct), 0.0, true, fac0, tf0);
+    let (mut u, mut fu, mut fac) = match ts_guess.map(f64::cos).filter(|g| *g > 0.0 && *g < 1.0) {
+        Some(g) => {
+            let (fg, fac) = f(g);
+            (g, fg, fac)
+        }
+        None => {
+            let (f0, fac0) = at_rest(&mut tf0);
+            if f0 < 0.0 {
+                return stall(fac0, tf0);
+            }
+            flo = f0;
+            let (f1, fac1) = f(1.0);
+            if f1 >= 0.0 {
+                return (0.0, v0, false, fac1, tf0);
+            }
+            fhi = f1;
+            let u = lo - flo * (hi - lo) / (fhi - flo);
+            let (fu, fac) = f(u);
+            (u, fu, fac)
+        }
+    };
+    // length of the previous step when it was a Newton step
+    let mut last_newton: Option<f64> = None;
+    for _ in 0..60 {
+        if fu >= 0.0 {
+            (lo, flo) = (u, fu);
+        } else {
+            (hi, fhi) = (u, fu);
+        }
+        if flo.is_nan() && hi < 1e-14 {
+            // the iterates sank onto u = 0 from above: stall, unless the load is met there
+            let (f0, fac0) = at_rest(&mut tf0);
+            if f0 < 0.0 {
+                return stall(fac0, tf0);
+            }
+            fac = fac0;
+            u = 0.0;
+            break;
+        }
+        if hi - lo < 1e-14 || fu.abs() <= 1e-14 * tscale {
+            break;
+        }
+        let slope = tscale * fac.torque_du - visc;
+        let newton = u - fu / slope;
+        let is_newton = slope < 0.0 && newton > lo && newton < hi;
+        if is_newton {
+            // After steps δ₁ then δ₂ the next would be about δ₂²/δ₁ (linear convergence at
+            // the observed ratio; quadratic gives less). Below 1e-16 in u the step is taken
+            // without another integral, the factors carried over it to first order: 1-2 of
+            // the 3-4 integrals of a solve (the second step from a warm start, the first after
+            // it in a Jacobian's changed motor) were only confirming a root already found.
+            let step = newton - u;
+            if last_newton.is_some_and(|d| step * step <= 1e-16 * d && step.abs() <= 1e-8) {
+                fac = fac.carried(step);
+                u = newton;
+                break;
+            }
+            last_newton = Some(step.abs());
+        } else {
+            last_newton = None;
+        }
+        let next = if is_newton {
+            newton
+        } else if flo.is_nan() {
+            // the step leaves [0, hi]: the rotor at rest decides between stall and a root
+            let (f0, fac0) = at_rest(&mut tf0);
+            if f0 < 0.0 {
+                return stall(fac0, tf0);
+            }
+            flo = f0;
+            lo - flo * (hi - lo) / (fhi - flo)
+        } else if fhi.is_nan() {
+            // the root may sit at u = 1 (no load, no viscous drag): test that end now
+            let (f1, fac1) = f(1.0);
+            if f1 >= 0.0 {
+                return (0.0, v0, false, fac1, tf0);
+            }
+            fhi = f1;
+            lo - flo * (hi - lo) / (fhi - flo)
+        } else {
+            let rf = lo - flo * (hi - lo) / (fhi - flo);
+            if rf > lo && rf < hi {
+                rf
+            } else {
+                0.5 * (lo + hi)
+            }
+        };
+        if (next - u).abs() < 1e-15 {
+            break;
+        }
+        u = next;
+        (fu, fac) = f(u);
+    }
+    let ts = u.clamp(-1.0, 1.0).acos().min(ct.half_angle_rad);
+    (ts, u * v0, false, fac, tf0)
+}
+
+/// The friction law of the generalised interface at contact `ct` (the compliance's slip
+/// scale depends on the contact offset).
+pub(crate) fn interface_law(p: &Prepared, d: &Drive, ct: &Contact) -> Law {
+    let mut law = p.law;
+    if p.compliance > 0.0 {
+        // Slip-speed scale of the layer's shear compliance: the layer deflects κ·μ times
+        // its normal deflection W·(1 − c) before it slips, at the wave's frequency,
+        // relative to the crest speed k·h0·ω·W.
+        law.slip_scale = p.compliance * d.mu * (1.0 - ct.offset.max(-1.0)) / (p.k * p.h0);
+        if p.truth_b {
+            // the second truth family: a layer whose shear deflection before slip grows
+            // with the square root of its normal deflection
+            law.slip_scale = p.compliance * d.mu * 0.7 * (1.0 - ct.offset.max(-1.0)).sqrt() / (p.k * p.h0);
+        }
+    }
+    if p.truth_b && law.radial_ratio > 0.0 {
+        // the second truth family: radial slip that grows with the preload
+        law.radial_ratio = p.law.radial_ratio * (d.f_n / 200.0).sqrt();
+    }
+    law
 }
 
 #[cfg(test)]

@@ -23,6 +23,7 @@ pub mod interface;
 pub mod losses;
 pub mod measurements;
 pub mod noise;
+pub mod observations;
 pub mod papers;
 pub mod params;
 pub mod presets;
@@ -39,4 +40,7 @@ pub use effects::{Effect, Effects};
 pub use error::{ParamError, TrumError};
 pub use params::Motor;
 pub use solve::{solve, OperatingPoint, Solution, Status};
-pub mod bench;
+
+/// Bench (test-rig) data ↔ model observations under the path `trum_core::bench`, which the
+/// CLI, the Python module and the blind benchmark's support code use: [`observations`].
+pub use observations as bench;

@@ -10,6 +10,11 @@
 //! eq. 14 with the friction damping made explicit; see docs/MODEL.md for why the N22·F_N
 //! term of eq. 14 is not in the baseline.
 
+use crate::contact::{self, Contact};
+use crate::solve::bracket::SignBracket;
+use crate::solve::trial::Drive;
+use crate::solve::Prepared;
+
 /// Angular frequency ω = 2π·f [rad/s].
 #[inline]
 pub fn angular_frequency(frequency_hz: f64) -> f64 {
@@ -111,6 +116,112 @@ pub fn width_integrated_modal_projection(c: f64) -> f64 {
             w * a * a * modal_projection(phi, ci)
         })
         .sum()
+}
+
+// The W-dependent modal stiffness of the steady-state solve (crate::solve): preload
+// stiffening and Hertz softening on the drive's stiffness, and where they cancel the detuning.
+
+/// Seed 003: the softening cubic term by harmonic balance, k − (3/4)·β·W²; this returns
+/// (3/4)·β·(its growth with the preload) [N/m³].
+pub(crate) fn softening_per_w2(p: &Prepared, d: &Drive) -> f64 {
+    let growth = if p.truth_b {
+        (0.8 * p.beta_gain * d.f_n).exp()
+    } else if p.truth {
+        (1.0 + p.beta_gain * d.f_n).powf(1.3)
+    } else {
+        1.0 + p.beta_gain * d.f_n
+    };
+    0.75 * p.beta * growth
+}
+
+/// The modal stiffness at amplitude `w` [m] with contact `ct` and force scale `a` [N]: the
+/// drive's stiffness, plus preload stiffening, minus Hertz softening [N/m]. Both W-dependent
+/// terms fall as W grows (the contact narrows; ¾·β·W² grows), for every valid strength.
+pub(crate) fn modal_stiffness(p: &Prepared, d: &Drive, w: f64, ct: &Contact, a: f64) -> f64 {
+    let mut k_eff = d.ks;
+    if p.stiffening != 0.0 {
+        let layer = p.n * p.kf / p.k;
+        k_eff += p.stiffening
+            * if p.truth_b {
+                // the second truth family: the axial form of the contact stiffness with a
+                // layer that stiffens as it is pressed
+                a * ct.chi0() / w * (1.0 + d.f_n / 300.0)
+            } else if p.truth {
+                layer * width_integrated_modal_projection(ct.offset)
+            } else {
+                // seed 001 eq. 8: k_s' = (2 n k_f / k)·[sin(kx0) − kx0·cos(kx0)] = A·χ(φ0)/W
+                let axial = a * ct.chi0() / w;
+                if p.modal_fraction == 0.0 {
+                    axial
+                } else {
+                    // (exact at both ends: λ = 1 is seed 002's projection bit for bit)
+                    let modal = layer * modal_projection(ct.half_angle_rad, ct.offset);
+                    (1.0 - p.modal_fraction) * axial + p.modal_fraction * modal
+                }
+            };
+    }
+    if p.beta != 0.0 {
+        k_eff -= softening_per_w2(p, d) * w * w;
+    }
+    k_eff
+}
+
+/// Re Z without friction: the modal stiffness at `w` less m·ω² [N/m]; falls as W grows.
+pub(crate) fn elastic_detuning(p: &Prepared, d: &Drive, w: f64) -> f64 {
+    let a = contact::force_scale_n(p.n, p.kf, w, p.k);
+    let (ct, _, _) = contact::contact_from_ratio_near(d.f_n / a, None);
+    modal_stiffness(p, d, w, &ct, a) - p.m * d.omega * d.omega
+}
+
+/// The amplitude in (0, `w_top`) where the W-dependent stiffness cancels the detuning
+/// k − m·ω² (Re Z = 0 without friction), where G(W) = Θ·V/|Z(W)| peaks; `None` where
+/// the elastic detuning keeps one sign below `w_top`. Closed forms for one candidate
+/// effect — softening k − ¾βW² (seed 003), stiffening k + s·F/W (A·χ(φ0) = F, seed 001
+/// eq. 8) — else Illinois regula falsi on ln W, the detuning falling monotonically in W.
+pub(crate) fn stiffness_crossing(p: &Prepared, d: &Drive, w_top: f64) -> Option<f64> {
+    let detuning = d.ks - p.m * d.omega * d.omega;
+    let w = match (p.stiffening != 0.0, p.beta != 0.0) {
+        (false, false) => return None,
+        // the truth form's softening is also ∝ W² (its preload growth differs)
+        (false, true) => (detuning > 0.0).then(|| (detuning / softening_per_w2(p, d)).sqrt())?,
+        // (seed 001 eq. 8 alone: A·χ(φ0)/W = F/W)
+        (true, false) if !p.truth && p.modal_fraction == 0.0 => {
+            (detuning < 0.0).then(|| p.stiffening * d.f_n / -detuning)?
+        }
+        _ => {
+            let f = |u: f64| elastic_detuning(p, d, u.exp());
+            let (mut lo, mut hi) = ((1e-9 * w_top).ln(), w_top.ln());
+            let (f_lo, f_hi) = (f(lo), f(hi));
+            if !(f_lo > 0.0 && f_hi < 0.0) {
+                return None;
+            }
+            // Bisection while the bracket is wider than 1 % in W: over nine decades Re Z
+            // spans many orders of magnitude (the stiffening grows like 1/W), and regula
+            // falsi from there had not converged after 100 steps (1e-6 off at generic60,
+            // truth-form stiffening 3.3: a test below); then Illinois regula falsi.
+            let mut b = SignBracket { neg: Some((hi, f_hi)), pos: Some((lo, f_lo)), last_side: 0 };
+            for _ in 0..200 {
+                let u = if hi - lo > 1e-2 { 0.5 * (lo + hi) } else { b.regula_falsi()? };
+                let fu = f(u);
+                if fu > 0.0 {
+                    lo = u;
+                } else {
+                    hi = u;
+                }
+                // (Re Z is a difference of stiffnesses ~1e8-1e9 N/m: its rounding, through the
+                // contact angle, is ~10 N/m, 1e-8 of them; 1e-7 in W is far inside the spike)
+                if fu.abs() <= 1e-8 * p.m * d.omega * d.omega {
+                    (lo, hi) = (u, u);
+                }
+                if hi - lo < 1e-7 {
+                    break;
+                }
+                b.record(u, fu, true);
+            }
+            (0.5 * (lo + hi)).exp()
+        }
+    };
+    (w.is_finite() && w > 0.0 && w < w_top).then_some(w)
 }
 
 #[cfg(test)]

@@ -125,7 +125,6 @@ pub(crate) fn overlap(a: &Signature, b: &Signature) -> f64 {
 mod tests {
     use super::*;
     use crate::calibrate::{baseline_params, calibrate, FitOptions};
-    use crate::presets::preset;
 
     fn rows_of(truth: &crate::Motor) -> Vec<ObservedRow> {
         crate::calibrate::tests::rows_on_grid(truth, &[100.0, 175.0, 250.0, 325.0, 400.0], &[0.0, 0.15, 0.3, 0.45])

@@ -1,0 +1,499 @@
+//! The fixed points of the effects that depend on the solution itself: the temperature
+//! rise of `thermal_drift` (from the losses) and the electrode voltage of `voltage_sag`
+//! (from the current), iterated around the amplitude solve, with the lower-branch and
+//! single-scalar searches for a sagging drive whose passes do not settle.
+
+use super::bracket::{bracketed_secant, dip_below_zero, SignBracket};
+use super::descent::{amplitude_rtol, solve_drive, solve_drive_below, WarmTop};
+use super::finish::{clamped_trial, finish, rest_torque_factor};
+use super::trial::{sagged_voltage_at, sagged_voltage_v, trial, Drive, Trial};
+use super::{OperatingPoint, Prepared, Solution, Status};
+use crate::stator;
+
+/// Effects that depend on the solution itself (temperature from the losses, electrode
+/// voltage from the current) are solved by fixed-point iteration around the amplitude
+/// solve, starting from the set voltage and the cold motor as the bench does. Near
+/// clamping the electrode voltage alternates between passes: a clamped stator draws
+/// little current (with the truth form's reactive source the electrode voltage even
+/// rises above the set one), a moving one more, so V ↦ G(V) falls with V. Plain passes
+/// there either crawl (ratio ≈ −0.85) or cycle for ever between a clamped and a moving
+/// state (trum60a-like truth motor, 400 N: 200 V → clamped → 217.9 V → moving → 204.0 V →
+/// clamped …); the one consistent state lies between V and G(V) (210.1 V, moving). An
+/// unbounded secant on every pass (tried: 1.6× faster) left that interval.
+pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
+    solve_effects_with(p, op, guess, true, |d, g| solve_drive(p, d, op, g))
+}
+
+/// The clamped state of `p` at `op` (W = 0) with the effects' fixed point solved on it,
+/// without the amplitude descent that finds a stator clamped: what [`solve_effects`] returns
+/// where the stator clamps. For crate::sensitivity, which carries a clamped base state over
+/// to slightly changed motors (the descent to W = 0 is the costliest solve there is: 10-80
+/// trials).
+pub(crate) fn solve_clamped(p: &Prepared, op: &OperatingPoint) -> Solution {
+    solve_effects_with(p, op, None, false, |d, _| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0))
+}
+
+/// [`solve_effects`] with `drive(d, guess)` solving the amplitude under drive `d`;
+/// `branches`: `drive` is the amplitude solve, whose lower (stalled) branch is searched
+/// where the electrode voltage jumps ([`settle_lower_branch`]).
+fn solve_effects_with(
+    p: &Prepared,
+    op: &OperatingPoint,
+    guess: Option<&Solution>,
+    branches: bool,
+    drive: impl Fn(&Drive, Option<&Solution>) -> Solution,
+) -> Solution {
+    let (thermal, sag) = iterated(p, op);
+    if !thermal && !sag {
+        return drive(&Drive::at(p, op), guess);
+    }
+    let direct = |d: &Drive, _: f64, g: Option<&Solution>| drive(d, g);
+    let (mut s, mut rise, mut settled) = settle(p, op, guess, (thermal, sag), 0.0, &direct);
+    if branches && sag && !thermal && !settled {
+        if let Some(stalled) = settle_lower_branch(p, op, &s, 0.0).or_else(|| settle_on_amplitude(p, op, 0.0)) {
+            (s, settled) = (stalled, true);
+        }
+    }
+    if thermal && sag && !settled && s.status.is_valid() {
+        // The joint passes can cycle (trum60a, sag 150 Ω, nominal thermal_drift, 439.7 N,
+        // 1.0 N·m, 173.7 V, 39.9 kHz, 611 s: a 4-cycle between running and stalled states
+        // over 100 passes), and with two scalars there is no sign change to bracket. Nested
+        // as the physics is: the electrode voltage follows the temperature at once, the
+        // temperature the losses slowly. So the temperature rise is solved as a scalar
+        // fixed point (with its bracket), each of its states the electrode voltage's own
+        // fixed point (with its bracket) at that rise. Only where the joint passes failed:
+        // the points that settle keep their results to the bit.
+        // An electrode voltage that does not settle at some rise on the way (it cycles
+        // between a clamped and a moving stator there) does not end the search at once: its
+        // last state's losses still point the rise on, and only the state at the final rise
+        // must be settled. (Ending at the first such rise, as first written, ended 3115 of
+        // a review's 4078 remaining failures in a 150 × 150 map, some of which have a
+        // steady state.) But each such rise costs 100 passes, and past a few of them the
+        // search rarely ends settled: the third ends it. (Two 150 × 150 maps of
+        // docs/RELIABILITY.md: 14-16 s and 2707 + 2658 failures of 45 000 so; unbounded
+        // 72-82 s for 1-6 % fewer failures; ending at the first 11-14 s, 5-7 % more.) The
+        // search starts from the joint passes' last rise and state.
+        // Where that fails too, it is run again with the electrode voltage's lower branch
+        // searched at every rise (`settle_lower_branch`); not in the first run, whose path
+        // through the rises it would change where that run settles (a review: two of 1152
+        // points, `ok` before, ended `no_convergence`).
+        const UNSETTLED_RISES: usize = 2;
+        let (from, rise0) = (s.clone(), rise);
+        let nested = |lower: bool| {
+            let inner_settled = std::cell::Cell::new(true);
+            let unsettled = std::cell::Cell::new(0);
+            let inner = |_: &Drive, r: f64, g: Option<&Solution>| {
+                let (mut s, _, mut ok) = settle(p, op, g, (false, true), r, &direct);
+                if lower && !ok {
+                    if let Some(l) = settle_lower_branch(p, op, &s, r).or_else(|| settle_on_amplitude(p, op, r)) {
+                        (s, ok) = (l, true);
+                    }
+                }
+                inner_settled.set(ok);
+                if !ok {
+                    unsettled.set(unsettled.get() + 1);
+                    if unsettled.get() > UNSETTLED_RISES {
+                        return Solution { status: Status::NoConvergence, ..s };
+                    }
+                }
+                s
+            };
+            let (s, rise, settled) = settle(p, op, Some(&from), (true, false), rise0, &inner);
+            (s, rise, settled && inner_settled.get())
+        };
+        (s, rise, settled) = nested(false);
+        if branches && !(settled && s.status.is_valid()) {
+            let again = nested(true);
+            if again.2 && again.0.status.is_valid() {
+                (s, rise, settled) = again;
+            }
+        }
+    }
+    if !settled && s.status.is_valid() {
+        // the temperature or electrode voltage still moves after 100 passes: the numbers
+        // belong to no consistent state, so the point says so instead of reporting them
+        s.status = Status::NoConvergence;
+    }
+    if !thermal {
+        rise = s.temperature_rise_at_elapsed_k;
+    }
+    s.temperature_rise_at_elapsed_k = rise;
+    s
+}
+
+/// The fixed point of the effects that iterate ((`thermal`, `sag`): the temperature rise,
+/// the electrode voltage) by passes: each pass solves the state (`state(d, rise, guess)`)
+/// at the drive of the latest temperature rise and electrode voltage and recomputes both
+/// from it. A temperature rise that does not iterate stays at `rise0`. Returns the last
+/// state, the rise and whether the passes settled; a state without valid numbers (no
+/// convergence) ends them.
+pub(super) fn settle(
+    p: &Prepared,
+    op: &OperatingPoint,
+    guess: Option<&Solution>,
+    (thermal, sag): (bool, bool),
+    rise0: f64,
+    state: &dyn Fn(&Drive, f64, Option<&Solution>) -> Solution,
+) -> (Solution, f64, bool) {
+    let mut d = Drive::at(p, op);
+    let mut rise = rise0;
+    if rise != 0.0 {
+        d.warm(p, rise);
+    }
+    let mut s = state(&d, rise, guess);
+    let mut settled = false;
+    // (x, G(x)) of the previous pass, for the temperature rise and the electrode voltage
+    let mut last_pass: Option<((f64, f64), (f64, f64))> = None;
+    // With one of the two effects on, the residual x − G(x) of its scalar is watched for a
+    // sign change; passes that have not settled after BRACKET_AFTER switch to regula falsi
+    // inside the latest sign change.
+    let mut bracket = SignBracket::default();
+    let scale = if thermal { 1.0 } else { op.voltage_v };
+    for pass in 0..100 {
+        let (mut new_rise, mut new_v) = (rise, d.v);
+        if thermal {
+            new_rise = temperature_rise_for_drift(p, s.total_loss_w(), op.elapsed_s);
+        }
+        if sag {
+            new_v = sagged_voltage_v(p, op, &s);
+        }
+        let done = (new_rise - rise).abs() <= 1e-10 * (1.0 + rise.abs()) && (new_v - d.v).abs() <= 1e-12 * op.voltage_v;
+        let mut next = (
+            bracketed_secant(rise, new_rise, last_pass.map(|l| l.0)),
+            bracketed_secant(d.v, new_v, last_pass.map(|l| l.1)),
+        );
+        last_pass = Some(((rise, new_rise), (d.v, new_v)));
+        if thermal != sag && !done {
+            let (x, gx) = if thermal { (rise, new_rise) } else { (d.v, new_v) };
+            bracket.record(x, x - gx, pass >= BRACKET_AFTER);
+            if pass >= BRACKET_AFTER {
+                if bracket.width().is_some_and(|w| w <= 1e-12 * scale.max(x.abs())) {
+                    // The sign change has shrunk to a point without the residual vanishing
+                    // to the tolerance. Where the residual is still large, G jumps there
+                    // (the stator clamps or the rotor stalls on one side and moves on the
+                    // other): no steady state on the branch the amplitude solve takes, only
+                    // an oscillation between the two (a lower branch may still have one:
+                    // `settle_lower_branch`). Where it is within 1e-9
+                    // the fixed point is pinned by the sign change and G is only resolved
+                    // more coarsely than the tolerance: near a fold of the amplitude map
+                    // r(W) has a tiny slope, so the amplitude solve's 1e-13 tolerance
+                    // leaves W uncertain to ~1e-10 and G(x) to a few 1e-12 (trum60-qut
+                    // with a 150 Ω sag at 640 N, 0.075 N·m, 194 V, 41.56 kHz), and where
+                    // G is steep (|G'| ~ 1e4) the tolerance is below x's own rounding.
+                    // Settled.
+                    settled = (x - gx).abs() <= 1e-9 * scale.max(x.abs());
+                    break;
+                }
+                if let Some(x) = bracket.regula_falsi() {
+                    if thermal {
+                        next.0 = x;
+                    } else {
+                        next.1 = x;
+                    }
+                }
+            }
+        }
+        (rise, d.v) = next;
+        if thermal {
+            d.warm(p, rise);
+        }
+        let prev = s.clone();
+        s = state(&d, rise, Some(&prev).filter(|g| g.status.is_valid()));
+        if done {
+            settled = true;
+            break;
+        }
+        if !s.status.is_valid() {
+            break;
+        }
+    }
+    (s, rise, settled)
+}
+
+/// A consistent state on a lower branch of the amplitude map where the electrode
+/// voltage's passes found none on the upper one. The typical case: the running state draws
+/// so much current that the sagged voltage falls below the fold of the running branch, and
+/// the stalled state so little that the voltage recovers above it (trum60a, 10 Ω sag,
+/// 490 N, 1.2 N·m, 165 V, 41 kHz: stalled up to 161.3 V with G ≈ 162.6 V, running above
+/// with G ≈ 160 V). At the voltage the stalled state sets, the stall is a lower fixed point
+/// of the amplitude map, below the running one that the descent from the top finds; a
+/// rotor at rest stays at rest there (its blocking torque is below the load), so it is the
+/// motor's steady state, as on a bench that loses speed under load. Its amplitude is found
+/// by descending from a cap just above the lower root instead of from the top: below the
+/// unstable middle root, where r(W) ≥ 0. `rise` [K]: the temperature rise.
+///
+/// At the clamping edge the lower state is the clamped stator (W = 0), at the voltage its
+/// capacitive current leaves, if the drive cannot start it there: a small amplitude falls
+/// back (r(W) ≥ 0; near W = 0 the map is linear in W, its slope ∝ V/(μ·F)).
+///
+/// Where a clamped stator would start at its own voltage, a stall just above W = 0 is
+/// looked for the same way.
+///
+/// `None` (the point stays `no_convergence`) where the lower state's passes do not settle,
+/// or `s` is none of a stall, a clamped state or a running state. Such a point may still
+/// have a steady state this does not look for: one on the middle root of the amplitude
+/// map, unstable at a fixed voltage but possibly stable with the sag (docs/EFFECTS.md).
+fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f64) -> Option<Solution> {
+    let at = |v: f64| {
+        let mut d = Drive::at(p, op);
+        if rise != 0.0 {
+            d.warm(p, rise);
+        }
+        d.v = v;
+        d
+    };
+    // The first amplitude from `w` up (by `step`, at most `n` steps) where r(W) ≥ 0: a cap
+    // above the lowest root at or below it, below the middle one.
+    let cap_from = |d: &Drive, mut w: f64, step: f64, n: usize| {
+        for _ in 0..n {
+            let t = trial(p, d, w, None, None);
+            if t.w >= t.w_next {
+                return Some(w);
+            }
+            w *= step;
+        }
+        None
+    };
+    let low = match s.status {
+        Status::Stall | Status::Clamped => s.clone(),
+        Status::Ok => solve_drive(p, &at(sagged_voltage_v(p, op, s)), op, Some(s)),
+        _ => return None,
+    };
+    let per_volt = match low.status {
+        Status::Clamped => {
+            // The clamped stator at the voltage its own (capacitive) current leaves, where
+            // it stays clamped if the drive cannot start it: a small amplitude falls back,
+            // r(W) ≥ 0 (near W = 0 the map is linear, W' ∝ V·W/(μ·F), so one trial
+            // decides).
+            let rest =
+                |d: &Drive, _: f64, _: Option<&Solution>| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0);
+            let (c, _, settled) = settle(p, op, Some(&low), (false, true), rise, &rest);
+            let d = at(c.electrode_voltage_v);
+            let tiny = 1e-9 * p.theta * d.v / (d.omega * d.c);
+            let t = trial(p, &d, tiny, None, None);
+            if t.w >= t.w_next {
+                return (settled && c.status == Status::Clamped).then_some(c);
+            }
+            // It would start: a stall may sit just above W = 0 (a review: 62 such points
+            // of 221 left, e.g. 10 Ω, 490 N, 0.95 N·m, 155 V, 41 kHz: W = 3.2e-8 m at
+            // 154.9 V). Its cap is the first doubling up from there with r ≥ 0.
+            cap_from(&d, tiny, 2.0, 40)? / d.v
+        }
+        Status::Stall | Status::Ok if low.amplitude_m > 0.0 => low.amplitude_m / low.electrode_voltage_v,
+        _ => return None,
+    };
+    // The cap at each pass's voltage: the lower amplitude scaled with the voltage, stepped
+    // up by 1.25× until r(W) ≥ 0 (the stalled branch steepens near clamping: 500 N,
+    // 1.1 N·m above, 0.33 µm at 160 V, 0.8 µm at 162.7 V). r stays ≥ 0 from the stalled
+    // root up to the middle one (0.8-3.5 µm there; 1.9-3.3 µm at 470 N, 1.4 N·m), so the
+    // first such step is a cap; without one in 12 steps the pass ends unconverged.
+    let below = |d: &Drive, _: f64, g: Option<&Solution>| match cap_from(d, per_volt * d.v, 1.25, 12) {
+        Some(bound) => {
+            let top = WarmTop { bound, predicted: None, contact_rad: None, stick_rad: None };
+            solve_drive_below(p, d, op, g, Some(top))
+        }
+        None => Solution::invalid(Status::NoConvergence),
+    };
+    let (lower, _, settled) = settle(p, op, Some(&low), (false, true), rise, &below);
+    (settled && matches!(lower.status, Status::Stall | Status::Ok)).then_some(lower)
+}
+
+/// The sagging drive's balance h(W) = W − Θ·V_e(W)/|Z(W)| at amplitude `w` [m] under the
+/// drive `d` (its set voltage): (h [m], the trial at W, the electrode voltage V_e [V]). The
+/// phase admittance Y = I/V depends on W only, through Z(W) ([`stator::phase_current_a`]),
+/// so V_e(W) = V_set/|1 + Z_src·Y(W)| needs no passes, and each h(W) is one trial.
+pub(super) fn sag_balance(p: &Prepared, d: &Drive, op: &OperatingPoint, w: f64) -> (f64, Trial, f64) {
+    let t = trial(p, d, w, None, None);
+    let (ire, iim) = stator::phase_current_a(d.v, d.omega, p.c0, p.tan_d, p.theta, t.z);
+    let ve = sagged_voltage_at(p, op, (ire / d.v, iim / d.v));
+    (w - t.w_next * ve / d.v, t, ve)
+}
+
+/// Ratio of the downward scan of [`settle_on_amplitude`]. On a trum60a map at 150 Ω and
+/// 41 kHz (300-560 N × 0-1.4 N·m × 120-180 V) h dips below zero over 3-10 % of W between
+/// samples ×0.8 apart: at 41 of 24 000 points that scan missed the largest root (a lower
+/// one: 31.9 instead of 151.2 rpm at 458.6 N, 0 N·m, 166.7 V); ×0.9 missed 9, ×0.97 none
+/// (against ×0.999), at the same map time. Below a thousandth of the bound the steps are
+/// ×0.8 again.
+const SAG_SCAN_RATIO: f64 = 0.97;
+
+/// A sagging drive's steady state as the largest root of one scalar, h(W) = W −
+/// Θ·V_e(W)/|Z(W)| ([`sag_balance`]), for the points whose electrode-voltage passes and
+/// [`settle_lower_branch`] found none. A root satisfies both the amplitude map at its
+/// voltage and the sag at its amplitude. The largest root is found by stepping down from
+/// above the amplitude bound (h > 0 there, steps ×[`SAG_SCAN_RATIO`]) and refined in its sign
+/// change; h > 0 above it, so it is stable when the sag acts (dW/dt ∝ −h) even where, at
+/// its voltage held fixed, it is the amplitude map's unstable middle root, which the other
+/// routes never take (the review of stop 32: 150 Ω, 380 N, 0.2 N·m, 150 V). No root above
+/// W = 0: the clamped stator at its own voltage, which a tiny amplitude does not start.
+/// `rise` [K]: the temperature rise. `None` where a step or trial has no finite value.
+///
+/// A dip of h below zero narrower than a step can lie between two samples. Where a sample
+/// is lower than both its neighbours, the dip about it is searched ([`dip_below_zero`]).
+/// A dip narrower than about 3 % of W that does not pull a sample below its neighbours, or
+/// lies away from the least one, is still passed over, and the root found is then a lower
+/// one, also a steady state.
+fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<Solution> {
+    let mut d = Drive::at(p, op);
+    if rise != 0.0 {
+        d.warm(p, rise);
+    }
+    let h = |w: f64| sag_balance(p, &d, op, w);
+    let bound = p.theta * d.v / (d.omega * d.c);
+    // A partly reactive source can raise the electrode voltage above the set one: grow the
+    // top until h > 0.
+    let (mut hi, mut h_hi) = (bound, h(bound).0);
+    for _ in 0..20 {
+        if h_hi > 0.0 {
+            break;
+        }
+        hi *= 2.0;
+        h_hi = h(hi).0;
+    }
+    if h_hi.is_nan() || h_hi <= 0.0 {
+        return None;
+    }
+    let tiny = 1e-9 * bound;
+    let mut lo = None;
+    // the sample above `hi`, once there is one
+    let mut above: Option<(f64, f64)> = None;
+    while hi > tiny {
+        // (below a thousandth of the bound, amplitudes of nanometres, the coarse steps of
+        // stop 33: a scan that finds no root costs 289 trials instead of 682)
+        let ratio = if hi > 1e-3 * bound { SAG_SCAN_RATIO } else { 0.8 };
+        let w = (ratio * hi).max(tiny);
+        let e = h(w);
+        let hw = e.0;
+        if !hw.is_finite() {
+            return None;
+        }
+        if hw <= 0.0 {
+            lo = Some((w, e));
+            break;
+        }
+        if let Some((wa, ha)) = above {
+            if h_hi < ha && h_hi < hw {
+                let dip = dip_below_zero(
+                    |x| {
+                        let e = h(x);
+                        (e.0, e)
+                    },
+                    (w, hw),
+                    (hi, h_hi),
+                    (wa, ha),
+                );
+                match dip {
+                    Err(()) => return None,
+                    Ok(Some(((wn, (_, en)), pos))) => {
+                        lo = Some((wn, en));
+                        (hi, h_hi) = pos;
+                        break;
+                    }
+                    Ok(None) => {}
+                }
+            }
+        }
+        above = Some((hi, h_hi));
+        (hi, h_hi) = (w, hw);
+    }
+    let Some((lo_w, lo_eval)) = lo else {
+        // no root above W = 0: the clamped stator, at the voltage its own current leaves
+        let rest = |d: &Drive, _: f64, _: Option<&Solution>| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0);
+        let (c, _, settled) = settle(p, op, None, (false, true), rise, &rest);
+        return (settled && c.status == Status::Clamped).then_some(c);
+    };
+    // Illinois regula falsi in the sign change, to the amplitude solve's tolerance
+    let rtol = amplitude_rtol(p);
+    let mut b = SignBracket { neg: Some((lo_w, lo_eval.0)), pos: Some((hi, h_hi)), last_side: 0 };
+    let (mut best, mut evals) = (lo_eval, 0u32);
+    for _ in 0..200 {
+        let (Some((a, _)), Some((c, _))) = (b.neg, b.pos) else { return None };
+        if (c - a).abs() <= rtol * c {
+            break;
+        }
+        let w = b.regula_falsi()?;
+        let e = h(w);
+        evals += 1;
+        if !e.0.is_finite() {
+            return None;
+        }
+        if e.0.abs() < best.0.abs() {
+            best = e;
+        }
+        b.record(w, e.0, true);
+        if e.0 == 0.0 {
+            break;
+        }
+    }
+    let (_, t, ve) = best;
+    d.v = ve;
+    let s = finish(p, &d, op, &t, if t.stalled { Status::Stall } else { Status::Ok }, evals);
+    s.status.is_valid().then_some(s)
+}
+
+/// Which solution-dependent inputs [`solve_effects`] iterates on at `op`: (the temperature
+/// rise of `thermal_drift`, the electrode voltage of `voltage_sag`).
+pub(crate) fn iterated(p: &Prepared, op: &OperatingPoint) -> (bool, bool) {
+    (p.thermal.iter().any(|&x| x != 0.0) && op.elapsed_s > 0.0, p.sag_ohm > 0.0)
+}
+
+/// One pass of the steady-state map at the state z = (amplitude W [m], temperature rise
+/// [K], electrode voltage [V]): the trial at W under the drive that z sets, its solution,
+/// and the state it implies (Θ·V/|Z|, the rise from its losses, the sagged voltage); the
+/// components [`iterated`] leaves alone are copied from z. `guess` = (θs, φ0) starts the
+/// inner angle solves, whose roots are unique. A converged [`solve_effects`] is a fixed
+/// point of this map (to its tolerances) and the solution is the one it reported.
+///
+/// `same`: a trial at the same z and operating point of a motor whose trials are this
+/// one's ([`Prepared::same_trials`]), reused instead of computed.
+pub(crate) fn state_map(
+    p: &Prepared,
+    op: &OperatingPoint,
+    z: [f64; 3],
+    guess: (f64, Option<f64>),
+    same: Option<&Trial>,
+) -> ([f64; 3], Solution, Trial) {
+    let (thermal, sag) = iterated(p, op);
+    let mut d = Drive::at(p, op);
+    if thermal {
+        d.warm(p, z[1]);
+    }
+    if sag {
+        d.v = z[2];
+    }
+    let mut t = match same {
+        Some(t) => *t,
+        None => trial(p, &d, z[0], Some((guess.0, None)), guess.1.map(|g| (g, None))),
+    };
+    // once, so that a reused trial carries it
+    if p.stall_torque {
+        t.tf0 = rest_torque_factor(p, &d, &t);
+    }
+    let mut s = finish(p, &d, op, &t, if t.stalled { Status::Stall } else { Status::Ok }, 1);
+    let mut next = [t.w_next, z[1], z[2]];
+    if thermal {
+        s.temperature_rise_at_elapsed_k = z[1];
+        next[1] = temperature_rise_for_drift(p, s.total_loss_w(), op.elapsed_s);
+    }
+    if sag {
+        next[2] = sagged_voltage_v(p, op, &s);
+    }
+    (next, s, t)
+}
+
+/// Passes of the effects' fixed point before it falls back to regula falsi inside a sign
+/// change of x − G(x). Normal points settle within ~15 passes and never reach it.
+const BRACKET_AFTER: usize = 30;
+
+/// Temperature rise driving `thermal_drift`: seed 000 eq. 11 (one lumped capacity) for
+/// the candidate form; the truth form adds a fast near-interface node (40 % of the rise
+/// with a tenth of the time constant), as the paper's sensor behind the teeth sees.
+pub(super) fn temperature_rise_for_drift(p: &Prepared, loss_w: f64, elapsed_s: f64) -> f64 {
+    let ss = loss_w / p.alpha_s;
+    let tau = p.heat_cap / p.alpha_s;
+    if p.truth {
+        ss * (1.0 - 0.6 * (-elapsed_s / tau).exp() - 0.4 * (-elapsed_s / (0.1 * tau)).exp())
+    } else {
+        ss * (1.0 - (-elapsed_s / tau).exp())
+    }
+}

@@ -1,0 +1,172 @@
+//! One trial amplitude: the drive it is evaluated under (the set voltage and frequency
+//! after `thermal_drift` and `voltage_sag` act on them) and everything that follows from
+//! the amplitude: contact zone, stick angle, interface factors, modal impedance and the
+//! amplitude G(W) = Θ·V/|Z(W)| it implies.
+
+use super::{OperatingPoint, Prepared, Solution};
+use crate::contact::{self, Contact};
+use crate::interface::{coulomb_interface, general_interface, interface_law, AngleCarry};
+use crate::stator::{self, modal_stiffness};
+
+/// Everything that follows from one trial amplitude.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Trial {
+    /// Trial amplitude W [m].
+    pub(super) w: f64,
+    /// The contact zone at W.
+    pub(super) contact: Contact,
+    /// χ(φ0) = sin φ0 − φ0·c.
+    pub(super) chi0: f64,
+    /// Stick half-angle θs [rad].
+    pub(super) ts: f64,
+    /// Rotor surface speed [m/s]: v0·cos θs, or below it when the whole contact drives.
+    pub(super) vr: f64,
+    /// True when the rotor is at rest (the load torque is at or above the drive).
+    pub(super) stalled: bool,
+    /// Force scale A = 2·N·k_f·W/k [N]: the axial force is A·χ(φ0).
+    pub(super) a: f64,
+    /// Crest surface speed v0 = k·h0·ω·W [m/s].
+    pub(super) v0: f64,
+    /// Torque factor 2χ(θs) − χ(φ0) or its generalisation ([`crate::interface::factors`]):
+    /// the drive torque is R0·μ·A·tf [-].
+    pub(super) tf: f64,
+    /// Friction power taken from the wave per v0, in units of 2Nμk_f·W/k [-].
+    pub(super) pf: f64,
+    /// Radial slip power per v0, same units as `pf` [-] (zero for the Coulomb interface).
+    pub(super) rf: f64,
+    /// Torque factor with the rotor at rest (stall torque = R0·μ·A·tf0); NaN when the
+    /// generalised interface did not need it (computed in `finish`).
+    pub(super) tf0: f64,
+    /// Modal impedance Z = (Re, Im) = (k_eff − m·ω², ω·(c + c_t)) [N/m].
+    pub(super) z: (f64, f64),
+    /// Effective modal stiffness k_eff (with preload stiffening and Hertz softening) [N/m].
+    pub(super) k_eff: f64,
+    /// Θ·V/|Z|: the amplitude this trial implies.
+    pub(super) w_next: f64,
+    /// d(W − w_next)/dW, exact: the baseline Coulomb interface only (NaN elsewhere).
+    pub(super) slope: f64,
+    /// Contact and stick angles for the next trial's start (baseline Coulomb interface).
+    pub(super) carry: [Option<AngleCarry>; 2],
+}
+
+impl Trial {
+    /// The Newton step on this trial's exact slope of r(W) = W − G(W), where it has a
+    /// positive one (callers keep it only inside their bracket).
+    pub(super) fn newton(&self) -> Option<f64> {
+        (self.slope > 0.0).then(|| self.w - (self.w - self.w_next) / self.slope)
+    }
+}
+
+/// Per-point inputs after effects that act on the drive (voltage sag, thermal state).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Drive {
+    /// Axial preload F [N].
+    pub(crate) f_n: f64,
+    /// Load torque T [N·m].
+    pub(crate) t_load: f64,
+    /// Electrode voltage amplitude V [V] (below the set voltage under `voltage_sag`).
+    pub(crate) v: f64,
+    /// Drive angular frequency ω [rad/s].
+    pub(crate) omega: f64,
+    /// Friction coefficient μ [-] (temperature dependent under `thermal_drift`).
+    pub(crate) mu: f64,
+    /// Modal stiffness k_s [N/m] (temperature dependent under `thermal_drift`).
+    pub(crate) ks: f64,
+    /// Modal damping [N·s/m] (temperature dependent under `thermal_drift`).
+    pub(crate) c: f64,
+}
+
+impl Drive {
+    /// The drive as set at `op`, before any effect acts on it.
+    pub(crate) fn at(p: &Prepared, op: &OperatingPoint) -> Drive {
+        Drive {
+            f_n: op.preload_n,
+            t_load: op.torque_nm,
+            v: op.voltage_v,
+            omega: stator::angular_frequency(op.frequency_hz),
+            mu: p.mu,
+            ks: p.ks,
+            c: p.c,
+        }
+    }
+
+    /// `thermal_drift`: the stiffness, friction and damping at a temperature rise [K]. Each
+    /// relative coefficient scales its nominal value: exponential laws in the truth form,
+    /// linear ones (floored at 5 % of nominal so a large drift cannot make a stiffness,
+    /// damping or friction coefficient non-physical) in the candidate.
+    pub(crate) fn warm(&mut self, p: &Prepared, rise_k: f64) {
+        // (the second truth family: a sensitivity that saturates over about 25 K)
+        let law = |x: f64| {
+            if p.truth_b {
+                (1.0 + x * 25.0 * (rise_k / 25.0).tanh()).max(0.05)
+            } else if p.truth {
+                (x * rise_k).exp()
+            } else {
+                (1.0 + x * rise_k).max(0.05)
+            }
+        };
+        let [a, b, g] = p.thermal;
+        (self.ks, self.mu, self.c) = (p.ks * law(a), p.mu * law(b), p.c * law(g));
+    }
+}
+
+/// `voltage_sag`: the set voltage over |1 + Z_src·Y| with Y = I/V_e the phase admittance
+/// of solution `s` (V_set = V_e·(1 + Z_src·Y)); the truth form's source is partly reactive.
+pub(super) fn sagged_voltage_v(p: &Prepared, op: &OperatingPoint, s: &Solution) -> f64 {
+    let ve = s.electrode_voltage_v;
+    sagged_voltage_at(p, op, (s.current_in_phase_a / ve, s.current_quadrature_a / ve))
+}
+
+/// [`sagged_voltage_v`] for the phase admittance (in phase, quadrature) [S].
+pub(super) fn sagged_voltage_at(p: &Prepared, op: &OperatingPoint, (yr, yi): (f64, f64)) -> f64 {
+    // (the second truth family: an output resistance that grows with the load current, as
+    // a driver's saturating magnetics give)
+    let (zr, zi) = if p.truth_b {
+        (p.sag_ohm * (0.4 + 4.5 * p.sag_ohm * yr.hypot(yi)), 0.0)
+    } else if p.truth {
+        (p.sag_ohm, 0.5 * p.sag_ohm)
+    } else {
+        (p.sag_ohm, 0.0)
+    };
+    let (re, im) = (1.0 + zr * yr - zi * yi, zr * yi + zi * yr);
+    op.voltage_v / re.hypot(im)
+}
+
+pub(super) fn trial(
+    p: &Prepared,
+    d: &Drive,
+    w: f64,
+    ts_guess: Option<contact::AngleStart>,
+    phi_guess: Option<contact::AngleStart>,
+) -> Trial {
+    let a = contact::force_scale_n(p.n, p.kf, w, p.k);
+    let (ct, s0, c0) = contact::contact_from_ratio_near(d.f_n / a, phi_guess);
+    let v0 = stator::crest_surface_speed_m_s(p.k, p.h0, d.omega, w);
+    let tscale = p.r0 * d.mu * a;
+    let (ts, vr, stalled, tf, pf, rf, tf0, dpf, carry);
+    if p.law.radial_ratio == 0.0 && p.compliance == 0.0 {
+        let cb = coulomb_interface(p, d, &ct, (s0, c0), w, tscale, v0, ts_guess);
+        (ts, vr, stalled, tf, pf, tf0, dpf, carry) =
+            (cb.ts, cb.vr, cb.stalled, cb.tf, cb.pf, cb.tf0, cb.pf_per_w, cb.carry);
+        rf = 0.0;
+    } else {
+        let law = interface_law(p, d, &ct);
+        let (t, v, st, fac, t0) = general_interface(p, d, &ct, tscale, v0, &law, ts_guess.map(|g| g.0));
+        (ts, vr, stalled, tf, pf, rf, tf0) = (t, v, st, fac.torque, fac.power, fac.radial, t0);
+        (dpf, carry) = (f64::NAN, [None; 2]);
+    }
+    let ct_omega_per_pf = 2.0 * p.n * d.mu * p.kf * p.h0;
+    let k_eff = modal_stiffness(p, d, w, &ct, a);
+    let z = (k_eff - p.m * d.omega * d.omega, d.omega * d.c + ct_omega_per_pf * pf);
+    let z2 = z.0 * z.0 + z.1 * z.1;
+    let w_next = p.theta * d.v / z2.sqrt();
+    // r = W − G(W), G = Θ·V/|Z|: dr/dW = 1 + G·Im Z·d(Im Z)/dW / |Z|² where the modal
+    // stiffness does not depend on W (NaN where it does, or dpf is not known).
+    let slope = match p.stiffening == 0.0 && p.beta == 0.0 {
+        true => 1.0 + w_next * z.1 * ct_omega_per_pf * dpf / z2,
+        false => f64::NAN,
+    };
+    // χ(φ0) with the sine the contact solve has (the axial force is A·χ(φ0))
+    let chi0 = s0 - ct.half_angle_rad * ct.offset;
+    Trial { w, contact: ct, chi0, ts, vr, stalled, a, v0, tf, pf, rf, tf0, z, k_eff, w_next, slope, carry }
+}
