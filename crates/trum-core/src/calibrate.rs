@@ -1066,9 +1066,11 @@ fn fit(
     if params.is_empty() {
         return Err(TrumError::input("no parameters to fit: name at least one"));
     }
-    if n_read <= params.len() {
+    // (a prior is a reading of its parameter)
+    let n_prior = params.iter().filter(|fp| fp.prior.is_some()).count();
+    if n_read + n_prior <= params.len() || n_read == 0 {
         return Err(TrumError::input(format!(
-            "{n_read} readings cannot determine {} parameters; need more measured points",
+            "{n_read} readings cannot determine {} parameters ({n_prior} with a prior); need more measured points",
             params.len()
         )));
     }
@@ -1203,7 +1205,7 @@ fn fit(
         let col = jp.column(k) * (scale[k] / d);
         jp.set_column(k, &col);
     }
-    let dof = (n_read - params.len()).max(1) as f64;
+    let dof = (n_read + n_prior).saturating_sub(params.len()).max(1) as f64;
     let s2 = (chi2 / dof).max(1e-300);
     let jtj = jp.transpose() * &jp;
     // nalgebra's plain `svd` iterates without bound on non-finite input; `try_svd` with an
