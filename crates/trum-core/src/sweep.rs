@@ -191,7 +191,7 @@ mod tests {
         // The presets, and trum60a with a softening stator (several amplitude branches; no
         // warm amplitude there, see solve::solve_in_sweep).
         let motors = ["trum60a", "trum60-qut", "generic60", "trum60a+hertz_softening"].map(|name| {
-            let mut m = crate::presets::preset(name.split('+').next().unwrap()).expect("preset");
+            let mut m = crate::presets::preset(name.split('+').next().unwrap_or(name)).expect("preset");
             if name.ends_with("softening") {
                 let e = crate::effects::Effect::HertzSoftening;
                 let strong: Vec<f64> = e.info().params.iter().map(|p| 3.0 * p.typical).collect();
@@ -291,16 +291,24 @@ mod tests {
         assert!(g.validate().is_ok());
         let mut bad = g;
         bad.preload_n.start = 0.0;
-        assert!(bad.validate().unwrap_err().to_string().contains("preload_n: 0 must be > 0"));
+        assert!(bad.validate().expect_err("an invalid grid").to_string().contains("preload_n: 0 must be > 0"));
         let mut bad = g;
         bad.torque_nm.stop = -0.1;
-        assert!(bad.validate().unwrap_err().to_string().contains("torque_nm: -0.1 must be >= 0"));
+        assert!(bad.validate().expect_err("an invalid grid").to_string().contains("torque_nm: -0.1 must be >= 0"));
         let mut bad = g;
         bad.voltage_v.n = 0;
-        assert!(bad.validate().unwrap_err().to_string().contains("voltage_v: an axis needs at least one point"));
+        assert!(bad
+            .validate()
+            .expect_err("an invalid grid")
+            .to_string()
+            .contains("voltage_v: an axis needs at least one point"));
         let mut bad = g;
         bad.frequency_hz.stop = f64::INFINITY;
-        assert!(bad.validate().unwrap_err().to_string().contains("frequency_hz: inf is not a finite number"));
+        assert!(bad
+            .validate()
+            .expect_err("an invalid grid")
+            .to_string()
+            .contains("frequency_hz: inf is not a finite number"));
         // the axes, their values and the names come in one order
         let op = g.point(7);
         assert_eq!(axis_values(&op), [op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz]);
