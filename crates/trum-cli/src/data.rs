@@ -1,7 +1,7 @@
 //! Shared by `synth`, `calibrate` and `diagnose`: reading a measurement file (its
 //! warnings go to stderr), JSON numbers without NaN, and writing a small file atomically.
 
-use crate::args::OutputTarget;
+use crate::output::OutputTarget;
 use anyhow::{anyhow, bail, Context, Result};
 use std::io::Write;
 use std::path::Path;
@@ -9,7 +9,7 @@ use trum_core::bench::{observations, BenchData};
 use trum_core::measurements::{parse_measurements, Measurements};
 use trum_core::Motor;
 
-/// Reads and checks a measurement file (shared/spec/measurements.md); warnings (ignored
+/// Reads and checks a measurement file (layout: docs/MEASUREMENTS.md); warnings (ignored
 /// columns, ...) are printed to `err`.
 pub fn read_data(path: &str, motor: &Motor, err: &mut dyn Write) -> Result<(Measurements, BenchData)> {
     let p = Path::new(path);

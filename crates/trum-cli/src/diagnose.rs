@@ -1,11 +1,13 @@
-//! `trum diagnose`: the sim-to-real gap diagnosis of shared/spec/diagnose.md — where the
-//! calibrated baseline misses, which unmodelled effect causes it, and how far the
-//! held-out gap shrinks once that effect is added. Summary to stdout, JSON and an HTML
-//! report on request.
+//! `trum diagnose`: the sim-to-real gap diagnosis — where the calibrated baseline misses,
+//! which unmodelled effect causes it, and how far the held-out gap shrinks once that
+//! effect is added. Summary to stdout, the JSON document (docs/DIAGNOSIS_JSON.md) and an
+//! HTML report (crate::report) on request.
 
-use crate::args::{fmt_sig, load_motor};
 use crate::data::{read_data, write_atomic};
+use crate::format::fmt_sig;
+use crate::motor::load_motor;
 use crate::table::{write_table, Align};
+use crate::verdict::{after_nrmse, verdict_words};
 use anyhow::{anyhow, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget};
@@ -16,14 +18,14 @@ use trum_core::diagnose::json::{to_json, Provenance};
 use trum_core::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
 use trum_core::Motor;
 
-pub use trum_core::diagnose::json::{unit, EVIDENCE_SCALE};
+use trum_core::diagnose::json::{unit, EVIDENCE_SCALE};
 
 #[derive(Args, Debug)]
 pub struct DiagnoseArgs {
     /// Nominal motor: a TOML motor file or a preset name.
     #[arg(long, value_name = "MOTOR.toml|PRESET")]
     motor: String,
-    /// Measurement CSV (shared/spec/measurements.md).
+    /// Measurement CSV (layout: docs/MEASUREMENTS.md).
     #[arg(long, value_name = "DATA.csv")]
     data: String,
     /// Write the diagnosis as JSON here (`-`: JSON to stdout instead of the summary).
@@ -43,7 +45,7 @@ pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     let (_, bench) = read_data(&a.data, &motor, err)?;
     // Check the output paths before the long run, so a typo fails at once.
     for p in [&a.json, &a.report].into_iter().flatten() {
-        drop(crate::args::OutputTarget::create(p, ".tmp")?);
+        drop(crate::output::OutputTarget::create(p, ".tmp")?);
     }
     let spinner = spinner();
     let opts = DiagnoseOptions { exact_cv: a.exact_cv, ..DiagnoseOptions::default() };
@@ -83,28 +85,6 @@ fn pct(x: f64) -> String {
         format!("{:.1} %", 100.0 * x)
     } else {
         "-".into()
-    }
-}
-
-/// The held-out NRMSE after adding the verdict's effect(s), when there is a verdict effect.
-pub fn after_nrmse(d: &Diagnosis) -> Option<f64> {
-    d.ranking.iter().find(|r| r.effect == d.verdict).map(|r| r.heldout_nrmse_after)
-}
-
-/// Verdict in words.
-pub fn verdict_words(d: &Diagnosis) -> String {
-    match d.verdict.as_str() {
-        "none" => "none (the calibrated baseline is adequate within the noise)".into(),
-        "unexplained" => match d.partial.as_ref().and_then(|p| d.ranking.iter().find(|r| &r.effect == p)) {
-            Some(r) => format!(
-                "unexplained (a real gap that no candidate effect closes; {} explains part of it, {} % of the held-out gap)",
-                r.effect,
-                fmt_sig(100.0 * r.shrink, 2)
-            ),
-            None => "unexplained (a real gap that no candidate effect closes)".into(),
-        },
-        v if v.contains('+') => format!("{v} (both effects together are needed to close the gap)"),
-        v => v.to_string(),
     }
 }
 

@@ -12,9 +12,13 @@ mod args;
 mod calib;
 mod data;
 mod diagnose;
+mod format;
+mod grid;
 mod info;
 mod map;
+mod motor;
 mod optimize;
+mod output;
 mod plot;
 mod point;
 mod report;
@@ -23,8 +27,9 @@ mod step;
 mod svg;
 mod synth;
 mod table;
+mod verdict;
 
-pub use args::parse_axis;
+pub use grid::parse_axis;
 
 /// Simulate, map and optimise traveling-wave rotary ultrasonic motors (SI units throughout).
 #[derive(Parser, Debug)]
@@ -42,7 +47,7 @@ enum Command {
     /// Solve a grid of operating points and write a CSV map (streamed, parallel).
     #[command(allow_negative_numbers = true)]
     Map(map::MapArgs),
-    /// Evaluate the preload optimisation criterion (seed 000 section 5).
+    /// Evaluate the preload optimisation criterion (Chen et al. 2020, section 5).
     #[command(allow_negative_numbers = true)]
     Optimize(optimize::OptimizeArgs),
     /// List the built-in motor presets, or print one as a motor file.
@@ -59,13 +64,13 @@ enum Command {
     Calibrate(calib::CalibrateArgs),
     /// Diagnose the sim-to-real gap: where the model misses, which effect causes it, how far it shrinks.
     Diagnose(diagnose::DiagnoseArgs),
-    /// Nonlinear (Hertzian) resonance curves: every branch, backbone and jump frequencies vs voltage and preload (seed 003).
+    /// Nonlinear (Hertzian) resonance curves: every branch, backbone and jump frequencies vs voltage and preload ([Hertz2022]: docs/REFERENCES.md).
     #[command(allow_negative_numbers = true)]
     Resonance(resonance::ResonanceArgs),
-    /// Identify the cubic coefficient beta from a sampled waveform by harmonic balance (seed 003 eq. 5-9).
+    /// Identify the cubic coefficient beta from a sampled waveform by harmonic balance ([Hertz2022] eq. 5-9).
     #[command(name = "identify-hertz", allow_negative_numbers = true)]
     IdentifyHertz(resonance::IdentifyArgs),
-    /// Step response of the rotor speed with stick-slip contact (seed 004); metrics vs the steady solver.
+    /// Step response of the rotor speed with stick-slip contact ([BarTransient]: docs/REFERENCES.md); metrics vs the steady solver.
     #[command(allow_negative_numbers = true)]
     Step(step::StepArgs),
 }

@@ -1,13 +1,16 @@
 //! `trum map`: a grid of operating points to CSV, streamed in constant memory.
 //!
-//! The grid is cut into fixed chunks of `CHUNK` points. Each chunk is solved serially
-//! with warm starts ([`trum_core::sweep::solve_range`]) and formatted into a byte buffer;
+//! The grid is cut into the core's fixed chunks ([`trum_core::sweep::CHUNK_POINTS`]). Each
+//! chunk is solved serially with warm starts ([`trum_core::sweep::solve_range`]), exactly
+//! as Python's `trum.map` solves it, and formatted into a byte buffer;
 //! a wave of chunks is solved in parallel with rayon while the previous wave is being
 //! written. Chunk boundaries do not depend on the thread count, so the output is
 //! byte-identical whatever the parallelism. At most three waves exist at once (one being
 //! solved, one queued, one being written): memory is constant for any grid size.
 
-use crate::args::{check_grid, default_grid, GridArgs, MotorArgs, OutputTarget, Progress, WritebackFile};
+use crate::args::{GridArgs, MotorArgs};
+use crate::grid::{check_grid, default_grid};
+use crate::output::{OutputTarget, Progress, WritebackFile};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use rayon::prelude::*;
@@ -15,19 +18,15 @@ use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 use trum_core::quantities::{self, Quantity, QUANTITIES};
 use trum_core::solve::Prepared;
-use trum_core::sweep::{solve_range, Grid};
+use trum_core::sweep::{axis_values, chunk_count, chunk_range, solve_range, Grid, AXES, CHUNK_POINTS};
 use trum_core::Motor;
-
-/// Points per chunk: large enough that warm starts pay off and scheduling is cheap,
-/// small enough that a wave of chunks stays a few megabytes.
-const CHUNK: u64 = 4096;
 
 /// Bytes between the early disk flushes of a map written to a file (4-32 MB measured the
 /// same; docs/PERFORMANCE.md "CSV maps").
 const WRITEBACK_STEP: u64 = 32 << 20;
 
-/// Input columns, in the order they are written.
-pub const INPUT_COLUMNS: [&str; 4] = ["preload_n", "torque_nm", "voltage_v", "frequency_hz"];
+/// Input columns, in the order they are written: the core's grid axes.
+pub const INPUT_COLUMNS: [&str; 4] = AXES;
 
 #[derive(Args, Debug)]
 pub struct MapArgs {
@@ -48,7 +47,7 @@ pub struct MapArgs {
     #[arg(short, long)]
     quiet: bool,
     /// Points per chunk (advanced; changes warm-start boundaries, so the last digits may differ).
-    #[arg(long, default_value_t = CHUNK, hide = true)]
+    #[arg(long, default_value_t = CHUNK_POINTS, hide = true)]
     chunk_points: u64,
 }
 
@@ -113,7 +112,7 @@ fn chunk_csv(motor: &Motor, prep: &Prepared, grid: &Grid, cols: &[&Quantity], ra
     let mut fmt = NumberFormatter::new();
     let mut last = ColumnMemo::new(INPUT_COLUMNS.len() + cols.len());
     solve_range(motor, prep, grid, range, |_, op, s| {
-        for (c, v) in [op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz].into_iter().enumerate() {
+        for (c, v) in axis_values(op).into_iter().enumerate() {
             last.push(&mut fmt, &mut buf, c, v);
             buf.push(b',');
         }
@@ -162,10 +161,10 @@ impl ColumnMemo {
     }
 }
 
-/// Writes numbers as `format!("{v}")` (and so [`crate::args::csv_number`]) does —
+/// Writes numbers as `format!("{v}")` (and so [`crate::format::csv_number`]) does —
 /// shortest round-trip digits, plain decimal notation, never an exponent — but through
 /// `zmij`, without allocating: number formatting cost more than solving in large maps
-/// (zmij instead of ryu since stop 17: 11 against 19 ns a number, the same digits).
+/// (zmij takes 11 ns a number where ryu takes 19, for the same digits).
 pub struct NumberFormatter {
     digits: zmij::Buffer,
 }
@@ -266,7 +265,7 @@ fn write_map(
 ) -> Result<()> {
     w.write_all(header(cols).as_bytes())?;
     let total = grid.len();
-    let nchunks = total.div_ceil(chunk);
+    let nchunks = chunk_count(total, chunk);
     // Two chunks per thread keep both busy; at most three waves (solving, queued, being
     // written) of ~2 MB chunks bound the memory (4 per thread reached 51 MB at 10^7 points).
     let wave = (2 * pool.current_num_threads() as u64).max(2);
@@ -283,7 +282,7 @@ fn write_map(
                 let bufs: Vec<Vec<u8>> = pool.install(|| {
                     (first..last)
                         .into_par_iter()
-                        .map(|c| chunk_csv(motor, prep, grid, cols, c * chunk..((c + 1) * chunk).min(total)))
+                        .map(|c| chunk_csv(motor, prep, grid, cols, chunk_range(total, chunk, c)))
                         .collect()
                 });
                 let done = (last * chunk).min(total);

@@ -4,7 +4,10 @@
 //! Text is rendered with plotters' `ttf` feature, which needs a system font. When none is
 //! found the plot is still drawn, without any text, and a warning says so.
 
-use crate::args::{check_grid, unit_of, GridArgs, MotorArgs, OutputTarget};
+use crate::args::{GridArgs, MotorArgs};
+use crate::format::unit_of;
+use crate::grid::check_grid;
+use crate::output::OutputTarget;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, ValueEnum};
 use plotters::coord::Shift;
@@ -269,7 +272,7 @@ fn plot_grid(motor: &Motor, a: &PlotArgs, sweep: &trum_core::params::SweepTable,
     let (p, t, v, f) = match a.kind {
         Some(k) => k.default_axes(),
         None => {
-            let d = crate::args::default_grid();
+            let d = crate::grid::default_grid();
             let t = if x == "torque_nm" { None } else { Some(d.torque_nm) };
             (d.preload_n, t, d.voltage_v, d.frequency_hz)
         }
@@ -399,7 +402,7 @@ fn finite_range(v: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
 }
 
 fn tick(v: &f64) -> String {
-    crate::args::fmt_sig(*v, 4)
+    crate::format::fmt_sig(*v, 4)
 }
 
 fn draw<DB: DrawingBackend>(
@@ -453,7 +456,7 @@ fn curves<DB: DrawingBackend>(
             points.sort_by(|a, b| a.0.total_cmp(&b.0));
             let label = spec.group.as_deref().map(|gname| {
                 let unit = unit_of(gname).map(|u| format!(" {}", u.replace(' ', "·"))).unwrap_or_default();
-                format!("{gname} = {}{unit}", crate::args::fmt_sig(g, 6))
+                format!("{gname} = {}{unit}", crate::format::fmt_sig(g, 6))
             });
             Line { label, color: series_color(gi, n), points, dashed: false }
         })

@@ -1,11 +1,13 @@
 //! `trum point`: one operating point, every quantity with its unit.
 
-use crate::args::{fmt_sig, MotorArgs};
+use crate::args::MotorArgs;
+use crate::format::fmt_sig;
 use crate::table::{write_table, Align};
 use anyhow::{bail, Result};
 use clap::Args;
 use serde_json::{json, Map, Value};
 use std::io::Write;
+use trum_core::layout::status_meaning;
 use trum_core::quantities::QUANTITIES;
 use trum_core::{solve, OperatingPoint, Status};
 
@@ -103,15 +105,11 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
     Ok(0)
 }
 
-fn status_note(s: Status, full: bool) -> &'static str {
+/// The status's meaning in brackets, as `trum_core::layout::status_meaning` words it.
+fn status_note(s: Status, full: bool) -> String {
     match s {
-        Status::Ok if full => " (rotor turning, full contact)",
-        Status::Ok => " (rotor turning)",
-        Status::Stall => " (load torque at or above the stall torque: rotor at rest)",
-        Status::Clamped => " (friction clamps the stator: no vibration at this drive)",
-        Status::NoConvergence => {
-            " (no steady state found: not converged, or the motor hunts between states; numbers withheld)"
-        }
-        Status::InvalidInput => " (invalid operating point)",
+        Status::Ok if full => format!(" ({}, full contact)", status_meaning(s)),
+        Status::NoConvergence => format!(" ({}; numbers withheld)", status_meaning(s)),
+        _ => format!(" ({})", status_meaning(s)),
     }
 }

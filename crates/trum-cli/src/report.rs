@@ -2,13 +2,14 @@
 //! charts, where table, held-out residual maps, measured-vs-model curves and notes. All
 //! plots are inline SVG; the page loads nothing from outside.
 
-use crate::args::fmt_sig;
-use crate::diagnose::{after_nrmse, unit, verdict_words, EVIDENCE_SCALE};
+use crate::format::fmt_sig;
 use crate::svg::{esc, Bars, Chart, Series, Style, PALETTE};
+use crate::verdict::{after_nrmse, verdict_words};
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 use trum_core::bench::BenchData;
 use trum_core::calibrate::{Observable, ObservedRow};
+use trum_core::diagnose::json::{unit, EVIDENCE_SCALE};
 use trum_core::diagnose::Diagnosis;
 use trum_core::Motor;
 

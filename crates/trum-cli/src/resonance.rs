@@ -1,11 +1,12 @@
-//! `trum resonance` (amplitude–frequency response of the Hertzian oscillator, seed 003
-//! eq. 10-12) and `trum identify-hertz` (β from a waveform by harmonic balance, eq. 5-9).
+//! `trum resonance` (amplitude–frequency response of the Hertzian oscillator, [Hertz2022]
+//! eq. 10-12, docs/REFERENCES.md) and `trum identify-hertz` (β from a waveform by harmonic balance, eq. 5-9).
 //!
 //! Both use the oscillator parameters of `trum_core::dynamics::hertz::HertzOscillator`:
 //! its 60 mm TRUM defaults, overridden by an `--oscillator` TOML file and then by flags.
 
-use crate::args::{csv_number, fmt_sig, parse_axis};
 use crate::data::{num, write_atomic};
+use crate::format::{csv_number, fmt_sig};
+use crate::grid::parse_axis;
 use crate::plot::{series_color, write_figure, Line, LinePlot};
 use crate::table::{write_table, Align};
 use anyhow::{anyhow, bail, Context, Result};
@@ -17,6 +18,7 @@ use trum_core::dynamics::hertz::{
     identify_beta, BetaIdentificationInput, Branch, FamilyCurve, HertzError, HertzOscillator, OperatingPoint,
     ResponseMethod,
 };
+use trum_core::layout::{response_rows, response_status, response_summary, RESPONSE_COLUMNS};
 use trum_core::sweep::Axis;
 
 /// Oscillator parameters: defaults, then `--oscillator FILE`, then the flags.
@@ -109,7 +111,7 @@ fn set_param(o: &mut HertzOscillator, key: &str, value: f64) -> Result<(), Strin
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Default)]
 pub enum Method {
-    /// Multiple scales (seed 003 eq. 10-12).
+    /// Multiple scales ([Hertz2022] eq. 10-12).
     #[default]
     MultipleScales,
     /// One-term harmonic balance (exact linear FRF for beta = 0).
@@ -147,13 +149,6 @@ pub struct ResonanceArgs {
     /// Plot of the curves (.png or .svg): stable branches solid, unstable and backbones dashed.
     #[arg(long, value_name = "FILE")]
     plot: Option<PathBuf>,
-}
-
-fn status_of(e: &HertzError) -> &'static str {
-    match e {
-        HertzError::NoStaticEquilibrium { .. } => "no_static_equilibrium",
-        _ => "invalid_input",
-    }
 }
 
 fn axis_values(ax: &Axis, name: &str) -> Result<Vec<f64>> {
@@ -196,7 +191,7 @@ pub fn run(a: &ResonanceArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     for c in &curves {
         if let Err(e) = &c.response {
             let op = c.operating_point;
-            writeln!(err, "note: {} V, {} N: {} ({e})", op.voltage_v, op.preload_n, status_of(e))?;
+            writeln!(err, "note: {} V, {} N: {} ({e})", op.voltage_v, op.preload_n, response_status(c))?;
         }
     }
     if let Some(path) = &a.output {
@@ -211,47 +206,23 @@ pub fn run(a: &ResonanceArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     Ok(0)
 }
 
-const RESPONSE_HEADER: &str = "voltage_v,preload_n,frequency_hz,branch,status,amplitude_m,phase_lag_rad,stable";
-
-/// One row per solution: every branch at every frequency, then the backbone and the two
-/// saddle nodes of each curve; a curve without a static equilibrium is one status row.
+/// The response table (`trum_core::layout::response_rows`, the layout Python's
+/// `Resonance.to_dict` has too) as CSV; numbers a row does not have are empty cells.
 fn response_csv(curves: &[FamilyCurve]) -> String {
-    let mut s = String::from(RESPONSE_HEADER);
+    let mut s = RESPONSE_COLUMNS.join(",");
     s.push('\n');
-    for c in curves {
-        let (v, n) = (csv_number(c.operating_point.voltage_v), csv_number(c.operating_point.preload_n));
-        let r = match &c.response {
-            Ok(r) => r,
-            Err(e) => {
-                s.push_str(&format!("{v},{n},,,{},,,\n", status_of(e)));
-                continue;
-            }
-        };
-        for p in &r.points {
-            s.push_str(&format!(
-                "{v},{n},{},{},ok,{},{},{}\n",
-                csv_number(p.frequency_hz),
-                p.branch.as_str(),
-                csv_number(p.amplitude_m),
-                csv_number(p.phase_lag_rad),
-                p.stable
-            ));
-        }
-        for b in &c.backbone {
-            s.push_str(&format!(
-                "{v},{n},{},backbone,ok,{},,\n",
-                csv_number(b.frequency_hz),
-                csv_number(b.amplitude_m)
-            ));
-        }
-        if let Some(j) = &r.jumps {
-            for (name, f, amp) in [
-                ("jump_up", j.jump_up_hz, j.jump_up_amplitude_m),
-                ("jump_down", j.jump_down_hz, j.jump_down_amplitude_m),
-            ] {
-                s.push_str(&format!("{v},{n},{},{name},ok,{},,false\n", csv_number(f), csv_number(amp)));
-            }
-        }
+    for r in response_rows(curves) {
+        let stable = r.stable.map(|b| b.to_string()).unwrap_or_default();
+        s.push_str(&format!(
+            "{},{},{},{},{},{},{},{stable}\n",
+            csv_number(r.voltage_v),
+            csv_number(r.preload_n),
+            csv_number(r.frequency_hz),
+            r.branch,
+            r.status,
+            csv_number(r.amplitude_m),
+            csv_number(r.phase_lag_rad),
+        ));
     }
     s
 }
@@ -325,19 +296,22 @@ fn write_summary(curves: &[FamilyCurve], out: &mut dyn Write) -> Result<()> {
     let mut rows = Vec::new();
     for c in curves {
         let mut row = vec![fmt_sig(c.operating_point.voltage_v, 6), fmt_sig(c.operating_point.preload_n, 6)];
-        match &c.response {
-            Err(e) => {
-                row.push(status_of(e).into());
-                row.extend(std::iter::repeat_n("-".to_string(), 6));
-            }
-            Ok(r) => {
-                row.push("ok".into());
-                // the backbone starts at zero amplitude, i.e. at the linear resonance
-                let lin = c.backbone.first().map_or(f64::NAN, |p| p.frequency_hz);
-                let peak = r.points.iter().map(|p| p.amplitude_m).fold(f64::NAN, f64::max);
-                let (up, down) = r.jumps.as_ref().map_or((f64::NAN, f64::NAN), |j| (j.jump_up_hz, j.jump_down_hz));
-                row.extend([lin, r.equivalent_beta_n_per_m3, peak, up, down, (up - down).abs()].map(|x| fmt_sig(x, 7)));
-            }
+        row.push(response_status(c).into());
+        if c.response.is_ok() {
+            let m = response_summary(c);
+            row.extend(
+                [
+                    m.linear_resonance_hz,
+                    m.equivalent_beta_n_per_m3,
+                    m.peak_amplitude_m,
+                    m.jump_up_hz,
+                    m.jump_down_hz,
+                    m.hysteresis_hz,
+                ]
+                .map(|x| fmt_sig(x, 7)),
+            );
+        } else {
+            row.extend(std::iter::repeat_n("-".to_string(), 6));
         }
         rows.push(row);
     }

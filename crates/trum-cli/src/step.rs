@@ -1,9 +1,11 @@
 //! `trum step`: the start-up (step response) of the rotor speed with the stick-slip
-//! contact of seed 004 (`trum_core::dynamics::transient`), compared with the steady-state
+//! contact of [BarTransient] (docs/REFERENCES.md; `trum_core::dynamics::transient`), compared with the steady-state
 //! solver at the same operating point; time series, contact snapshots and plots.
 
-use crate::args::{csv_number, fmt_sig, parse_axis, MotorArgs};
+use crate::args::MotorArgs;
 use crate::data::write_atomic;
+use crate::format::{csv_number, fmt_sig};
+use crate::grid::parse_axis;
 use crate::plot::{series_color, write_figure, Line, LinePlot};
 use crate::table::{write_table, Align};
 use anyhow::{anyhow, bail, Result};
@@ -42,7 +44,7 @@ pub struct StepArgs {
     /// Time steps per drive period.
     #[arg(long, default_value_t = 64)]
     steps_per_period: usize,
-    /// Contact nodes per wavelength (256 in seed 004).
+    /// Contact nodes per wavelength (256 in [BarTransient]).
     #[arg(long, default_value_t = 256)]
     nodes_per_wavelength: usize,
     /// Tangential stiffness of the contact layer as a multiple of the normal (Winkler) stiffness.

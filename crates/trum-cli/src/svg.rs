@@ -386,7 +386,7 @@ impl Bars {
                     );
                 }
             }
-            let txt = crate::args::fmt_sig(v, 3);
+            let txt = crate::format::fmt_sig(v, 3);
             let _ = write!(s, r#"<text x="{:.1}" y="{:.1}" font-size="10">{txt}</text>"#, b + 4.0, y + bh / 2.0 + 4.0);
         }
         let _ = write!(s, r##"<line x1="{zx:.1}" y1="{mt}" x2="{zx:.1}" y2="{:.1}" stroke="#333"/>"##, mt + ph);

@@ -1,5 +1,5 @@
 //! `trum synth`: a synthetic bench campaign with known effects, written as a measurement
-//! file (shared/spec/measurements.md) for `trum calibrate` and `trum diagnose`.
+//! file (layout: docs/MEASUREMENTS.md) for `trum calibrate` and `trum diagnose`.
 
 use crate::args::MotorArgs;
 use crate::data::write_atomic;

@@ -148,18 +148,29 @@ fn map_columns_rows_and_defaults() {
 }
 
 #[test]
-fn invalid_points_have_empty_cells_and_a_status() {
-    let out = ok(&["map", "--motor", "trum60a", "--preload-n", "0:200:3", "--torque-nm", "-0.5:0.5:3", "-o", "-"]);
-    assert!(!out.to_lowercase().contains("nan"), "{out}");
-    let (h, rows) = parse_csv(&out);
-    assert_eq!(rows.len(), 9);
-    for r in &rows {
-        let invalid = r[0] == "0" || r[1] == "-0.5";
-        assert_eq!(r[4], if invalid { "invalid_input" } else { "ok" }, "{r:?}");
-        for (name, cell) in h.iter().zip(r).skip(5) {
-            assert_eq!(cell.is_empty(), invalid, "{name} in {r:?}");
-        }
+fn grids_outside_the_model_domain_are_refused_before_anything_is_written() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let target = dir.path().join("m.csv");
+    let t = target.to_str().unwrap_or_default();
+    for (axis, value, message) in [
+        ("--preload-n", "0:200:3", "preload_n: 0 must be > 0"),
+        ("--torque-nm", "-0.5:0.5:3", "torque_nm: -0.5 must be >= 0"),
+        ("--voltage-v", "-200", "voltage_v: -200 must be > 0"),
+        ("--frequency-hz", "0", "frequency_hz: 0 must be > 0"),
+    ] {
+        let e = fails(&["map", "--motor", "trum60a", axis, value, "-o", t], 1);
+        assert!(e.contains(message), "{axis} {value}: {e}");
+        assert!(!target.exists(), "{axis} {value}: an output file was written");
+        let e = fails(&["plot", "--motor", "trum60a", "--kind", "speed-torque", axis, value, "-o", "p.svg"], 1);
+        assert!(e.contains(message), "plot {axis} {value}: {e}");
     }
+    // through stall and clamping, every cell of a valid grid is a number or (for an
+    // invalid status) empty, never NaN
+    let out = ok(&["map", "--motor", "trum60a", "--preload-n", "50:2000:6", "--torque-nm", "0:3:4", "-o", "-"]);
+    assert!(!out.to_lowercase().contains("nan"), "{out}");
+    let (_, rows) = parse_csv(&out);
+    assert_eq!(rows.len(), 24);
+    assert!(rows.iter().any(|r| r[4] == "stall") && rows.iter().any(|r| r[4] == "ok"), "{out}");
 }
 
 #[test]

@@ -20,6 +20,7 @@ pub mod error;
 pub mod fluctuation;
 mod golden;
 pub mod interface;
+pub mod layout;
 pub mod losses;
 pub mod measurements;
 pub mod noise;

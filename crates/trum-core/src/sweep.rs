@@ -1,13 +1,42 @@
-//! Grids of operating points for maps. The grid is enumerated lazily (index → point), so
-//! a 10^8-point map never exists in memory; chunks are solved with warm starts along the
-//! fastest-varying axis. Parallelism and writing live in the CLI and Python layers.
+//! Grids of operating points for maps, as the command-line tool (`trum map`, `trum plot`)
+//! and the Python module (`trum.map`) both use them: the axes and their order, the
+//! validation of a grid, and how a grid is cut into chunks that are solved with warm starts.
+//! The grid is enumerated lazily (index → point), so a 10^8-point map never exists in
+//! memory. Parallelism and writing live in the front ends.
 
 use crate::error::TrumError;
 use crate::params::Motor;
 use crate::solve::{OperatingPoint, Prepared, Solution, SweepPoint, SWEEP_HISTORY};
 
-/// The swept input axes, in nesting order (the last varies fastest).
-pub const AXES: [&str; 4] = ["preload_n", "voltage_v", "frequency_hz", "torque_nm"];
+/// The swept input axes, in the order a map writes its input columns (and the order of
+/// [`OperatingPoint::new`]'s arguments). Points are enumerated in another order: see
+/// [`Grid::point`].
+pub const AXES: [&str; 4] = ["preload_n", "torque_nm", "voltage_v", "frequency_hz"];
+
+/// Points per chunk of a map. A map is cut into chunks of this many points, in index
+/// order, and each chunk is solved by [`solve_range`]: the first point cold, every other
+/// one warm-started from its predecessors. The boundaries depend on nothing else, so a
+/// map is the same number for number whatever the thread count or the front end. Large
+/// enough that warm starts pay off and scheduling is cheap, small enough that a few
+/// chunks per thread stay a few megabytes.
+pub const CHUNK_POINTS: u64 = 4096;
+
+/// The values of `op` on the grid's axes, in [`AXES`] order.
+pub fn axis_values(op: &OperatingPoint) -> [f64; 4] {
+    [op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz]
+}
+
+/// Number of chunks of `chunk` points (≥ 1) that hold `len` points.
+pub fn chunk_count(len: u64, chunk: u64) -> u64 {
+    len.div_ceil(chunk.max(1))
+}
+
+/// The point indices of chunk `c` of `len` points cut into chunks of `chunk` (≥ 1); the
+/// last chunk may be shorter.
+pub fn chunk_range(len: u64, chunk: u64, c: u64) -> std::ops::Range<u64> {
+    let chunk = chunk.max(1);
+    (c * chunk).min(len)..((c + 1) * chunk).min(len)
+}
 
 /// One axis: `n` points from `start` to `stop` inclusive (n = 1: just `start`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,7 +84,9 @@ pub struct Grid {
 
 impl Grid {
     /// Checks the axes: at least one point each, finite values, and the operating-point
-    /// ranges (preload, voltage, frequency > 0; torque ≥ 0). Errors name the axis.
+    /// ranges (preload, voltage, frequency > 0; torque ≥ 0), so that every point of the
+    /// grid is a valid operating point. Errors name the axis and the value, e.g.
+    /// `preload_n: 0 must be > 0`.
     pub fn validate(&self) -> Result<(), TrumError> {
         for (name, ax) in AXES.iter().zip(self.axes()) {
             if ax.n == 0 {
@@ -78,8 +109,9 @@ impl Grid {
         Ok(())
     }
 
-    fn axes(&self) -> [Axis; 4] {
-        [self.preload_n, self.voltage_v, self.frequency_hz, self.torque_nm]
+    /// The axes in [`AXES`] order.
+    pub fn axes(&self) -> [Axis; 4] {
+        [self.preload_n, self.torque_nm, self.voltage_v, self.frequency_hz]
     }
 
     fn len_checked(&self) -> Option<u64> {
@@ -96,7 +128,9 @@ impl Grid {
         self.len() == 0
     }
 
-    /// The operating point with flat index `i` (torque fastest, preload slowest).
+    /// The operating point with flat index `i`: torque varies fastest, then frequency,
+    /// then voltage, and preload slowest (so the points along a torque line are
+    /// neighbours, which is where warm starts pay off).
     pub fn point(&self, i: u64) -> OperatingPoint {
         let nt = self.torque_nm.n as u64;
         let nf = self.frequency_hz.n as u64;
@@ -157,7 +191,7 @@ mod tests {
         // The presets, and trum60a with a softening stator (several amplitude branches; no
         // warm amplitude there, see solve::solve_in_sweep).
         let motors = ["trum60a", "trum60-qut", "generic60", "trum60a+hertz_softening"].map(|name| {
-            let mut m = crate::presets::preset(name.split('+').next().unwrap()).expect("preset");
+            let mut m = crate::presets::preset(name.split('+').next().unwrap_or(name)).expect("preset");
             if name.ends_with("softening") {
                 let e = crate::effects::Effect::HertzSoftening;
                 let strong: Vec<f64> = e.info().params.iter().map(|p| 3.0 * p.typical).collect();
@@ -197,16 +231,14 @@ mod tests {
         }
         assert!([Status::Ok, Status::Stall, Status::Clamped].iter().all(|s| seen.contains(s)), "{seen:?}");
         // the torque-ordered warm start is taken (solve::solve_in_sweep): fewer amplitude
-        // evaluations than cold, not the same answer by never leaving the cold path; with
-        // the extrapolated amplitude and Newton steps on the trials' exact slopes 0.604 of
-        // the cold count on these coarse grids (0.641 with extrapolated slopes, 0.674 from
-        // the bound alone)
+        // evaluations than cold, not the same answer by never leaving the cold path (0.604
+        // of the cold count on these coarse grids)
         assert!(warm_evals * 100 < cold_evals * 62, "sweep {warm_evals} vs cold {cold_evals} amplitude evaluations");
     }
 
-    /// Review cases (stop 14) where the cold descent of a softening or stiffening stator
-    /// lands on another branch than the largest: a sweep must still give the cold answer
-    /// (no warm amplitude there), whatever the chunks.
+    /// Stators (softening or stiffening) whose cold descent lands on another branch than
+    /// the largest: a sweep must still give the cold answer (no warm amplitude there),
+    /// whatever the chunks.
     #[test]
     fn sweeps_of_multi_branch_stators_give_the_cold_answer_in_any_chunks() {
         use crate::effects::Effect;
@@ -259,6 +291,43 @@ mod tests {
         assert!(g.validate().is_ok());
         let mut bad = g;
         bad.preload_n.start = 0.0;
-        assert!(bad.validate().unwrap_err().to_string().contains("preload_n: 0 must be > 0"));
+        assert!(bad.validate().expect_err("an invalid grid").to_string().contains("preload_n: 0 must be > 0"));
+        let mut bad = g;
+        bad.torque_nm.stop = -0.1;
+        assert!(bad.validate().expect_err("an invalid grid").to_string().contains("torque_nm: -0.1 must be >= 0"));
+        let mut bad = g;
+        bad.voltage_v.n = 0;
+        assert!(bad
+            .validate()
+            .expect_err("an invalid grid")
+            .to_string()
+            .contains("voltage_v: an axis needs at least one point"));
+        let mut bad = g;
+        bad.frequency_hz.stop = f64::INFINITY;
+        assert!(bad
+            .validate()
+            .expect_err("an invalid grid")
+            .to_string()
+            .contains("frequency_hz: inf is not a finite number"));
+        // the axes, their values and the names come in one order
+        let op = g.point(7);
+        assert_eq!(axis_values(&op), [op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz]);
+        assert_eq!(g.axes()[1], g.torque_nm);
+        assert_eq!(AXES[1], "torque_nm");
+    }
+
+    #[test]
+    fn chunks_cover_every_point_once_in_order() {
+        for (len, chunk) in [(0u64, 4096u64), (1, 4096), (4096, 4096), (4097, 4096), (10, 3), (9, 3), (5, 1)] {
+            let n = chunk_count(len, chunk);
+            let mut next = 0;
+            for c in 0..n {
+                let r = chunk_range(len, chunk, c);
+                assert_eq!(r.start, next, "len {len} chunk {chunk}");
+                assert!(!r.is_empty() && r.end - r.start <= chunk, "len {len} chunk {chunk}: {r:?}");
+                next = r.end;
+            }
+            assert_eq!(next, len, "len {len} chunk {chunk}");
+        }
     }
 }

@@ -1,5 +1,6 @@
-//! `trum.diagnose`: the sim-to-real diagnosis over a measurement CSV (shared/spec/), the
-//! same document `trum diagnose --json` writes (built by trum_core::diagnose::json).
+//! `trum.diagnose`: the sim-to-real diagnosis over a measurement CSV (docs/MEASUREMENTS.md),
+//! the same document `trum diagnose --json` writes (docs/DIAGNOSIS_JSON.md; built by
+//! trum_core::diagnose::json).
 
 use crate::{detached, input_err, PyMotor};
 use pyo3::prelude::*;

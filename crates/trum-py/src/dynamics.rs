@@ -1,5 +1,6 @@
 //! Nonlinear and transient dynamics for Python: the Hertzian oscillator's response curves
-//! and β identification (seed 003), and the stick-slip step response (seed 004). The
+//! and β identification ([Hertz2022]), and the stick-slip step response ([BarTransient];
+//! keys of docs/REFERENCES.md). The
 //! numbers are trum-core's; the work runs with the GIL released.
 
 use crate::{detached, input_err, raise, PyMotor};
@@ -10,6 +11,7 @@ use trum_core::dynamics::hertz::{
     identify_beta, BetaIdentificationInput, HertzError, HertzOscillator, OperatingPoint, ResponseMethod,
 };
 use trum_core::dynamics::transient::{steady_comparison, step_response, TransientConfig, TransientError};
+use trum_core::layout::{response_rows, response_status, response_summary, ResponseRow, RESPONSE_COLUMNS};
 
 /// The oscillator: defaults with `params` (name, value) applied; a bad name or value is a
 /// `ParameterError` naming the key.
@@ -52,7 +54,8 @@ pub fn hertz_defaults() -> Vec<(&'static str, f64)> {
 /// each curve is a dict with the operating point, `status`, `reason`, the branch points
 /// (`frequency_hz`, `amplitude_m`, `phase_lag_rad`, `stable`, `branch`), the backbone,
 /// the saddle nodes (`None` when single valued), `linear_resonance_hz` and the
-/// equivalent β.
+/// equivalent β; and `table`, the response table of `trum resonance -o` as columns
+/// (`trum_core::layout::response_rows`, column order in `columns`).
 #[pyfunction]
 #[pyo3(signature = (params, voltage_v, preload_n, frequency_hz = None, method_name = "multiple_scales"))]
 pub fn hertz_response<'py>(
@@ -91,13 +94,8 @@ pub fn hertz_response<'py>(
         let d = PyDict::new(py);
         d.set_item("voltage_v", c.operating_point.voltage_v)?;
         d.set_item("preload_n", c.operating_point.preload_n)?;
-        let (status, reason) = match &c.response {
-            Ok(_) => ("ok", String::new()),
-            Err(e @ HertzError::NoStaticEquilibrium { .. }) => ("no_static_equilibrium", e.to_string()),
-            Err(e) => ("invalid_input", e.to_string()),
-        };
-        d.set_item("status", status)?;
-        d.set_item("reason", reason)?;
+        d.set_item("status", response_status(c))?;
+        d.set_item("reason", c.response.as_ref().err().map(ToString::to_string).unwrap_or_default())?;
         let empty = Vec::new();
         let pts = c.response.as_ref().map_or(&empty, |r| &r.points);
         let col = |f: fn(&trum_core::dynamics::hertz::ResponsePoint) -> f64| pts.iter().map(f).collect::<Vec<f64>>();
@@ -117,16 +115,35 @@ pub fn hertz_response<'py>(
         d.set_item("jump_down_hz", jumps.map(|j| j.jump_down_hz))?;
         d.set_item("jump_down_amplitude_m", jumps.map(|j| j.jump_down_amplitude_m))?;
         d.set_item("equivalent_beta_n_per_m3", r.map(|r| r.equivalent_beta_n_per_m3))?;
-        d.set_item("linear_resonance_hz", c.backbone.first().map(|b| b.frequency_hz))?;
+        let lin = response_summary(c).linear_resonance_hz;
+        d.set_item("linear_resonance_hz", lin.is_finite().then_some(lin))?;
         curves.push(d);
     }
+    // the table `trum resonance -o` writes, as columns
+    let rows = response_rows(&family);
+    let table = PyDict::new(py);
+    let num = |f: fn(&ResponseRow) -> f64| PyArray::from_vec(py, rows.iter().map(f).collect::<Vec<f64>>());
+    for (name, f) in [
+        ("voltage_v", (|r| r.voltage_v) as fn(&ResponseRow) -> f64),
+        ("preload_n", |r| r.preload_n),
+        ("frequency_hz", |r| r.frequency_hz),
+        ("amplitude_m", |r| r.amplitude_m),
+        ("phase_lag_rad", |r| r.phase_lag_rad),
+    ] {
+        table.set_item(name, num(f))?;
+    }
+    table.set_item("branch", rows.iter().map(|r| r.branch).collect::<Vec<&str>>())?;
+    table.set_item("status", rows.iter().map(|r| r.status).collect::<Vec<&str>>())?;
+    table.set_item("stable", rows.iter().map(|r| r.stable).collect::<Vec<Option<bool>>>())?;
     let out = PyDict::new(py);
     out.set_item("frequency_hz", PyArray::from_vec(py, freqs))?;
     out.set_item("curves", curves)?;
+    out.set_item("columns", RESPONSE_COLUMNS.to_vec())?;
+    out.set_item("table", table)?;
     Ok(out)
 }
 
-/// β by harmonic balance from a sampled waveform (seed 003 eq. 5-9). `signal` is the
+/// β by harmonic balance from a sampled waveform ([Hertz2022] eq. 5-9, docs/REFERENCES.md). `signal` is the
 /// feedback voltage [V] with `feedback_gain_v_per_m`, else the displacement [m]. The drive
 /// force is `drive_force_n`, or A·V + k_c·N from `voltage_v` and `preload_n`.
 #[pyfunction]
@@ -204,7 +221,7 @@ fn argument(name: &str) -> &str {
     }
 }
 
-/// Step response of the rotor speed (seed 004). Returns a dict: `series` (arrays),
+/// Step response of the rotor speed ([BarTransient], docs/REFERENCES.md). Returns a dict: `series` (arrays),
 /// `metrics` (`None` where undefined), `status`, `averages`, `steady` (the steady solver
 /// at the same point), `snapshots` (per-node arrays and states), `time_step_s`, `steps`.
 #[pyfunction]

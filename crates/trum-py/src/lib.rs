@@ -15,6 +15,7 @@ use pyo3::types::{PyDict, PyTuple};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use trum_core::criterion::{self as core_criterion, CriterionConfig};
 use trum_core::effects::EFFECTS;
+use trum_core::layout::STATUS_NAMES;
 use trum_core::quantities::QUANTITIES;
 use trum_core::sweep::{Axis, Grid, AXES};
 use trum_core::{presets, Motor, ParamError, TrumError};
@@ -358,27 +359,29 @@ fn axis(py: Python<'_>, name: &str, spec: (f64, f64, i64)) -> PyResult<Axis> {
     Ok(Axis::linspace(a, b, n as usize))
 }
 
-/// Full-factorial map over preload × voltage × frequency × torque (torque fastest).
-/// Each axis is `(start, stop, n)`. Returns a dict of flat columns: the four inputs,
-/// every quantity, `status_code` and `reasons`.
+/// Full-factorial map over the grid axes `AXES` (preload, torque, voltage, frequency;
+/// points run torque fastest, then frequency, voltage, preload), solved as `trum map`
+/// solves it. Each axis is `(start, stop, n)`; the grid is checked as the CLI checks it.
+/// Returns a dict of flat columns: the four inputs, every quantity, `status_code` and
+/// `reasons`.
 #[pyfunction]
-#[pyo3(signature = (motor, preload_n, voltage_v, frequency_hz, torque_nm, max_points = 20_000_000, parallel = None))]
+#[pyo3(signature = (motor, preload_n, torque_nm, voltage_v, frequency_hz, max_points = 20_000_000, parallel = None))]
 #[allow(clippy::too_many_arguments)]
 fn map_grid<'py>(
     py: Python<'py>,
     motor: &Bound<'py, PyMotor>,
     preload_n: (f64, f64, i64),
+    torque_nm: (f64, f64, i64),
     voltage_v: (f64, f64, i64),
     frequency_hz: (f64, f64, i64),
-    torque_nm: (f64, f64, i64),
     max_points: u64,
     parallel: Option<bool>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let grid = Grid {
         preload_n: axis(py, "preload_n", preload_n)?,
+        torque_nm: axis(py, "torque_nm", torque_nm)?,
         voltage_v: axis(py, "voltage_v", voltage_v)?,
         frequency_hz: axis(py, "frequency_hz", frequency_hz)?,
-        torque_nm: axis(py, "torque_nm", torque_nm)?,
     };
     grid.validate().map_err(|e| trum_err(py, e))?;
     let len = grid.len();
@@ -412,7 +415,7 @@ fn map_grid<'py>(
     Ok(d)
 }
 
-/// The preload criterion (seed 000 section 5). Unset settings take the core's defaults
+/// The preload criterion (Chen et al. 2020, section 5). Unset settings take the core's defaults
 /// (`CriterionConfig::seed000`). Returns a dict: `table` (columns), `optimum_preload_n`,
 /// `region_n`.
 #[pyfunction]
@@ -543,7 +546,7 @@ fn _trum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dynamics::hertz_identify, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::step, m)?)?;
     m.add_function(wrap_pyfunction!(diagnosis::diagnose_csv, m)?)?;
-    m.add("STATUS_NAMES", vector::STATUS_NAMES.to_vec())?;
+    m.add("STATUS_NAMES", STATUS_NAMES.to_vec())?;
     m.add("INPUTS", vector::INPUTS.to_vec())?;
     m.add("AXES", AXES.to_vec())?;
     m.add("PARALLEL_MIN_POINTS", vector::PARALLEL_MIN_POINTS)?;

@@ -1,36 +1,23 @@
 //! Vectorised solving without Python types: broadcasting of the five input columns,
 //! chunked (optionally rayon-parallel) solves into column buffers, full-factorial maps.
-//! Every point is solved independently of the chunking, so results are bitwise the same
-//! serial, parallel, or split over processes.
+//! Results do not depend on the thread count: a vectorised solve solves every point from a
+//! cold start, and a map uses the core's fixed chunks (as `trum map` does).
 
 use rayon::prelude::*;
+use trum_core::layout::{status_code, status_meaning, status_of_code};
 use trum_core::quantities::{values, QUANTITIES};
 use trum_core::solve::{solve_prepared, OperatingPoint, Prepared};
-use trum_core::sweep::{solve_range, Grid};
+use trum_core::sweep::{axis_values, chunk_range, solve_range, Grid, AXES, CHUNK_POINTS};
 use trum_core::{Motor, Solution, Status};
-
-/// Status words in code order (`status_code` indexes this).
-pub const STATUS_NAMES: [&str; 5] = ["ok", "stall", "clamped", "no_convergence", "invalid_input"];
 
 /// Inputs with at least this many points are solved in parallel by default.
 pub const PARALLEL_MIN_POINTS: usize = 4096;
 
-/// Points per work item.
+/// Points per work item of a vectorised solve (cold points: any size gives the same bits).
 const CHUNK: usize = 1024;
 
-/// Input names in the order of [`solve_points`]'s columns.
-pub const INPUTS: [&str; 5] = ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "elapsed_s"];
-
-/// Code of a status in [`STATUS_NAMES`].
-pub fn status_code(s: Status) -> u8 {
-    match s {
-        Status::Ok => 0,
-        Status::Stall => 1,
-        Status::Clamped => 2,
-        Status::NoConvergence => 3,
-        Status::InvalidInput => 4,
-    }
-}
+/// Input names in the order of [`solve_points`]'s columns: the grid axes, then the time.
+pub const INPUTS: [&str; 5] = [AXES[0], AXES[1], AXES[2], AXES[3], "elapsed_s"];
 
 /// One broadcast input column: a scalar, a borrowed contiguous buffer (zero-copy) or a
 /// gathered copy of a strided view.
@@ -80,11 +67,12 @@ pub fn broadcast_shape(names: &[&str], shapes: &[&[usize]]) -> Result<Vec<usize>
     Ok(out)
 }
 
-/// Output columns of a vectorised solve, in [`QUANTITIES`] order, plus status codes.
+/// Output columns of a vectorised solve, in [`QUANTITIES`] order, plus status codes
+/// (`trum_core::layout::status_code`).
 pub struct Columns {
     /// One column per quantity (NaN where the status is not valid).
     pub values: Vec<Vec<f64>>,
-    /// Status codes (see [`STATUS_NAMES`]).
+    /// Status codes (`trum_core::layout::STATUS_NAMES` indexed by code).
     pub status: Vec<u8>,
 }
 
@@ -172,14 +160,17 @@ pub fn solve_points(motor: &Motor, cols: &[Column<'_>; 5], n: usize, parallel: b
 
 /// Whether a status code is of a solved point (ok, stall, clamped): one without a reason.
 pub fn is_valid_code(status: u8) -> bool {
-    status < 3
+    status_of_code(status).is_some_and(Status::is_valid)
 }
 
-/// Why the point `i` of a solve is not valid (`None` when it is).
+/// Why a point with status code `status` is not valid (`None` when it is): the operating
+/// point's own reason for an invalid input, the status's meaning otherwise.
 pub fn reason(status: u8, op: &OperatingPoint) -> Option<String> {
-    match status {
-        3 => Some("no steady state found: the iteration did not converge, or the motor hunts between states".into()),
-        4 => Some(op.invalid_reason().unwrap_or_else(|| "invalid operating point".into())),
+    match status_of_code(status)? {
+        Status::InvalidInput => {
+            Some(op.invalid_reason().unwrap_or_else(|| status_meaning(Status::InvalidInput).into()))
+        }
+        s if !s.is_valid() => Some(status_meaning(s).into()),
         _ => None,
     }
 }
@@ -203,22 +194,17 @@ pub fn reasons(cols: &[Column<'_>; 5], status: &[u8]) -> Vec<(usize, String)> {
         .collect()
 }
 
-/// Solves a validated grid. Rows along the torque axis (the fastest) are warm-started
-/// from their previous point like the core's sweeps; each row starts cold, so the result
-/// does not depend on the chunking.
+/// Solves a validated grid of `n` points in the core's chunks
+/// ([`trum_core::sweep::CHUNK_POINTS`]), each warm-started point after point
+/// ([`solve_range`]) exactly as `trum map` solves it, so the two give the same numbers.
 pub fn solve_grid(motor: &Motor, grid: &Grid, n: usize, parallel: bool) -> Option<Columns> {
     let p = Prepared::new(motor);
-    let row = grid.torque_nm.n.max(1);
-    let rows_per_chunk = (CHUNK / row).max(1);
+    let chunk = usize::try_from(CHUNK_POINTS).unwrap_or(usize::MAX);
     let mut out = Columns::try_new(n)?;
-    run(out.chunks(rows_per_chunk * row), parallel, |c| {
-        let (start, end) = (c.start, c.start + c.status.len());
-        let mut r0 = start;
-        while r0 < end {
-            let r1 = (r0 + row).min(end);
-            solve_range(motor, &p, grid, r0 as u64..r1 as u64, |i, _, s| c.write(i as usize - start, s));
-            r0 = r1;
-        }
+    run(out.chunks(chunk), parallel, |c| {
+        let start = c.start;
+        let range = chunk_range(n as u64, CHUNK_POINTS, (start / chunk) as u64);
+        solve_range(motor, &p, grid, range, |i, _, s| c.write(i as usize - start, s));
     });
     Some(out)
 }
@@ -227,8 +213,7 @@ pub fn solve_grid(motor: &Motor, grid: &Grid, n: usize, parallel: bool) -> Optio
 pub fn grid_inputs(grid: &Grid, n: usize) -> [Vec<f64>; 4] {
     let mut cols: [Vec<f64>; 4] = std::array::from_fn(|_| Vec::with_capacity(n));
     for i in 0..n as u64 {
-        let op = grid.point(i);
-        for (c, v) in cols.iter_mut().zip([op.preload_n, op.voltage_v, op.frequency_hz, op.torque_nm]) {
+        for (c, v) in cols.iter_mut().zip(axis_values(&grid.point(i))) {
             c.push(v);
         }
     }
@@ -268,5 +253,55 @@ mod tests {
         }
         let s = trum_core::solve(&m, &OperatingPoint::new(pre[7], 0.1, 200.0, 43e3));
         assert_eq!(a.values[0][7].to_bits(), s.speed_rpm.to_bits());
+    }
+
+    #[test]
+    fn a_map_is_the_cores_chunked_sweep_in_any_parallelism() {
+        use trum_core::sweep::{chunk_count, Axis};
+        let m = trum_core::presets::preset("trum60a").unwrap();
+        // more than one chunk, and rows (17 torques) that do not divide the chunk size
+        let g = Grid {
+            preload_n: Axis::linspace(100.0, 500.0, 250),
+            torque_nm: Axis::linspace(0.0, 1.2, 17),
+            voltage_v: Axis::fixed(200.0),
+            frequency_hz: Axis::fixed(43e3),
+        };
+        let n = g.len() as usize;
+        assert!(chunk_count(g.len(), CHUNK_POINTS) > 1);
+        let serial = solve_grid(&m, &g, n, false).unwrap();
+        let parallel = solve_grid(&m, &g, n, true).unwrap();
+        assert_eq!(serial.status, parallel.status);
+        // the core's sweep of the same chunks, as trum map runs it
+        let p = Prepared::new(&m);
+        let speed = QUANTITIES.iter().position(|q| q.name == "speed_rpm").unwrap();
+        for c in 0..chunk_count(g.len(), CHUNK_POINTS) {
+            solve_range(&m, &p, &g, chunk_range(g.len(), CHUNK_POINTS, c), |i, _, s| {
+                let i = i as usize;
+                assert_eq!(serial.status[i], status_code(s.status), "point {i}");
+                let want = if s.status.is_valid() { s.speed_rpm } else { f64::NAN };
+                assert_eq!(serial.values[speed][i].to_bits(), want.to_bits(), "point {i}");
+                assert_eq!(parallel.values[speed][i].to_bits(), want.to_bits(), "point {i}");
+            });
+        }
+        // and within the solver's tolerance of cold solves
+        for i in (0..n).step_by(97) {
+            let c = trum_core::solve(&m, &g.point(i as u64));
+            assert_eq!(serial.status[i], status_code(c.status), "point {i}");
+            let (a, b) = (serial.values[speed][i], c.speed_rpm);
+            assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-9), "point {i}: {a} vs {b}");
+        }
+        let inputs = grid_inputs(&g, n);
+        assert_eq!(inputs[1][18], g.point(18).torque_nm);
+        assert_eq!(inputs[0][18], g.point(18).preload_n);
+    }
+
+    #[test]
+    fn every_status_code_has_its_reason_or_none() {
+        let op = OperatingPoint::new(-5.0, 0.0, 200.0, 43e3);
+        assert_eq!(reason(status_code(Status::Ok), &op), None);
+        assert_eq!(reason(status_code(Status::Clamped), &op), None);
+        assert_eq!(reason(status_code(Status::InvalidInput), &op).as_deref(), Some("preload_n = -5 must be > 0"));
+        assert!(reason(status_code(Status::NoConvergence), &op).unwrap().starts_with("no steady state found"));
+        assert!(is_valid_code(2) && !is_valid_code(3) && !is_valid_code(200));
     }
 }

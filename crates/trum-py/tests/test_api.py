@@ -1,5 +1,10 @@
 """Motor construction, errors, pickling, registries, map and optimize."""
+import csv
+import io
+import os
 import pickle
+import shutil
+import subprocess
 
 import numpy as np
 import pytest
@@ -105,7 +110,7 @@ def test_registries():
     ps = fx["preload_stiffening"].params
     assert [(p.name, p.shape) for p in ps] == [("stiffness_scale", False), ("modal_fraction", True)]
     assert (ps[1].typical, ps[1].min, ps[1].max) == (0.0, 0.0, 1.0)
-    # NAME=STRENGTH keeps seed 001 eq. 8 (fraction 0) bit for bit; the modal projection differs
+    # NAME=STRENGTH keeps Sun et al. 2021 eq. 8 (fraction 0) bit for bit; the modal projection differs
     speed = lambda spec: trum.Motor("trum60a").with_effects(spec).solve(
         preload_n=400.0, voltage_v=200.0, frequency_hz=43e3
     ).speed_rpm.tolist()
@@ -121,13 +126,13 @@ def test_registries():
 
 def test_map_columns_and_values(motor):
     d = trum.map(motor, preload_n=(150, 300, 4), voltage_v=200, frequency_hz=43e3, torque_nm=(0.0, 0.3, 7))
-    assert list(d)[:5] == ["preload_n", "voltage_v", "frequency_hz", "torque_nm", "status"]
+    assert list(d)[:5] == ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status"]
     assert list(d)[5:] == list(trum.QUANTITY_NAMES)
     assert all(len(v) == 28 for v in d.values())
     assert d["torque_nm"][:7].tolist() == pytest.approx(np.linspace(0, 0.3, 7).tolist())
     res = motor.solve(preload_n=d["preload_n"], torque_nm=d["torque_nm"], voltage_v=200, frequency_hz=43e3)
     assert d["status"].tolist() == res.status.tolist()
-    # warm starts along torque rows: equal to the cold solve within the solver tolerance
+    # warm starts from point to point: equal to the cold solve within the solver tolerance
     np.testing.assert_allclose(d["speed_rpm"], res.speed_rpm, rtol=1e-8, atol=1e-9)
     par = trum.map(motor, preload_n=(150, 300, 4), voltage_v=200, frequency_hz=43e3, torque_nm=(0.0, 0.3, 7), parallel=True)
     for k in trum.QUANTITY_NAMES:
@@ -136,9 +141,30 @@ def test_map_columns_and_values(motor):
     assert pd.DataFrame(d).shape == (28, 5 + len(trum.QUANTITY_NAMES))
 
 
+@pytest.mark.skipif(not os.environ.get("TRUM_BIN"), reason="set TRUM_BIN to a trum CLI binary to compare with it")
+def test_map_is_the_clis_map_bit_for_bit(motor):
+    # 3 × 2 × 700 = 4200 points: two of the core's chunks, the second starting mid-row
+    cli = shutil.which(os.environ["TRUM_BIN"]) or os.environ["TRUM_BIN"]
+    out = subprocess.run([cli, "map", "--motor", "trum60a", "--preload-n", "100:400:3", "--voltage-v", "180:220:2",
+                          "--torque-nm", "0:1.4:700", "--columns", "speed_rpm,efficiency,amplitude_m", "-o", "-"],
+                         check=True, capture_output=True, text=True).stdout
+    rows = list(csv.DictReader(io.StringIO(out)))
+    d = trum.map(motor, preload_n=(100, 400, 3), voltage_v=(180, 220, 2), frequency_hz=43e3, torque_nm=(0, 1.4, 700))
+    assert len(rows) == d["speed_rpm"].size == 4200
+    for i, row in enumerate(rows):
+        assert row["status"] == d["status"][i], i
+        for col in ("preload_n", "torque_nm", "voltage_v", "speed_rpm", "efficiency", "amplitude_m"):
+            # shortest round-trip CSV numbers: equal bit for bit; empty cells are NaN here
+            want = d[col][i]
+            assert (row[col] == "" and np.isnan(want)) or float(row[col]) == want, (i, col)
+
+
 def test_map_errors(motor):
     with pytest.raises(trum.InputError, match=r"^preload_n: 0 must be > 0$"):
         trum.map(motor, preload_n=(0, 100, 3), voltage_v=200, frequency_hz=43e3)
+    # the same words as `trum map` for a negative torque
+    with pytest.raises(trum.InputError, match=r"^torque_nm: -0.5 must be >= 0$"):
+        trum.map(motor, preload_n=100, voltage_v=200, frequency_hz=43e3, torque_nm=(-0.5, 0.5, 3))
     with pytest.raises(trum.InputError, match="must be a positive whole number"):
         trum.map(motor, preload_n=(100, 200, 2.5), voltage_v=200, frequency_hz=43e3)
     with pytest.raises(trum.InputError, match="at least one point"):

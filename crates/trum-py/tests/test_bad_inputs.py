@@ -78,9 +78,8 @@ def test_sweep_table_values_are_not_checked_by_the_python_reader(path):
 
 @pytest.mark.parametrize("path", NOT_UTF8, ids=lambda p: p.name)
 def test_non_utf8_motor_file_raises_trum_error(path):
-    # KNOWN BUG (docs/RELIABILITY.md): Motor.from_toml opens the file with
-    # encoding="utf-8" and lets UnicodeDecodeError escape; it must raise a TrumError that
-    # names the file, like the CLI ("cannot read motor file ...: ... UTF-8").
+    # A motor file that is not UTF-8 raises a TrumError that names the file, like the CLI
+    # ("cannot read motor file ...: ... UTF-8"), not Python's UnicodeDecodeError.
     with pytest.raises(trum.TrumError) as info:
         trum.Motor.from_toml(path)
     assert str(path) in str(info.value)

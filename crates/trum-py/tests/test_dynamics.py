@@ -24,7 +24,7 @@ def test_resonance_branches_jumps_and_trends():
     assert set(c.branch[inside]) == {"lower", "middle", "upper"}
     assert set(c.branch[~inside]) == {"single"}
     assert not c.stable[c.branch == "middle"].any() and c.stable[c.branch != "middle"].all()
-    # softening (seed 003 Fig. 11): jump-up above jump-down, backbone bends down
+    # softening ([Hertz2022] Fig. 11): jump-up above jump-down, backbone bends down
     assert c.jump_up_hz > c.jump_down_hz + 100
     assert np.all(np.diff(c.backbone_frequency_hz) < 0) and c.backbone_amplitude_m[0] == 0.0
     assert c.backbone_frequency_hz[0] == c.linear_resonance_hz

@@ -47,19 +47,22 @@ def map(  # noqa: A001 - the CLI's name for it
     max_points: int = 20_000_000,
     parallel: Optional[bool] = None,
 ) -> Dict[str, np.ndarray]:
-    """A full-factorial map over preload × voltage × frequency × torque (torque varies
-    fastest). Each axis is a value or ``(start, stop, n)``; returns flat columns
-    ``{preload_n, voltage_v, frequency_hz, torque_nm, status, <quantities>}`` ready for
-    ``pandas.DataFrame``. Points along each torque row are warm-started from their
-    neighbour like the core's sweeps (equal to ``Motor.solve`` within the solver
-    tolerance); rows start cold, so the result does not depend on threads or chunking.
+    """A full-factorial map over preload × torque × voltage × frequency, as ``trum map``
+    computes it. Each axis is a value or ``(start, stop, n)``; every point must be a valid
+    operating point (preload, voltage, frequency > 0, torque >= 0), else ``InputError``
+    names the axis. Returns flat columns ``{preload_n, torque_nm, voltage_v, frequency_hz,
+    status, <quantities>}`` ready for
+    ``pandas.DataFrame``; points run torque fastest, then frequency, voltage, preload.
+    Points are warm-started from their predecessors in the same fixed chunks as
+    ``trum map``, so the numbers are the CLI's, equal to ``Motor.solve`` within the solver
+    tolerance, and do not depend on threads.
     """
     d = _trum.map_grid(
         _motor(motor),
-        _axis("preload_n", preload_n),
-        _axis("voltage_v", voltage_v),
-        _axis("frequency_hz", frequency_hz),
-        _axis("torque_nm", torque_nm),
+        preload_n=_axis("preload_n", preload_n),
+        torque_nm=_axis("torque_nm", torque_nm),
+        voltage_v=_axis("voltage_v", voltage_v),
+        frequency_hz=_axis("frequency_hz", frequency_hz),
         max_points=int(max_points),
         parallel=parallel,
     )
@@ -96,7 +99,7 @@ def optimize(
     region_tolerance: Optional[float] = None,
     torque_samples: Optional[int] = None,
 ) -> Optimum:
-    """The preload optimisation criterion of seed 000 section 5 (as ``trum optimize``).
+    """The preload optimisation criterion of Chen et al. 2020, section 5 (as ``trum optimize``).
 
     For each candidate preload: stall torque, maximum efficiency over load torque,
     temperature rise after ``run_time_s`` and the speed fluctuation from ``runout_m``;

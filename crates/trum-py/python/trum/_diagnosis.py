@@ -1,4 +1,4 @@
-"""The sim-to-real diagnosis (shared/spec/diagnose.md) from Python."""
+"""The sim-to-real diagnosis from Python (the document: docs/DIAGNOSIS_JSON.md)."""
 from __future__ import annotations
 
 import json
@@ -22,10 +22,10 @@ def diagnose(
     causes it, and how far the held-out gap shrinks once it is added.
 
     ``motor`` is the nominal motor (a ``trum.Motor`` or a preset name); ``data`` a
-    measurement CSV in the layout of shared/spec/measurements.md, as a path or as the
+    measurement CSV in the layout of docs/MEASUREMENTS.md, as a path or as the
     file's bytes. Returns the JSON document of ``trum diagnose --json`` as a dict
-    (``verdict``, ``confounded_with``, ``partial``, ``gap``, ``ranking``, ``notes``, ...; method and
-    scales in docs/DIAGNOSIS.md). Columns the reader ignores are reported with
+    (``verdict``, ``confounded_with``, ``partial``, ``gap``, ``ranking``, ``notes``, ...;
+    every field in docs/DIAGNOSIS_JSON.md, the method in docs/DIAGNOSIS.md). Columns the reader ignores are reported with
     ``warnings.warn``. A bad file, or data that cannot support a held-out test, raises
     ``trum.InputError`` naming the file, line and column. The GIL is released while it runs.
     """

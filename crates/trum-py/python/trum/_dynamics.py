@@ -1,11 +1,12 @@
-"""Nonlinear resonance of the Hertzian oscillator and β identification (seed 003), and the
-stick-slip step response (seed 004): ``trum.resonance``, ``trum.identify_hertz``,
-``trum.step`` (the CLI's ``trum resonance``, ``trum identify-hertz``, ``trum step``)."""
+"""Nonlinear resonance of the Hertzian oscillator and β identification ([Hertz2022]), and
+the stick-slip step response ([BarTransient]; keys of docs/REFERENCES.md):
+``trum.resonance``, ``trum.identify_hertz``, ``trum.step`` (the CLI's ``trum resonance``,
+``trum identify-hertz``, ``trum step``)."""
 from __future__ import annotations
 
 import numbers
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -85,38 +86,25 @@ class Resonance:
 
     frequency_hz: np.ndarray
     curves: List[ResonanceCurve]
+    #: The response table as the core lays it out, column by column (see ``to_dict``).
+    table: Dict[str, Any] = field(default_factory=dict, repr=False)
+    #: Its column order.
+    columns: Tuple[str, ...] = ()
 
     def to_dict(self) -> Dict[str, np.ndarray]:
-        """Flat columns laid out like the CLI's CSV: ``voltage_v, preload_n, frequency_hz,
-        branch, status, amplitude_m, phase_lag_rad, stable``; branch rows, then the
-        ``backbone`` rows, then ``jump_up``/``jump_down``; a curve without a response is
-        one row with its status and NaN numbers."""
-        cols: Dict[str, list] = {k: [] for k in
-                                 ("voltage_v", "preload_n", "frequency_hz", "branch", "status",
-                                  "amplitude_m", "phase_lag_rad", "stable")}
-
-        def add(c: ResonanceCurve, f, branch, status, a, ph, st) -> None:
-            for k, v in zip(cols, (c.voltage_v, c.preload_n, f, branch, status, a, ph, st)):
-                cols[k].append(v)
-
-        nan = float("nan")
-        for c in self.curves:
-            if c.status != "ok":
-                add(c, nan, "", c.status, nan, nan, None)
-                continue
-            for i in range(c.frequency_hz.size):
-                add(c, c.frequency_hz[i], c.branch[i], "ok", c.amplitude_m[i], c.phase_lag_rad[i], bool(c.stable[i]))
-            for f, a in zip(c.backbone_frequency_hz, c.backbone_amplitude_m):
-                add(c, f, "backbone", "ok", a, nan, None)
-            if c.jump_up_hz is not None:
-                add(c, c.jump_up_hz, "jump_up", "ok", c.jump_up_amplitude_m, nan, False)
-                add(c, c.jump_down_hz, "jump_down", "ok", c.jump_down_amplitude_m, nan, False)
-        out = {k: np.array(v, dtype=np.float64) for k, v in cols.items()
-               if k in ("voltage_v", "preload_n", "frequency_hz", "amplitude_m", "phase_lag_rad")}
-        out["branch"] = np.array(cols["branch"], dtype=object)
-        out["status"] = np.array(cols["status"], dtype=object)
-        out["stable"] = np.array(cols["stable"], dtype=object)
-        return out
+        """Flat columns laid out like the CLI's CSV (``trum resonance -o``, one table for
+        both): ``voltage_v, preload_n, frequency_hz, branch, status, amplitude_m,
+        phase_lag_rad, stable``; branch rows, then the ``backbone`` rows, then
+        ``jump_up``/``jump_down``; a curve without a response is one row with its status.
+        Numbers a row does not have are NaN; ``stable`` is ``None`` where stability does
+        not apply."""
+        t = self.table
+        out = {k: np.asarray(t[k], dtype=np.float64)
+               for k in ("voltage_v", "preload_n", "frequency_hz", "amplitude_m", "phase_lag_rad")}
+        out["branch"] = np.array(t["branch"], dtype=object)
+        out["status"] = np.array(t["status"], dtype=object)
+        out["stable"] = np.array(t["stable"], dtype=object)
+        return {k: out[k] for k in self.columns}
 
 
 def resonance(
@@ -127,7 +115,7 @@ def resonance(
     method: str = "multiple_scales",
     oscillator: Optional[Mapping[str, float]] = None,
 ) -> Resonance:
-    """Amplitude–frequency response of the Hertzian oscillator (seed 003 eq. 10-12) for
+    """Amplitude–frequency response of the Hertzian oscillator ([Hertz2022] eq. 10-12) for
     every voltage × preload: all branches incl. the unstable one, backbone, jump-up and
     jump-down frequencies. Each of ``voltage_v``, ``preload_n``, ``frequency_hz`` is a
     number, a 1-D array or ``(start, stop, n)``; ``frequency_hz=None`` picks 401 points
@@ -143,7 +131,7 @@ def resonance(
         c = dict(c)
         c["branch"] = np.array(c["branch"], dtype=object)
         curves.append(ResonanceCurve(**c))
-    return Resonance(d["frequency_hz"], curves)
+    return Resonance(d["frequency_hz"], curves, dict(d["table"]), tuple(d["columns"]))
 
 
 @dataclass(frozen=True)
@@ -173,7 +161,7 @@ def identify_hertz(
     oscillator: Optional[Mapping[str, float]] = None,
     harmonics: int = 3,
 ) -> HertzIdentification:
-    """The cubic coefficient β from a sampled waveform (seed 003 eq. 5-9), given m, c and
+    """The cubic coefficient β from a sampled waveform ([Hertz2022] eq. 5-9), given m, c and
     k (``oscillator``, e.g. ``{"modal_mass_kg": ..., "damping_ns_per_m": ...}``).
 
     ``signal`` is the feedback-electrode voltage [V] when ``feedback_gain_v_per_m`` is
@@ -195,7 +183,7 @@ def identify_hertz(
 
 @dataclass(frozen=True)
 class Snapshot:
-    """Contact state over one wavelength at one instant (seed 004 Fig. 10)."""
+    """Contact state over one wavelength at one instant ([BarTransient] Fig. 10)."""
 
     requested_time_s: float
     time_s: float
@@ -241,7 +229,7 @@ def step(
     record_every: int = 16,
     snapshot_at_s: Sequence[float] = (),
 ) -> StepResult:
-    """Step response of the rotor speed with the stick-slip contact (seed 004): the drive
+    """Step response of the rotor speed with the stick-slip contact ([BarTransient]): the drive
     switches on at t = 0. Returns the time series, the metrics (delay, rise time,
     overshoot, settling time; ``None`` where undefined, e.g. a standing wave at 0°), the
     settled averages, the steady-state solver at the same point and the contact

@@ -55,9 +55,9 @@ def solve_arrays(
 def map_grid(
     motor: Motor,
     preload_n: _Axis,
+    torque_nm: _Axis,
     voltage_v: _Axis,
     frequency_hz: _Axis,
-    torque_nm: _Axis,
     max_points: int = 20_000_000,
     parallel: Optional[bool] = None,
 ) -> Dict[str, Any]: ...
