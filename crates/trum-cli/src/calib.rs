@@ -10,7 +10,7 @@ use serde_json::json;
 use std::io::Write;
 use std::path::PathBuf;
 use trum_core::calibrate::{
-    baseline_params, calibrate_refitting_bounds, residuals, Calibration, FitOptions, ObservedRow,
+    baseline_params_with, calibrate_refitting_bounds, residuals, Calibration, FitOptions, ObservedRow,
 };
 
 #[derive(Args, Debug)]
@@ -35,7 +35,8 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     }
     let (motor, _) = a.motor.load()?;
     let (_, bench) = read_data(&a.data, &motor, err)?;
-    let params = baseline_params(&motor, &bench.rows);
+    let tolerances = crate::motor::load_tolerances(&a.motor.motor)?;
+    let params = baseline_params_with(&motor, &bench.rows, &tolerances);
     let mut cal = calibrate_refitting_bounds(&motor, &bench.rows, &params, &FitOptions::default())
         .map_err(|e| anyhow!("{}: {e}", a.data))?;
     rescale_uncertainties(&mut cal, &bench.rows);

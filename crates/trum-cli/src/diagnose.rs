@@ -48,7 +48,11 @@ pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
         drop(crate::output::OutputTarget::create(p, ".tmp")?);
     }
     let spinner = spinner();
-    let opts = DiagnoseOptions { exact_cv: a.exact_cv, ..DiagnoseOptions::default() };
+    let opts = DiagnoseOptions {
+        exact_cv: a.exact_cv,
+        tolerances: crate::motor::load_tolerances(&a.motor)?,
+        ..DiagnoseOptions::default()
+    };
     let d = diagnose(&motor, &bench.rows, &bench.groups, &opts);
     spinner.finish_and_clear();
     let d = d.map_err(|e| anyhow!("cannot diagnose '{}': {e}", a.data))?;

@@ -42,3 +42,14 @@ pub fn load_motor(spec: &str) -> Result<(Motor, SweepTable)> {
         }
     }
 }
+
+/// The `[tolerances]` table of `--motor` when it is a motor file (empty for a preset): the
+/// priors of the baseline calibration (`trum_core::params::tolerances_from_toml_str`).
+pub fn load_tolerances(spec: &str) -> Result<std::collections::BTreeMap<String, f64>> {
+    let path = Path::new(spec);
+    if !path.is_file() {
+        return Ok(Default::default());
+    }
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read motor file '{spec}'"))?;
+    trum_core::params::tolerances_from_toml_str(&text, spec).map_err(|e| anyhow!("{e}"))
+}

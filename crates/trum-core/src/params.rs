@@ -237,6 +237,64 @@ struct MotorFile {
     assembly: Option<AssemblyPatch>,
     effects: Option<toml::Table>,
     sweep: Option<SweepPatch>,
+    tolerances: Option<toml::Table>,
+}
+
+/// Reads the `[tolerances]` table of a motor file: how well each uncertain baseline
+/// parameter is known before calibration, as the prior standard deviation of its
+/// logarithm (0.05 ≈ ±5 %; 0 holds the parameter at its file value; `inf` fits it without a
+/// prior). Keys are dotted motor keys (`"geometry.neutral_plane_distance_m" = 0.02`) or
+/// sub-tables (`[tolerances.geometry]`), limited to the parameters calibration fits
+/// ([`crate::calibrate::TOLERANCES`], docs/DIAGNOSIS.md); the bench's speed-std floor is
+/// `bench.speed_std_floor_rpm` (0: the bench has none). Empty without a table; errors name
+/// the file, line and key.
+pub fn tolerances_from_toml_str(
+    text: &str,
+    source_name: &str,
+) -> Result<std::collections::BTreeMap<String, f64>, ParamError> {
+    let file: MotorFile = toml::from_str(text).map_err(|e| ParamError {
+        source_name: source_name.into(),
+        line: e.span().map(|s| line_of_offset(text, s.start)),
+        key: "tolerances".into(),
+        reason: e.message().trim().to_string(),
+    })?;
+    let mut out = std::collections::BTreeMap::new();
+    let Some(table) = file.tolerances else { return Ok(out) };
+    let valid: Vec<String> = crate::calibrate::TOLERANCES
+        .iter()
+        .map(|t| t.key.to_string())
+        .chain(std::iter::once("bench.speed_std_floor_rpm".to_string()))
+        .collect();
+    let mut flat: Vec<(String, &toml::Value)> = Vec::new();
+    for (k, v) in &table {
+        match v {
+            toml::Value::Table(sub) => flat.extend(sub.iter().map(|(k2, v2)| (format!("{k}.{k2}"), v2))),
+            _ => flat.push((k.clone(), v)),
+        }
+    }
+    for (key, v) in flat {
+        let (sec, name) = key.split_once('.').unwrap_or(("", key.as_str()));
+        let err = |reason: String| ParamError {
+            source_name: source_name.into(),
+            line: line_of_key(text, &format!("tolerances.{sec}"), name)
+                .or_else(|| line_of_key(text, "tolerances", &key)),
+            key: format!("tolerances.{key}"),
+            reason,
+        };
+        if !valid.contains(&key) {
+            return Err(err(format!("not a calibrated parameter; valid keys are: {}", valid.join(", "))));
+        }
+        let x = match v {
+            toml::Value::Integer(i) => *i as f64,
+            toml::Value::Float(x) => *x,
+            _ => return Err(err("expected a number (relative standard deviation, 0 or inf)".into())),
+        };
+        if x.is_nan() || x < 0.0 {
+            return Err(err(format!("{x} must be >= 0 (or inf)")));
+        }
+        out.insert(key, x);
+    }
+    Ok(out)
 }
 
 /// One axis in a `[sweep]` table: a single value or `[start, stop, n]`.
