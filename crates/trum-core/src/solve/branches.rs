@@ -21,7 +21,7 @@ pub struct AmplitudeBranch {
 
 /// Every steady amplitude at `op`, smallest first: the multi-valued region of a softening
 /// stator (`hertz_softening`) has three (the middle one unstable), elsewhere there is one.
-/// [`solve`] reports the largest stable one (the amplitude reached from above, i.e. when
+/// [`super::solve`] reports the largest stable one (the amplitude reached from above, i.e. when
 /// the frequency is swept down onto the resonance). Effects that iterate on the solution
 /// (thermal state, voltage sag) are not applied here: the drive is the set voltage.
 /// Found by a scan of 400 logarithmically spaced amplitudes from 10⁻⁶ of the bound
