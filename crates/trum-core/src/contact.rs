@@ -5,17 +5,19 @@
 //! * θ is the wave phase measured from a wave crest; k = N/R0 is the wave number, so a
 //!   circumferential length x corresponds to θ = k·x.
 //! * φ0 is the contact **half-angle in wave phase**: contact where |θ| ≤ φ0, 0 < φ0 ≤ π.
-//! * The contact angle Xc (seed 000 eq. 1-2) is the **full** contact arc in mechanical
-//!   degrees: Xc = 2·φ0/(2π)·(360°/N), which is 40·φ0/π for N = 9, so 0 ≤ Xc ≤ 40°.
-//! * The friction layer is a Winkler bed (seed 000 eq. 3, seed 001 eq. 5): pressure per
-//!   unit circumferential length p(θ) = k_f·W·(cos θ − c), k_f = E_f·b_f/h_f [N/m²].
-//!   In partial contact c = cos φ0; in full contact (the rotor touches the whole wave,
-//!   φ0 = π) the rotor sits below the trough and c < −1.
+//! * The contact angle Xc (Chen et al. 2020 eq. 1-2) is the **full** contact arc in
+//!   mechanical degrees: Xc = 2·φ0/(2π)·(360°/N), which is 40·φ0/π for N = 9, so 0 ≤ Xc ≤
+//!   40°.
+//! * The friction layer is a Winkler bed (Chen et al. 2020 eq. 3, Sun et al. 2021 eq. 5):
+//!   pressure per unit circumferential length p(θ) = k_f·W·(cos θ − c), k_f = E_f·b_f/h_f
+//!   [N/m²]. In partial contact c = cos φ0; in full contact (the rotor touches the whole
+//!   wave, φ0 = π) the rotor sits below the trough and c < −1.
 
 use crate::params::Motor;
 use std::f64::consts::PI;
 
-/// χ(θ) = sin θ − θ·c, the integral ∫₀^θ (cos t − c) dt (seed 001 eq. 10 with c = cos φ0).
+/// χ(θ) = sin θ − θ·c, the integral ∫₀^θ (cos t − c) dt (Sun et al. 2021 eq. 10 with c =
+/// cos φ0).
 #[inline]
 pub fn chi(theta_rad: f64, c: f64) -> f64 {
     theta_rad.sin() - theta_rad * c
@@ -30,13 +32,13 @@ pub fn e_int(theta_rad: f64, c: f64) -> f64 {
 }
 
 /// Equivalent Winkler stiffness of the friction layer per unit circumferential length,
-/// k_f = E_f·b_f/h_f [N/m²] (seed 001 eq. 4).
+/// k_f = E_f·b_f/h_f [N/m²] (Sun et al. 2021 eq. 4).
 pub fn layer_stiffness_n_per_m2(youngs_modulus_pa: f64, contact_width_m: f64, thickness_m: f64) -> f64 {
     youngs_modulus_pa * contact_width_m / thickness_m
 }
 
-/// Force scale A = 2·N·k_f·W/k [N]: the axial force is A·χ(φ0) (seed 001 eq. 5,
-/// seed 000 eq. 6 with the width integral folded into k_f).
+/// Force scale A = 2·N·k_f·W/k [N]: the axial force is A·χ(φ0) (Sun et al. 2021 eq. 5,
+/// Chen et al. 2020 eq. 6 with the width integral folded into k_f).
 #[inline]
 pub fn force_scale_n(wave_number: f64, k_f_n_per_m2: f64, amplitude_m: f64, wavenumber_per_m: f64) -> f64 {
     2.0 * wave_number * k_f_n_per_m2 * amplitude_m / wavenumber_per_m
@@ -79,8 +81,8 @@ fn g(phi: f64) -> f64 {
     s - phi * c
 }
 
-/// Contact zone from the ratio y = F_N/A of preload to force scale (seed 001 eq. 5
-/// solved for x0; seed 000 eq. 6). Valid for any y > 0: y ≥ π means full contact.
+/// Contact zone from the ratio y = F_N/A of preload to force scale (Sun et al. 2021 eq. 5
+/// solved for x0; Chen et al. 2020 eq. 6). Valid for any y > 0: y ≥ π means full contact.
 ///
 /// Inverts g(φ0) = y by safeguarded Newton iteration to 1e-14 in φ0, starting from the
 /// small-angle (g ≈ φ³/3) or near-full (g ≈ π − π·ε²/2, ε = π − φ) asymptotes.
@@ -164,8 +166,8 @@ fn newton_sin_cos(
         } else if d > 0.0 && next == x {
             // The Newton step is below the rounding of x (v = 0 included): x is the root.
             // It is also an end of the bracket now, so the regula falsi below would take
-            // the far end and bisect from there (found by counting: 5-10 % of the warm-
-            // started solves in a diagnosis spent 28-50 evaluations here).
+            // the far end and bisect from there (5-10 % of the warm-started solves in a
+            // diagnosis would spend 28-50 evaluations here).
             return (x, s, c);
         } else {
             // Regula falsi, with the Illinois halving when the same end keeps moving.
@@ -186,7 +188,7 @@ fn newton_sin_cos(
 }
 
 /// Contact angle Xc [mechanical degrees, full arc] from the half-angle φ0 in wave phase
-/// (seed 000 eq. 2 convention: Xc = 40·φ0/π for N = 9).
+/// (Chen et al. 2020 eq. 2 convention: Xc = 40·φ0/π for N = 9).
 #[inline]
 pub fn contact_angle_deg(half_angle_rad: f64, wave_number: f64) -> f64 {
     half_angle_rad * 360.0 / (PI * wave_number)
@@ -199,7 +201,7 @@ pub fn contact_length_m(half_angle_rad: f64, wavenumber_per_m: f64) -> f64 {
 }
 
 /// Pressure per unit circumferential length p(θ) = k_f·W·(cos θ − c) inside the contact,
-/// 0 outside [N/m] (seed 000 eq. 3, seed 001 eq. 5).
+/// 0 outside [N/m] (Chen et al. 2020 eq. 3, Sun et al. 2021 eq. 5).
 pub fn pressure_n_per_m(theta_rad: f64, k_f_n_per_m2: f64, amplitude_m: f64, contact: &Contact) -> f64 {
     if theta_rad.abs() > contact.half_angle_rad {
         0.0
@@ -208,8 +210,8 @@ pub fn pressure_n_per_m(theta_rad: f64, k_f_n_per_m2: f64, amplitude_m: f64, con
     }
 }
 
-/// Torque shape factor 2·χ(θs) − χ(φ0) (seed 001 eq. 11, seed 000 eq. 4-5): the drive
-/// torque is R0·μ·A·[2χ(θs) − χ(φ0)], where |θ| < θs is the driving zone.
+/// Torque shape factor 2·χ(θs) − χ(φ0) (Sun et al. 2021 eq. 11, Chen et al. 2020 eq. 4-5):
+/// the drive torque is R0·μ·A·[2χ(θs) − χ(φ0)], where |θ| < θs is the driving zone.
 #[inline]
 pub fn torque_factor(stick_half_angle_rad: f64, contact: &Contact) -> f64 {
     2.0 * chi(stick_half_angle_rad, contact.offset) - contact.chi0()
@@ -222,9 +224,9 @@ pub fn stall_stick_half_angle_rad(contact: &Contact) -> f64 {
     contact.half_angle_rad.min(0.5 * PI)
 }
 
-/// Solves the stick half-angle θs ∈ [0, θmax] of the torque balance
-/// R0·μ·A·[2χ(θs) − χ(φ0)] = T_load + d_r·v0·cos(θs)/R0 (seed 000 eq. 5 and Table A1's
-/// rotor damping; the rotor surface speed is v_r = v0·cos θs, seed 001 eq. 13).
+/// Solves the stick half-angle θs ∈ [0, θmax] of the torque balance R0·μ·A·[2χ(θs) − χ(φ0)]
+/// = T_load + d_r·v0·cos(θs)/R0 (Chen et al. 2020 eq. 5 and Table A1's rotor damping; the
+/// rotor surface speed is v_r = v0·cos θs, Sun et al. 2021 eq. 13).
 ///
 /// `torque_scale_nm` = R0·μ·A, `viscous_nm_per_cos` = d_r·v0/R0. The left side increases
 /// and the right side decreases with θs, so the root is unique when it exists; returns
@@ -319,7 +321,7 @@ mod tests {
     fn stick_angle_solves_torque_balance_and_reports_stall() {
         let ct = contact_from_ratio(1.0);
         let scale = 2.0;
-        let t = stick_half_angle_rad(&ct, scale, 0.3, 0.05, None).unwrap();
+        let t = stick_half_angle_rad(&ct, scale, 0.3, 0.05, None).expect("a running stick angle");
         let resid = scale * torque_factor(t, &ct) - 0.3 - 0.05 * t.cos();
         assert!(resid.abs() < 1e-12);
         assert!(t > 0.0 && t <= ct.half_angle_rad);

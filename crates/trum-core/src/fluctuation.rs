@@ -1,9 +1,9 @@
-//! Speed fluctuation from a once-per-revolution preload variation (eccentric assembly,
-//! seed 000 section 4.3). An axial runout δ of the rotor changes the compression of the
-//! preload path — the disc spring k_sp in series with the contact's normal stiffness
-//! K_z — by ΔF = δ/(1/k_sp + 1/K_z) once per revolution. The rotor period (~0.5 s) is far
-//! longer than every mechanical time constant of the contact (~10 ms, seed 004), so the
-//! speed follows the preload quasi-statically: Ω(φ) = Ω_ss(F + ΔF·cos φ).
+//! Speed fluctuation from a once-per-revolution preload variation (eccentric assembly, Chen
+//! et al. 2020 section 4.3). An axial runout δ of the rotor changes the compression of the
+//! preload path — the disc spring k_sp in series with the contact's normal stiffness K_z —
+//! by ΔF = δ/(1/k_sp + 1/K_z) once per revolution. The rotor period (~0.5 s) is far longer
+//! than every mechanical time constant of the contact (~10 ms, the bar-type transient
+//! paper), so the speed follows the preload quasi-statically: Ω(φ) = Ω_ss(F + ΔF·cos φ).
 
 pub use crate::contact::contact_normal_stiffness_n_per_m;
 use crate::error::TrumError;
@@ -22,7 +22,8 @@ pub struct Fluctuation {
     pub mean_speed_rpm: f64,
     /// Time-weighted standard deviation of speed over a revolution [rev/min].
     pub speed_std_rpm: f64,
-    /// Smallest and largest contact angle over the revolution [deg] (seed 000 Fig. 7).
+    /// Smallest and largest contact angle over the revolution [deg] (Chen et al. 2020 Fig.
+    /// 7).
     pub contact_angle_range_deg: (f64, f64),
 }
 
@@ -107,16 +108,16 @@ mod tests {
 
     #[test]
     fn zero_runout_gives_no_fluctuation_and_small_runout_is_linear() {
-        let m = preset("trum60a").unwrap();
+        let m = preset("trum60a").expect("preset");
         let op = OperatingPoint::new(250.0, 0.2, 200.0, 43e3);
-        let f0 = speed_fluctuation(&m, &op, 0.0, 16).unwrap();
+        let f0 = speed_fluctuation(&m, &op, 0.0, 16).expect("valid runout");
         // Zero up to rounding: the samples are warm-started from each other, and warm and
         // cold solves agree to the solver's tolerance, not to the last bit.
         assert!(f0.speed_std_rpm <= 1e-12 * f0.mean_speed_rpm, "{}", f0.speed_std_rpm);
         let s = crate::solve(&m, &op);
         assert!((f0.mean_speed_rpm - s.speed_rpm).abs() < 1e-9 * s.speed_rpm);
         // std ≈ |dΩ/dF|·ΔF/√2 for a small ripple (first-order perturbation)
-        let f1 = speed_fluctuation(&m, &op, 1e-6, 32).unwrap();
+        let f1 = speed_fluctuation(&m, &op, 1e-6, 32).expect("valid runout");
         let h = 0.5;
         let mut a = op;
         a.preload_n += h;

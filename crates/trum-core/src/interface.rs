@@ -1,16 +1,17 @@
 //! Friction in the contact interface beyond the 2-D Coulomb law of the baseline: the
 //! traction μ·p acts along the **total** slip velocity, which has a radial part when the
-//! stator surface points also move radially (`radial_friction`, seed 002), and its
-//! magnitude saturates smoothly over a slip-velocity scale set by the shear compliance
-//! of the friction layer (`tangential_compliance`, Storck and Wallaschek 2003; seed 004).
+//! stator surface points also move radially (`radial_friction`, the radial-friction paper),
+//! and its magnitude saturates smoothly over a slip-velocity scale set by the shear
+//! compliance of the friction layer (`tangential_compliance`, Storck and Wallaschek 2003;
+//! the bar-type transient paper).
 //!
 //! Kinematics in the wave frame (θ wave phase, 0 at the crest; everything divided by the
-//! crest speed v0): tangential stator speed cos θ, rotor speed u = v_r/v0, radial
-//! stator speed ρ·sin θ (seed 002 eq. 10-12: the radial displacement −z·∂R/∂r·A·cos(ωt−mθ)
-//! is in phase with the transverse one, so its velocity is in quadrature with the
-//! tangential velocity — zero at the crest, largest towards the nodes).
-//! Slip s = (cos θ − u, ρ·sin θ), |s| = D; traction direction s/D, magnitude
-//! μ·p·S(D/σ) with S(x) = tanh x (σ = 0: S = 1, Coulomb).
+//! crest speed v0): tangential stator speed cos θ, rotor speed u = v_r/v0, radial stator
+//! speed ρ·sin θ (the radial-friction paper eq. 10-12: the radial displacement
+//! −z·∂R/∂r·A·cos(ωt−mθ) is in phase with the transverse one, so its velocity is in
+//! quadrature with the tangential velocity — zero at the crest, largest towards the nodes).
+//! Slip s = (cos θ − u, ρ·sin θ), |s| = D; traction direction s/D, magnitude μ·p·S(D/σ)
+//! with S(x) = tanh x (σ = 0: S = 1, Coulomb).
 //!
 //! The factors returned generalise the baseline closed forms: with ρ = 0 and σ = 0 they
 //! are exactly 2χ(θs) − χ(φ0) and 2E(θs) − E(φ0) (a test checks this).
@@ -238,8 +239,10 @@ impl Nodes {
 }
 
 /// Adds the integrand at a node (sin θ, cos θ) with weight `w`, any law (the tests'
-/// reference for [`coulomb_sums`] and the saturating laws' route).
+/// reference for [`coulomb_sums`] and the saturating laws' route). The node's scalars are
+/// passed one by one: this runs once per node and radius in the innermost loop.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn accumulate(f: &mut Factors, s: f64, co: f64, w: f64, c: f64, u: f64, rho: f64, law: &Law) {
     let q = co - c;
     if q <= 0.0 {
@@ -280,7 +283,7 @@ fn accumulate(f: &mut Factors, s: f64, co: f64, w: f64, c: f64, u: f64, rho: f64
 /// Node k adds to partial sum k mod 4 and the node terms have no branch, so the compiler
 /// runs the square roots and divisions two nodes at a time in vector registers (SSE2, in
 /// every x86-64): 19 % less time a `factors` call, results within a few ulp of sequential
-/// sums (docs/PERFORMANCE.md, stop 23). The order of the sums is fixed, so results do not
+/// sums (docs/PERFORMANCE.md). The order of the sums is fixed, so results do not
 /// depend on the machine. A node with q ≤ 0 (outside the contact, possible only by
 /// rounding at its edge) gets weight 0; D = 0 cannot occur at an interior node with ρ > 0,
 /// and with ρ = 0 only where u = cos θ at a node, which the split at θs rules out; the
@@ -437,20 +440,20 @@ const GRADE_RATIO: f64 = 6.0;
 /// Nearer singularities are graded as this far (at most MAX_PANELS panels). Below it the
 /// turn is a step at θs on the scale of the panel next to it, which the split at θs
 /// integrates like the Coulomb law's sign change (ρ = 1e-14: within 1.1e-8 of adaptive
-/// quadrature at u = 1, test below). 1e-6 until a review found 7.8e-9 at ρ = 1,
+/// quadrature at u = 1, test below). A floor of 1e-6 would leave 7.8e-9 at ρ = 1,
 /// u = 1 − 1.7e-8, where θ* is 1.7e-8 from the axis.
 const MIN_FEATURE_WIDTH: f64 = 1e-9;
 /// A singularity whose real part is within SNAP × its distance from the real axis of a
 /// panel end is graded from that end ([`graded_ends`]), one end fewer: where the
-/// first-order estimate of stop 31 held, Re θ* is that close to θs, and the ends are the
-/// ones that rule had. Seen from the end, θ* is then a little off the point the grading
-/// starts from, and the first sub-panel's Bernstein ellipse shrinks (E ≈ 3.3 at 0.1, 2.8 at
-/// 0.5). Against adaptive quadrature on a dense sweep the worst relative error is about
-/// 1e-13 at SNAP = 0.1, 2.4e-11 at 0.5 (a review's sweep, σ = 0.2), and where the snap sets
-/// in the factors step by that much (2.5e-11 at 0.5). Without snapping (0) the ends move
+/// first-order estimate Re θ* ≈ θs holds, Re θ* is that close to θs, and the ends are those
+/// of the first-order rule. Seen from the end, θ* is then a little off the point the
+/// grading starts from, and the first sub-panel's Bernstein ellipse shrinks (E ≈ 3.3 at
+/// 0.1, 2.8 at 0.5). Against adaptive quadrature on a dense sweep the worst relative error
+/// is about 1e-13 at SNAP = 0.1, 2.4e-11 at 0.5 (σ = 0.2), and where the snap sets in the
+/// factors step by that much (2.5e-11 at 0.5). Without snapping (0) the ends move
 /// continuously, for 12 % more instructions on a `tangential_compliance` map and 13 % on a
-/// `radial_friction=0.05` one; 0.1 costs 21 % and 5 % more than the first-order rule,
-/// 0.5 10 % and 5 %.
+/// `radial_friction=0.05` one; 0.1 costs 21 % and 5 % more than the first-order rule, 0.5
+/// 10 % and 5 %.
 const SNAP: f64 = 0.1;
 
 /// The complex singularity of the integrand nearest to the real θ axis, (Re θ*, |Im θ*|),
@@ -464,9 +467,9 @@ const SNAP: f64 = 0.1;
 /// (1 − ρ²)·c² − 2u·c + (u² + ρ² + κ²) = 0, so θ* = arccos c at its roots (complex, or real
 /// beyond ±1: then θ* = i·arcosh c or π + i·arcosh(−c)). Away from the crest the nearest
 /// root sits about the band's half-width w = √(κ² + ρ² sin² θs)/sin θs from θs (to first
-/// order in w, the estimate used until stop 34); at the crest (u → 1, sin θs → 0) that
-/// estimate diverges while θ* approaches 0 (ρ = 1: |Im θ*| = arcosh((1 + u²)/2u) ≈ 1 − u),
-/// and the ungraded panels had relative errors up to 8e-5. The truth form's radii each
+/// order in w); at the crest (u → 1, sin θs → 0) that estimate diverges while θ*
+/// approaches 0 (ρ = 1: |Im θ*| = arcosh((1 + u²)/2u) ≈ 1 − u), where ungraded panels
+/// have relative errors up to 8e-5: hence the exact root. The truth form's radii each
 /// have theirs; the nearest counts.
 fn nearest_singularity(law: &Law, u: f64, phi0: f64) -> Option<(f64, f64)> {
     let kappa = if law.slip_scale > 0.0 {
@@ -594,16 +597,16 @@ fn arccos_near(u: f64, sin_ts: f64, dc: C64) -> C64 {
 /// 0, θs when inside, φ0, and in each of the plain rule's panels [0, θs] and [θs, φ0] the
 /// point n nearest to θ* (when strictly inside) and the ends n ∓ 3w·6^k that fall inside
 /// the panel, w the distance from θ* to n (ascending; the count is the second value).
-/// `None` when no end is added: the plain rule's panels are then no wider than 3w each
-/// side of n, and as accurate. With θ* near θs (Re θ* = θs to first order in w) this is
-/// the rule of stop 31, graded about θs. The ends move continuously with u, w and φ0, and a
+/// `None` when no end is added: the plain rule's panels are then no wider than 3w each side
+/// of n, and as accurate. With θ* near θs (Re θ* = θs to first order in w) this is the
+/// first-order rule, graded about θs. The ends move continuously with u, w and φ0, and a
 /// panel appears or leaves with zero width, so the factors are continuous in u except where
 /// n snaps to a panel end ([`SNAP`]): there they step by up to the rule's error (about
-/// 1e-13 relative). (The plain
-/// rule alone, its panels much wider than w, had relative errors up to 3.5e-4 and a
-/// ∂torque/∂u 20-30 % off at ρ = 0.0035 or σ = 0.003; 89 of 18 697 points of a trum60a map at
-/// ρ = 0.0035 ended without convergence, the same amplitude trial returning two rotor
-/// speeds depending on its start: tests/solver_convergence.rs.)
+/// 1e-13 relative). (The plain rule alone, its panels much wider than w, has relative
+/// errors up to 3.5e-4 and a ∂torque/∂u 20-30 % off at ρ = 0.0035 or σ = 0.003; with it 89
+/// of 18 697 points of a trum60a map at ρ = 0.0035 end without convergence, the same
+/// amplitude trial returning two rotor speeds depending on its start:
+/// tests/solver_convergence.rs.)
 fn graded_ends(ts: f64, phi0: f64, z: (f64, f64)) -> Option<([f64; MAX_PANELS + 1], usize)> {
     let mut ends = [0.0; MAX_PANELS + 1];
     // ends in ascending order, panel by panel: graded ends below its nearest point (made
@@ -717,7 +720,7 @@ pub(crate) struct Coulomb {
     pub(crate) carry: [Option<AngleCarry>; 2],
 }
 
-/// Baseline 2-D Coulomb interface at amplitude `w`: closed forms (seed 001 eq. 10-11;
+/// Baseline 2-D Coulomb interface at amplitude `w`: closed forms (Sun et al. 2021 eq. 10-11;
 /// crate::contact). `sc0` = (sin φ0, cos φ0). χ and E are written out here with the sines
 /// and cosines the root finds already have: one `sin_cos` per Newton step is the whole
 /// transcendental cost of a trial, and none where the angles carried from the previous
@@ -1012,15 +1015,15 @@ mod tests {
                 for &u in &[0.0, 0.03, 0.4, 0.77, 0.999, 1.0] {
                     let (a, b) = (factors(&ct, u, &law), factors_direct(&ct, u, &law));
                     // (rounding on the order of the integrand's magnitude, O(0.1) and more, not
-                    // of a near-cancelling sum: at u = 1 a torque of −0.05 differs by 8e-15, and
-                    // by 2.4e-14 since stop 34 graded the crest's panels towards θ = 0)
+                    // of a near-cancelling sum: at u = 1 a torque of −0.05 differs by up to
+                    // 2.4e-14 with the crest's panels graded towards θ = 0)
                     let scale = b.torque.abs().max(b.power.abs()).max(0.1);
                     for (x, z) in [(a.torque, b.torque), (a.power, b.power), (a.radial, b.radial)] {
                         assert!((x - z).abs() <= 5e-13 * scale, "{law:?} y={y} u={u}: {x} vs {z}");
                     }
                     // (at u = 1 with radial slip, ∂torque/∂u is log-divergent at θ = 0: the
-                    // graded rule's many panels next to 0 sum ~1/θ terms, 4e-12 apart at ρ = 0.0035,
-                    // 1.3e-11 since stop 34 grades them about the exact singularity there)
+                    // graded rule's many panels next to 0 sum ~1/θ terms, 1.3e-11 apart at
+                    // ρ = 0.0035 with them graded about the exact singularity there)
                     for (x, z) in [(a.torque_du, b.torque_du), (a.power_du, b.power_du), (a.radial_du, b.radial_du)] {
                         assert!((x - z).abs() <= 3e-11 * z.abs().max(1.0), "{law:?} u={u}: {x} vs {z}");
                     }
@@ -1048,9 +1051,9 @@ mod tests {
 
     /// The derivatives at fixed nodes against central differences of the rule. For weak
     /// radial slip or compliance (ρ = 0.0035, σ = 0.003) ∂torque/∂u is a narrow peak at θs
-    /// that the plain rule's nodes straddled: 20-30 % too small before the panels were
-    /// graded, and the rotor-speed solve's Newton steps and their carried last step
-    /// (solve::general_interface) rested on it.
+    /// that the plain rule's nodes straddle (20-30 % too small without graded panels),
+    /// and the rotor-speed solve's Newton steps and their carried last step
+    /// (`general_interface`) rest on it.
     #[test]
     fn torque_derivative_matches_central_differences() {
         let mut worst: f64 = 0.0;
@@ -1092,20 +1095,17 @@ mod tests {
     /// The rule against adaptive Gauss–Kronrod (`crate::quad`, 1e-12 relative) of the
     /// defining integrals ∫₀^φ0 (cos θ − c)·(…) dθ, split at the stick point θs, over both
     /// friction laws in both forms, contacts from small to full and rotor speeds up to the
-    /// crest speed. Since stop 34 the panels are graded about the integrand's nearest complex
-    /// singularity (`nearest_singularity`) instead of a first-order estimate of it about θs,
-    /// which diverged at the crest (u → 1, θs → 0). Measured worst relative errors (of the
-    /// larger of torque and power) over 8 contacts and 17 rotor speeds from 0 to 1 (1 − 1e-9
-    /// and 1 included, denser near the crest and where a review's sweep found the worst):
-    /// 6.3e-13 (σ = 0.02), 4.3e-13 up to u = 0.8 (σ = 0.2); the bounds below are 1.5e-12 and
-    /// 1e-12. Before, at u = 0.9999: ρ = 0.3: 1.9e-6, ρ = 1: 3.3e-5, σ = 0.003: 3.5e-5,
-    /// σ = 0.02: 8.3e-5, truth σ = 0.05: 7.9e-6, and up to 7.1e-4 at u = 0.999999; up to
-    /// u = 0.8, 1.2e-11. Left: a singularity nearer than MIN_FEATURE_WIDTH is graded as that
-    /// far (ρ = 1e-14 at u = 1: 1.1e-8), and at u = 1 exactly ρ = 1e-7 leaves 5.5e-10
-    /// (its singularity, 2e-7 off θ = 0, is graded; not examined further). Before the
-    /// panels were graded at all the errors were
-    /// 7.2e-5 at ρ = 0.05 and 3.5e-4 at σ = 0.02 at any u (and at ρ = 0.0035 the torque was
-    /// not monotonic in u).
+    /// crest speed. The panels are graded about the integrand's nearest complex singularity
+    /// (`nearest_singularity`), not about a first-order estimate of it near θs, which
+    /// diverges at the crest (u → 1, θs → 0; there its errors reach 3.3e-5 at ρ = 1 and
+    /// u = 0.9999, 7.1e-4 at u = 0.999999; ungraded panels give 7.2e-5 at ρ = 0.05 and
+    /// 3.5e-4 at σ = 0.02 at any u). Measured worst relative errors (of the larger of
+    /// torque and power) over 8 contacts and 17 rotor speeds from 0 to 1 (1 − 1e-9 and 1
+    /// included, denser near the crest and where the errors peak): 6.3e-13 (σ = 0.02),
+    /// 4.3e-13 up to u = 0.8 (σ = 0.2); the bounds below are 1.5e-12 and 1e-12. Not
+    /// covered: a singularity nearer than MIN_FEATURE_WIDTH is graded as that far
+    /// (ρ = 1e-14 at u = 1: 1.1e-8), and at u = 1 exactly ρ = 1e-7 leaves 5.5e-10 (its
+    /// singularity, 2e-7 off θ = 0, is graded).
     #[test]
     fn factors_agree_with_adaptive_quadrature_of_their_integrals() {
         use crate::quad::integrate;
@@ -1179,7 +1179,9 @@ mod tests {
                         }
                         pick(&f)
                     };
-                    let picks: [(&str, fn(&Factors) -> f64, f64); 3] = [
+                    // (name, the factor it picks, the rule's value)
+                    type Pick = (&'static str, fn(&Factors) -> f64, f64);
+                    let picks: [Pick; 3] = [
                         ("torque", |f| f.torque, rule.torque),
                         ("power", |f| f.power, rule.power),
                         ("radial", |f| f.radial, rule.radial),
@@ -1202,12 +1204,12 @@ mod tests {
         }
     }
 
-    /// `nearest_singularity` returns a zero of D² + κ² to within 1 % of its distance from the
-    /// axis (the quadratic's root, without Newton steps where |δ| ≤ 0.1; of tan²(θ/2) + ρ²
-    /// exactly at u = ±1 with the Coulomb law), for rotor speeds from −1 to 1 and radial
-    /// ratios below, at and above 1; for u < 0 too (a review found ρ = 1, u = −0.6 at Im 37
-    /// instead of 0.51), and of the two equally high roots at u = 0, ρ > 1, the one at θ = 0,
-    /// next to the contact.
+    /// `nearest_singularity` returns a zero of D² + κ² to within 1 % of its distance from
+    /// the axis (the quadratic's root, without Newton steps where |δ| ≤ 0.1; of tan²(θ/2) +
+    /// ρ² exactly at u = ±1 with the Coulomb law), for rotor speeds from −1 to 1 and radial
+    /// ratios below, at and above 1; for u < 0 too (at ρ = 1, u = −0.6 the nearest root has
+    /// Im 0.51, not the other root's 37), and of the two equally high roots at u = 0, ρ >
+    /// 1, the one at θ = 0, next to the contact.
     #[test]
     fn the_nearest_singularity_is_a_zero_of_the_slip() {
         let laws = [

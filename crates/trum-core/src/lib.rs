@@ -6,8 +6,19 @@
 //! fluctuation and the preload optimisation criterion. Pure Rust, no file or network I/O:
 //! parsers take strings, progress is reported through callbacks.
 //!
-//! Sources are the five papers in `shared/seeds/` (cited as seed 000 … 004 with their
-//! equation numbers). SI units everywhere; every public quantity name carries its unit.
+//! Sources are five papers, cited with their equation numbers under these keys:
+//! - Chen et al. 2020: N. Chen, J. Zheng, D. Fan, *Pre-pressure optimization for
+//!   ultrasonic motors based on multi-sensor fusion*, Sensors 2020 (the TRUM60A motor);
+//! - Sun et al. 2021: H. Sun, H. Yin, J. Liu, X. Zhang, *Efficiency model for traveling
+//!   wave-type ultrasonic motors based on contact variables and preload*, Actuators 2021;
+//! - the radial-friction paper: *A novel model of ultrasonic motors with effect of radial
+//!   friction in contact mechanism*;
+//! - the Hertzian driving-circuit paper (2022): *A design method of traveling wave rotary
+//!   ultrasonic motors driving circuit under high voltage using single-sided Hertzian
+//!   contact forced oscillator model*, 2022;
+//! - the bar-type transient paper: *Transient analysis of bar-type ultrasonic motors*.
+//!
+//! SI units everywhere; every public quantity name carries its unit.
 #![warn(missing_docs)]
 
 pub mod calibrate;

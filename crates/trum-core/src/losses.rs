@@ -1,16 +1,16 @@
 //! Power losses: dielectric loss of the piezoceramic, structural damping of the stator,
 //! friction in the contact interface (closed form and quadrature), rotor viscous loss.
 //!
-//! The baseline friction law is Coulomb: traction μ·p along the slip. The friction loss
-//! is therefore ∫ μ·p·|v_s − v_r| dx over the contact of all N waves, which this module
-//! evaluates both in closed form and by adaptive quadrature (a test checks they agree).
-//! The papers' closed forms (seed 000 eq. 9-10, seed 001 eq. 22-26) integrate a
+//! The baseline friction law is Coulomb: traction μ·p along the slip. The friction loss is
+//! therefore ∫ μ·p·|v_s − v_r| dx over the contact of all N waves, which this module
+//! evaluates both in closed form and by adaptive quadrature (a test checks they agree). The
+//! papers' closed forms (Chen et al. 2020 eq. 9-10, Sun et al. 2021 eq. 22-26) integrate a
 //! viscous-like ΔF·(v_s − v_r)² instead; `crate::papers` and docs/PAPERS.md compare them.
 
 use crate::contact::{self, Contact};
 use crate::quad;
 
-/// Dielectric loss of both phases P = ω·C0·V²·tan δ [W] (seed 000 eq. 7 with
+/// Dielectric loss of both phases P = ω·C0·V²·tan δ [W] (Chen et al. 2020 eq. 7 with
 /// ε_p·A/h_p = C0 and two phases of ½·ω·C0·V²·tan δ each). V is the zero-to-peak
 /// amplitude per phase. Valid for any ω, C0, V ≥ 0.
 #[inline]
@@ -18,10 +18,10 @@ pub fn dielectric_loss_w(omega_rad_s: f64, capacitance_f: f64, loss_tangent: f64
     omega_rad_s * capacitance_f * voltage_v * voltage_v * loss_tangent
 }
 
-/// Structural damping loss of the stator, two modes of amplitude W:
-/// P = 2·½·c·ω²·W² = c·ω²·W² [W]. (Seed 001 eq. 17 gives the same loss per cycle from
-/// the composite beam's bending energy; [`composite_modal_damping_ns_per_m`] converts
-/// one into the other.)
+/// Structural damping loss of the stator, two modes of amplitude W: P = 2·½·c·ω²·W² =
+/// c·ω²·W² [W]. (Sun et al. 2021 eq. 17 gives the same loss per cycle from the composite
+/// beam's bending energy; [`composite_modal_damping_ns_per_m`] converts one into the
+/// other.)
 #[inline]
 pub fn stator_damping_loss_w(modal_damping_ns_per_m: f64, omega_rad_s: f64, amplitude_m: f64) -> f64 {
     modal_damping_ns_per_m * omega_rad_s * omega_rad_s * amplitude_m * amplitude_m
@@ -85,11 +85,11 @@ pub fn friction_loss_quadrature_w(
     2.0 * wave_number * total
 }
 
-/// Modal damping c [N·s/m] equivalent to the composite stator's material damping
-/// (seed 001 eq. 17-21). A traveling wave u = W·cos(kx − ωt) is two standing modes, each
+/// Modal damping c [N·s/m] equivalent to the composite stator's material damping (Sun et
+/// al. 2021 eq. 17-21). A traveling wave u = W·cos(kx − ωt) is two standing modes, each
 /// with peak strain energy ½·EI·k⁴·W²·π·R0; hysteretic damping η loses 2π·η of that per
-/// cycle and mode, a viscous modal damper π·c·ω·W². Equating gives
-/// c = π·R0·k⁴·(E_eq·I_e·η_e + E_p·I_p·η_p)/ω.
+/// cycle and mode, a viscous modal damper π·c·ω·W². Equating gives c =
+/// π·R0·k⁴·(E_eq·I_e·η_e + E_p·I_p·η_p)/ω.
 ///
 /// `ei_eta_nm2` = E_eq·I_e·η_e + E_p·I_p·η_p [N·m²], the loss-weighted bending stiffness;
 /// [`composite_section`] gives I_e, I_p and the neutral-layer depth D (eq. 18-21).
@@ -103,7 +103,7 @@ pub fn composite_modal_damping_ns_per_m(
     ei_eta_nm2 * k4 * std::f64::consts::PI * mean_radius_m / omega_rad_s
 }
 
-/// Composite stator section (seed 001 eq. 18-21): returns (D, I_e, I_p) for ring width
+/// Composite stator section (Sun et al. 2021 eq. 18-21): returns (D, I_e, I_p) for ring width
 /// b_e, ring+teeth height h_e, piezo width b_p and thickness h_p, moduli E_eq and E_p.
 /// D is the depth of the neutral layer below the ring's upper surface [m]; I_e, I_p the
 /// cross-section moments about it [m⁴]. Eq. 19 is printed with a 1/12 factor where the

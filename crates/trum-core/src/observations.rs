@@ -87,11 +87,13 @@ mod tests {
 
     #[test]
     fn synth_output_passes_the_reader_and_round_trips() {
-        let m = preset("trum60a").unwrap();
-        let rows = synthesize(&m, &SynthConfig { campaign: Campaign::Combined, ..SynthConfig::default() }).unwrap();
-        let meas = to_measurements(&rows).unwrap();
+        let m = preset("trum60a").expect("preset");
+        let rows =
+            synthesize(&m, &SynthConfig { campaign: Campaign::Combined, ..SynthConfig::default() }).expect("synthesis");
+        let meas = to_measurements(&rows).expect("measurements");
         let text = meas.to_csv_string();
-        let back = crate::measurements::parse_measurements(text.as_bytes(), "synth.csv").unwrap();
+        let back =
+            crate::measurements::parse_measurements(text.as_bytes(), "synth.csv").expect("the written file reads back");
         assert_eq!(back.len(), rows.len());
         assert!(back.warnings.is_empty(), "{:?}", back.warnings);
         let obs = observations(&back, &m);
@@ -99,8 +101,8 @@ mod tests {
             assert_eq!(a.op, b.op);
             let mut x: Vec<(Observable, f64)> = a.readings.iter().map(|r| (r.0, r.1)).collect();
             let mut y = b.readings.clone();
-            x.sort_by(|p, q| p.0.cmp(&q.0));
-            y.sort_by(|p, q| p.0.cmp(&q.0));
+            x.sort_by_key(|p| p.0);
+            y.sort_by_key(|p| p.0);
             assert_eq!(x, y);
         }
     }

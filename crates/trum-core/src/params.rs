@@ -111,7 +111,7 @@ macro_rules! section {
 }
 
 section! {
-    /// Ring geometry and kinematics (seed 000 Table A1, seed 001 Table 1).
+    /// Ring geometry and kinematics (Chen et al. 2020 Table A1, Sun et al. 2021 Table 1).
     Geometry / GeometryPatch = "geometry" {
         /// N: number of traveling waves around the ring (9 for the TRUM-60 family).
         wave_number: PositiveInteger = "number of traveling waves N around the ring [-]",
@@ -119,13 +119,14 @@ section! {
         mean_radius_m: Positive = "mean radius R0 of the contact ring [m]",
         /// b_f: radial width of the contact (friction layer) [m].
         contact_width_m: Positive = "radial width b_f of the friction-layer contact [m]",
-        /// h0: distance from the stator tooth surface to the neutral plane [m] (seed 001 eq. 12).
+        /// h0: distance from the stator tooth surface to the neutral plane [m] (Sun et al.
+        /// 2021 eq. 12).
         neutral_plane_distance_m: Positive = "distance h0 from tooth surface to neutral plane [m]",
     }
 }
 
 section! {
-    /// Friction layer bonded to the rotor (seed 001 eq. 4).
+    /// Friction layer bonded to the rotor (Sun et al. 2021 eq. 4).
     FrictionLayer / FrictionLayerPatch = "friction_layer" {
         /// E_f: Young's modulus of the friction layer [Pa].
         youngs_modulus_pa: Positive = "Young's modulus E_f of the friction layer [Pa]",
@@ -138,7 +139,7 @@ section! {
 
 section! {
     /// Modal model of the stator: one traveling wave = two degenerate standing modes
-    /// (seed 001 eq. 6; seed 000 Appendix A).
+    /// (Sun et al. 2021 eq. 6; Chen et al. 2020 Appendix A).
     Stator / StatorPatch = "stator" {
         /// m: modal mass of each standing mode, mode shape normalised to 1 at the contact surface [kg].
         modal_mass_kg: Positive = "modal mass m of each standing mode [kg]",
@@ -152,7 +153,8 @@ section! {
 }
 
 section! {
-    /// Electrical side of the piezoceramic (seed 000 eq. 7, seed 001 eq. 1 and 15).
+    /// Electrical side of the piezoceramic (Chen et al. 2020 eq. 7, Sun et al. 2021 eq. 1
+    /// and 15).
     Electrical / ElectricalPatch = "electrical" {
         /// C0: clamped capacitance of one phase [F].
         clamped_capacitance_f: NonNegative = "clamped capacitance C0 of one phase [F]",
@@ -164,7 +166,7 @@ section! {
 }
 
 section! {
-    /// Rotor (seed 000 Table A1).
+    /// Rotor (Chen et al. 2020 Table A1).
     Rotor / RotorPatch = "rotor" {
         /// d_r: viscous (bearing/air) rotor damping torque per angular speed [N·m·s].
         viscous_damping_nms: NonNegative = "rotor viscous damping d_r [N m s]",
@@ -176,7 +178,7 @@ section! {
 }
 
 section! {
-    /// Lumped thermal model of the motor (seed 000 eq. 11).
+    /// Lumped thermal model of the motor (Chen et al. 2020 eq. 11).
     Thermal / ThermalPatch = "thermal" {
         /// α: convective heat-transfer coefficient [W/(m²·K)].
         heat_transfer_coefficient_w_per_m2k: Positive = "convective heat-transfer coefficient alpha [W/(m^2 K)]",
@@ -190,7 +192,7 @@ section! {
 }
 
 section! {
-    /// Assembly of the preload path (seed 000 section 4.3).
+    /// Assembly of the preload path (Chen et al. 2020 section 4.3).
     Assembly / AssemblyPatch = "assembly" {
         /// k_sp: axial stiffness of the preload spring (disc spring or gasket) [N/m].
         axial_spring_stiffness_n_per_m: Positive = "axial stiffness of the preload spring [N/m]",

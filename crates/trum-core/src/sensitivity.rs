@@ -110,8 +110,8 @@ impl Linear {
         }
         if out.status == Status::Ok && out.speed_rad_s < 0.0 {
             // The status is the changed motor's at the base state; the correction carried a
-            // point within a step of stall across it (found in review: voltage_sag, μ ×
-            // (1 + 1e-4), Ok at −0.002 rpm where the whole solve stalls). Solve it whole.
+            // point within a step of stall across it (voltage_sag, μ × (1 + 1e-4): Ok at
+            // −0.002 rpm where the whole solve stalls). Solve it whole.
             return None;
         }
         out.efficiency =
@@ -123,7 +123,7 @@ impl Linear {
 /// One steady-state solve of a base point, carried over to nearby motors.
 enum Part {
     /// A running or stalled state, linearised at its fixed point.
-    Smooth(Linear),
+    Smooth(Box<Linear>),
     /// A clamped stator (W = 0, the only fixed point of the amplitude map): a slightly
     /// changed motor is clamped too, and its clamped state is a closed form (with the
     /// effects' fixed point on it, [`solve_clamped`]). Within a forward-difference step of
@@ -138,7 +138,7 @@ impl Part {
         if s.status == Status::Clamped {
             Some(Part::Clamped { active: iterated(p, op) })
         } else {
-            Linear::at(p, op, s).map(Part::Smooth)
+            Linear::at(p, op, s).map(|l| Part::Smooth(Box::new(l)))
         }
     }
 

@@ -1,14 +1,14 @@
 //! Stator modal dynamics: the traveling wave as two degenerate standing modes driven 90°
 //! apart, with the contact's normal and tangential forces acting on them.
 //!
-//! Each mode obeys m·q̈ + c·q̇ + k_s·q = Θ·V_phase + (contact force on the mode)
-//! (seed 001 eq. 6; seed 000 Appendix A, eq. A1-A4 with ε = 0). In steady state the
-//! traveling wave q_A + i·q_B = W·e^{i(ωt−ψ)} gives one complex balance
-//! Θ·V = [k_s + k_add − m·ω² + i·ω·(c + c_t)]·W·e^{−iψ}, where c_t is the equivalent
-//! damping of the friction forces (power taken from the wave / (ω·W)²) and k_add any
-//! stiffness the effects add (preload stiffening, Hertzian softening). This is seed 001
-//! eq. 14 with the friction damping made explicit; see docs/MODEL.md for why the N22·F_N
-//! term of eq. 14 is not in the baseline.
+//! Each mode obeys m·q̈ + c·q̇ + k_s·q = Θ·V_phase + (contact force on the mode) (Sun et
+//! al. 2021 eq. 6; Chen et al. 2020 Appendix A, eq. A1-A4 with ε = 0). In steady state the
+//! traveling wave q_A + i·q_B = W·e^{i(ωt−ψ)} gives one complex balance Θ·V = [k_s + k_add
+//! − m·ω² + i·ω·(c + c_t)]·W·e^{−iψ}, where c_t is the equivalent damping of the friction
+//! forces (power taken from the wave / (ω·W)²) and k_add any stiffness the effects add
+//! (preload stiffening, Hertzian softening). This is Sun et al. 2021 eq. 14 with the
+//! friction damping made explicit; see docs/MODEL.md for why the N22·F_N term of eq. 14 is
+//! not in the baseline.
 
 use crate::contact::{self, Contact};
 use crate::solve::bracket::SignBracket;
@@ -28,7 +28,8 @@ pub fn modal_stiffness_n_per_m(modal_mass_kg: f64, resonance_frequency_hz: f64) 
     modal_mass_kg * w * w
 }
 
-/// Crest tangential surface speed v0 = k·h0·ω·W [m/s] (seed 001 eq. 12, seed 000 eq. 1).
+/// Crest tangential surface speed v0 = k·h0·ω·W [m/s] (Sun et al. 2021 eq. 12, Chen et al.
+/// 2020 eq. 1).
 #[inline]
 pub fn crest_surface_speed_m_s(
     wavenumber_per_m: f64,
@@ -63,7 +64,7 @@ pub fn phase_current_a(
     )
 }
 
-/// Feedback (isolated) electrode voltage amplitude V_f = K_WV·W [V] (seed 001 eq. 1;
+/// Feedback (isolated) electrode voltage amplitude V_f = K_WV·W [V] (Sun et al. 2021 eq. 1;
 /// the printed (√2/2) factor is a typo of the sum of two quadrature terms, and in any
 /// case K_WV is identified from measured data, so it absorbs the constant).
 #[inline]
@@ -74,10 +75,11 @@ pub fn feedback_voltage_v(gain_v_per_m: f64, amplitude_m: f64) -> f64 {
 /// The pressed layer's pressure projected on the mode shape, per unit amplitude and per
 /// N·k_f/k [-]: ∫ (cos θ − c)₊ cos θ dθ over one wavelength, = φ0 − sin φ0·c with
 /// half-angle `phi0_rad` and rotor-plane offset `c` (= cos φ0 in partial contact, ≤ −1 in
-/// full contact, where it is π). The stiffness the contact adds to the mode in seed 002
-/// section 5.3 (the normal contact force on the generalised coordinate, in phase with it);
-/// `preload_stiffening` with modal fraction 1. Equals seed 001 eq. 8's χ(φ0) = 2(sin φ0 −
-/// φ0·c) to leading order in φ0 (both 2φ0³/3) and half of it at full contact.
+/// full contact, where it is π). The stiffness the contact adds to the mode in the
+/// radial-friction paper section 5.3 (the normal contact force on the generalised
+/// coordinate, in phase with it); `preload_stiffening` with modal fraction 1. Equals Sun et
+/// al. 2021 eq. 8's χ(φ0) = 2(sin φ0 − φ0·c) to leading order in φ0 (both 2φ0³/3) and half
+/// of it at full contact.
 #[inline]
 pub fn modal_projection(phi0_rad: f64, c: f64) -> f64 {
     phi0_rad - phi0_rad.sin() * c
@@ -121,8 +123,8 @@ pub fn width_integrated_modal_projection(c: f64) -> f64 {
 // The W-dependent modal stiffness of the steady-state solve (crate::solve): preload
 // stiffening and Hertz softening on the drive's stiffness, and where they cancel the detuning.
 
-/// Seed 003: the softening cubic term by harmonic balance, k − (3/4)·β·W²; this returns
-/// (3/4)·β·(its growth with the preload) [N/m³].
+/// The Hertzian driving-circuit paper (2022): the softening cubic term by harmonic balance,
+/// k − (3/4)·β·W²; this returns (3/4)·β·(its growth with the preload) [N/m³].
 pub(crate) fn softening_per_w2(p: &Prepared, d: &Drive) -> f64 {
     let growth = if p.truth_b {
         (0.8 * p.beta_gain * d.f_n).exp()
@@ -149,12 +151,14 @@ pub(crate) fn modal_stiffness(p: &Prepared, d: &Drive, w: f64, ct: &Contact, a: 
             } else if p.truth {
                 layer * width_integrated_modal_projection(ct.offset)
             } else {
-                // seed 001 eq. 8: k_s' = (2 n k_f / k)·[sin(kx0) − kx0·cos(kx0)] = A·χ(φ0)/W
+                // Sun et al. 2021 eq. 8: k_s' = (2 n k_f / k)·[sin(kx0) − kx0·cos(kx0)] =
+                // A·χ(φ0)/W
                 let axial = a * ct.chi0() / w;
                 if p.modal_fraction == 0.0 {
                     axial
                 } else {
-                    // (exact at both ends: λ = 1 is seed 002's projection bit for bit)
+                    // (exact at both ends: λ = 1 is the radial-friction paper's projection
+                    // bit for bit)
                     let modal = layer * modal_projection(ct.half_angle_rad, ct.offset);
                     (1.0 - p.modal_fraction) * axial + p.modal_fraction * modal
                 }
@@ -173,18 +177,19 @@ pub(crate) fn elastic_detuning(p: &Prepared, d: &Drive, w: f64) -> f64 {
     modal_stiffness(p, d, w, &ct, a) - p.m * d.omega * d.omega
 }
 
-/// The amplitude in (0, `w_top`) where the W-dependent stiffness cancels the detuning
-/// k − m·ω² (Re Z = 0 without friction), where G(W) = Θ·V/|Z(W)| peaks; `None` where
-/// the elastic detuning keeps one sign below `w_top`. Closed forms for one candidate
-/// effect — softening k − ¾βW² (seed 003), stiffening k + s·F/W (A·χ(φ0) = F, seed 001
-/// eq. 8) — else Illinois regula falsi on ln W, the detuning falling monotonically in W.
+/// The amplitude in (0, `w_top`) where the W-dependent stiffness cancels the detuning k −
+/// m·ω² (Re Z = 0 without friction), where G(W) = Θ·V/|Z(W)| peaks; `None` where the
+/// elastic detuning keeps one sign below `w_top`. Closed forms for one candidate effect —
+/// softening k − ¾βW² (the Hertzian driving-circuit paper (2022)), stiffening k + s·F/W
+/// (A·χ(φ0) = F, Sun et al. 2021 eq. 8) — else Illinois regula falsi on ln W, the detuning
+/// falling monotonically in W.
 pub(crate) fn stiffness_crossing(p: &Prepared, d: &Drive, w_top: f64) -> Option<f64> {
     let detuning = d.ks - p.m * d.omega * d.omega;
     let w = match (p.stiffening != 0.0, p.beta != 0.0) {
         (false, false) => return None,
         // the truth form's softening is also ∝ W² (its preload growth differs)
         (false, true) => (detuning > 0.0).then(|| (detuning / softening_per_w2(p, d)).sqrt())?,
-        // (seed 001 eq. 8 alone: A·χ(φ0)/W = F/W)
+        // (Sun et al. 2021 eq. 8 alone: A·χ(φ0)/W = F/W)
         (true, false) if !p.truth && p.modal_fraction == 0.0 => {
             (detuning < 0.0).then(|| p.stiffening * d.f_n / -detuning)?
         }
@@ -247,7 +252,8 @@ mod tests {
         for c in [-1.0, -1.3, -2.0] {
             assert!((modal_projection(PI, c) - projected_pressure(c)).abs() < 1e-11, "full contact, c = {c}");
         }
-        // leading order: both forms 2φ³/3 at a narrow contact; half of seed 001's at full contact
+        // leading order: both forms 2φ³/3 at a narrow contact; half of Sun et al. 2021's at
+        // full contact
         let phi: f64 = 1e-2;
         let chi = 2.0 * (phi.sin() - phi * phi.cos());
         assert!((modal_projection(phi, phi.cos()) / chi - 1.0).abs() < 1e-4);
@@ -255,11 +261,11 @@ mod tests {
     }
 
     /// The truth form's five-point rule against the two-dimensional integral it stands for
-    /// (adaptive over the width of the angle integral): within 5e-4 over wide contacts
-    /// (c ≤ 0.5, φ0 ≥ 60°, where the bench campaigns of trum60a run; 1.0e-4 at most today,
-    /// at −0.8 and −1.1, where the outer strips reach full contact), and it differs in form
-    /// from every blend of seed 001 eq. 8 and the modal projection (the strips reach full
-    /// contact one by one): by 3.5 % at best today, at λ = 1.
+    /// (adaptive over the width of the angle integral): within 5e-4 over wide contacts (c ≤
+    /// 0.5, φ0 ≥ 60°, where the bench campaigns of trum60a run; 1.0e-4 at most today, at
+    /// −0.8 and −1.1, where the outer strips reach full contact), and it differs in form
+    /// from every blend of Sun et al. 2021 eq. 8 and the modal projection (the strips reach
+    /// full contact one by one): by 3.5 % at best today, at λ = 1.
     #[test]
     fn the_width_integrated_projection_is_its_two_dimensional_integral() {
         let exact = |c: f64| {

@@ -1,11 +1,11 @@
-//! Temperature rise of the motor from its losses (seed 000 eq. 11): a single lumped heat
-//! capacity C exchanging heat with ambient air through α·S,
-//! T(t) = T_air + P_loss/(α·S)·(1 − exp(−α·S·t/C)).
-//! The paper's S is the motor's surface area, α the convective coefficient; C is not
-//! given in the paper (the presets document the value assumed).
+//! Temperature rise of the motor from its losses (Chen et al. 2020 eq. 11): a single lumped
+//! heat capacity C exchanging heat with ambient air through α·S, T(t) = T_air +
+//! P_loss/(α·S)·(1 − exp(−α·S·t/C)). The paper's S is the motor's surface area, α the
+//! convective coefficient; C is not given in the paper (the presets document the value
+//! assumed).
 
-/// Temperature rise over ambient after `elapsed_s` of constant loss [K] (seed 000 eq. 11).
-/// Valid for loss ≥ 0, α·S > 0, C > 0, t ≥ 0; t → ∞ gives the steady rise P/(α·S).
+/// Temperature rise over ambient after `elapsed_s` of constant loss [K] (Chen et al. 2020
+/// eq. 11). Valid for loss ≥ 0, α·S > 0, C > 0, t ≥ 0; t → ∞ gives the steady rise P/(α·S).
 pub fn temperature_rise_k(loss_w: f64, alpha_s_w_per_k: f64, heat_capacity_j_per_k: f64, elapsed_s: f64) -> f64 {
     loss_w / alpha_s_w_per_k * (1.0 - (-alpha_s_w_per_k * elapsed_s / heat_capacity_j_per_k).exp())
 }

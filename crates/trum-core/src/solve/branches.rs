@@ -7,8 +7,9 @@ use crate::params::Motor;
 use crate::stator::stiffness_crossing;
 
 /// One steady amplitude of the stator at an operating point: a fixed point of the
-/// harmonic-balance amplitude map W ↦ Θ·V/|Z(W)| (seed 001 eq. 14; with `hertz_softening`
-/// the modal stiffness is k − ¾·β·W², seed 003 eq. 10-12).
+/// harmonic-balance amplitude map W ↦ Θ·V/|Z(W)| (Sun et al. 2021 eq. 14; with
+/// `hertz_softening` the modal stiffness is k − ¾·β·W², the Hertzian driving-circuit paper
+/// (2022) eq. 10-12).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AmplitudeBranch {
     /// Transverse amplitude W [m].
@@ -20,7 +21,7 @@ pub struct AmplitudeBranch {
 
 /// Every steady amplitude at `op`, smallest first: the multi-valued region of a softening
 /// stator (`hertz_softening`) has three (the middle one unstable), elsewhere there is one.
-/// [`solve`] reports the largest stable one (the amplitude reached from above, i.e. when
+/// [`super::solve`] reports the largest stable one (the amplitude reached from above, i.e. when
 /// the frequency is swept down onto the resonance). Effects that iterate on the solution
 /// (thermal state, voltage sag) are not applied here: the drive is the set voltage.
 /// Found by a scan of 400 logarithmically spaced amplitudes from 10⁻⁶ of the bound
@@ -77,15 +78,15 @@ pub fn amplitude_branches(motor: &Motor, op: &OperatingPoint) -> Vec<AmplitudeBr
 }
 
 /// The multi-valued frequency band of the steady response at `op`'s preload, torque and
-/// voltage, where two stable amplitudes coexist: (jump-down, jump-up) frequencies [Hz].
-/// A sweep down in frequency follows the upper branch and drops at the lower edge; a sweep
-/// up follows the lower branch and jumps up at the upper edge (softening, seed 003
-/// section 3). `None` when no frequency of `f_lo_hz..f_hi_hz` (scanned in `steps`,
-/// edges refined by bisection to 0.01 Hz) has two stable amplitudes; an edge beyond the
-/// scan is reported as the scan's end. With the cubic softening term the lower edge often
-/// lies far below the resonance (the upper branch lives as long as ¾·β·W² can cancel
-/// k − m·ω², beyond the validity of a small nonlinearity): the jump-up edge is the
-/// meaningful one there.
+/// voltage, where two stable amplitudes coexist: (jump-down, jump-up) frequencies [Hz]. A
+/// sweep down in frequency follows the upper branch and drops at the lower edge; a sweep up
+/// follows the lower branch and jumps up at the upper edge (softening, the Hertzian
+/// driving-circuit paper (2022) section 3). `None` when no frequency of `f_lo_hz..f_hi_hz`
+/// (scanned in `steps`, edges refined by bisection to 0.01 Hz) has two stable amplitudes;
+/// an edge beyond the scan is reported as the scan's end. With the cubic softening term the
+/// lower edge often lies far below the resonance (the upper branch lives as long as ¾·β·W²
+/// can cancel k − m·ω², beyond the validity of a small nonlinearity): the jump-up edge is
+/// the meaningful one there.
 pub fn jump_frequencies_hz(
     motor: &Motor,
     op: &OperatingPoint,

@@ -64,8 +64,8 @@ pub(super) fn amplitude_rtol(p: &Prepared) -> f64 {
 /// starts it within a hair of its root (7 % fewer integrals). The Coulomb interface instead
 /// carries each angle from the previous trial along its exact derivative in W, with its
 /// sine and cosine: late in the descent that start is the root to rounding and the angle
-/// solves need no `sin_cos` at all (a secant extrapolation of its angles without them had
-/// cost more than it saved, callgrind +7 % a point).
+/// solves need no `sin_cos` at all (a secant extrapolation of its angles without them
+/// costs more than it saves: callgrind +7 % a point).
 struct Trials<'a> {
     p: &'a Prepared,
     d: &'a Drive,
@@ -245,7 +245,8 @@ fn first_step(warm: Option<Trial>, below: Option<Trial>, hi: &Trial) -> f64 {
 ///
 /// Stiffening alone on a mode already stiffer than the drive only moves it further away:
 /// G rises with W below its one fixed point, no branch to step over, no cap (24 → 14
-/// evaluations a point at trum60a, stiffening 1, no point moved in `multi_branch_census`).
+/// evaluations a point at trum60a, stiffening 1, no point of the census of
+/// `multi_branch_stators_report_the_largest_fixed_point` moves).
 /// Not so for softening on a mode below the drive (a long step near clamping lands on a
 /// lower branch).
 #[derive(Clone, Copy)]
@@ -580,17 +581,17 @@ fn fold_window(p: &Prepared, d: &Drive, spike: &Trial, eval: &mut dyn FnMut(f64)
 /// the usual one then. An interval with r < 0 at its lower end that is narrower than
 /// `resolved` (relative) is taken as the answer at once: 1 − MULTI_BRANCH_STEP, the step
 /// the capped descent trusts, from a crossing with r < 0; 0 after the descent. (Returning
-/// at any width was tried by a review: it missed a higher window inside that interval,
-/// generic60 softening 3e17 at 409 N, 1.47 N·m.) A search that finds none costs nothing
+/// at any width would miss a higher window inside that interval: generic60, softening
+/// 3e17, 409 N, 1.47 N·m.) A search that finds none costs nothing
 /// where the descent kept clear of the crossing.
 ///
 /// Both falls held without exception for the Coulomb interface on fine scans (4000
 /// amplitudes from 1e-3 of the crossing to the top, 1740 random points of the
-/// multi-branch test configurations; a review: 10 000 points × 6 000 amplitudes, torque up
-/// to 5 N·m). Under `tangential_compliance` Im Z can jump up where the speed ratio drops
+/// multi-branch test configurations; 10 000 points × 6 000 amplitudes, torque up to
+/// 5 N·m). Under `tangential_compliance` Im Z can jump up where the speed ratio drops
 /// (generic60, stiffening 3.3 and compliance 1 in truth form: 7× over 0.2 % of W), so the
-/// bound above the crossing is not proven there; a review's soundness check (18
-/// configurations, dense grids) found no interval it ruled out that held r < 0.
+/// bound above the crossing is not proven there; on dense grids of 18 configurations no
+/// interval it rules out holds r < 0.
 fn highest_window(
     p: &Prepared,
     d: &Drive,

@@ -18,8 +18,9 @@ use crate::stator;
 /// rises above the set one), a moving one more, so V ↦ G(V) falls with V. Plain passes
 /// there either crawl (ratio ≈ −0.85) or cycle for ever between a clamped and a moving
 /// state (trum60a-like truth motor, 400 N: 200 V → clamped → 217.9 V → moving → 204.0 V →
-/// clamped …); the one consistent state lies between V and G(V) (210.1 V, moving). An
-/// unbounded secant on every pass (tried: 1.6× faster) left that interval.
+/// clamped …); the one consistent state lies between V and G(V) (210.1 V, moving). The
+/// secant step is therefore kept inside that interval ([`bracketed_secant`]): unbounded,
+/// it is faster but can leave it.
 pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
     solve_effects_with(p, op, guess, true, |d, g| solve_drive(p, d, op, g))
 }
@@ -66,17 +67,17 @@ fn solve_effects_with(
         // An electrode voltage that does not settle at some rise on the way (it cycles
         // between a clamped and a moving stator there) does not end the search at once: its
         // last state's losses still point the rise on, and only the state at the final rise
-        // must be settled. (Ending at the first such rise, as first written, ended 3115 of
-        // a review's 4078 remaining failures in a 150 × 150 map, some of which have a
-        // steady state.) But each such rise costs 100 passes, and past a few of them the
+        // must be settled. (Ending at the first such rise would end 3115 of 4078 failures
+        // in a 150 × 150 map, some of which have a steady state.) But each such rise
+        // costs 100 passes, and past a few of them the
         // search rarely ends settled: the third ends it. (Two 150 × 150 maps of
         // docs/RELIABILITY.md: 14-16 s and 2707 + 2658 failures of 45 000 so; unbounded
         // 72-82 s for 1-6 % fewer failures; ending at the first 11-14 s, 5-7 % more.) The
         // search starts from the joint passes' last rise and state.
         // Where that fails too, it is run again with the electrode voltage's lower branch
         // searched at every rise (`settle_lower_branch`); not in the first run, whose path
-        // through the rises it would change where that run settles (a review: two of 1152
-        // points, `ok` before, ended `no_convergence`).
+        // through the rises it would change where that run settles (two of 1152 points
+        // that settle `ok` in the first run end `no_convergence` with it).
         const UNSETTLED_RISES: usize = 2;
         let (from, rise0) = (s.clone(), rise);
         let nested = |lower: bool| {
@@ -274,9 +275,9 @@ fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f6
             if t.w >= t.w_next {
                 return (settled && c.status == Status::Clamped).then_some(c);
             }
-            // It would start: a stall may sit just above W = 0 (a review: 62 such points
-            // of 221 left, e.g. 10 Ω, 490 N, 0.95 N·m, 155 V, 41 kHz: W = 3.2e-8 m at
-            // 154.9 V). Its cap is the first doubling up from there with r ≥ 0.
+            // It would start: a stall may sit just above W = 0 (e.g. 10 Ω, 490 N,
+            // 0.95 N·m, 155 V, 41 kHz: W = 3.2e-8 m at 154.9 V). Its cap is the first
+            // doubling up from there with r ≥ 0.
             cap_from(&d, tiny, 2.0, 40)? / d.v
         }
         Status::Stall | Status::Ok if low.amplitude_m > 0.0 => low.amplitude_m / low.electrode_voltage_v,
@@ -324,7 +325,7 @@ const SAG_SCAN_RATIO: f64 = 0.97;
 /// above the amplitude bound (h > 0 there, steps ×[`SAG_SCAN_RATIO`]) and refined in its sign
 /// change; h > 0 above it, so it is stable when the sag acts (dW/dt ∝ −h) even where, at
 /// its voltage held fixed, it is the amplitude map's unstable middle root, which the other
-/// routes never take (the review of stop 32: 150 Ω, 380 N, 0.2 N·m, 150 V). No root above
+/// routes never take (150 Ω, 380 N, 0.2 N·m, 150 V). No root above
 /// W = 0: the clamped stator at its own voltage, which a tiny amplitude does not start.
 /// `rise` [K]: the temperature rise. `None` where a step or trial has no finite value.
 ///
@@ -358,8 +359,8 @@ fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<S
     // the sample above `hi`, once there is one
     let mut above: Option<(f64, f64)> = None;
     while hi > tiny {
-        // (below a thousandth of the bound, amplitudes of nanometres, the coarse steps of
-        // stop 33: a scan that finds no root costs 289 trials instead of 682)
+        // (below a thousandth of the bound, amplitudes of nanometres, coarse steps: a scan
+        // that finds no root costs 289 trials instead of 682)
         let ratio = if hi > 1e-3 * bound { SAG_SCAN_RATIO } else { 0.8 };
         let w = (ratio * hi).max(tiny);
         let e = h(w);
@@ -485,8 +486,8 @@ pub(crate) fn state_map(
 /// change of x − G(x). Normal points settle within ~15 passes and never reach it.
 const BRACKET_AFTER: usize = 30;
 
-/// Temperature rise driving `thermal_drift`: seed 000 eq. 11 (one lumped capacity) for
-/// the candidate form; the truth form adds a fast near-interface node (40 % of the rise
+/// Temperature rise driving `thermal_drift`: Chen et al. 2020 eq. 11 (one lumped capacity)
+/// for the candidate form; the truth form adds a fast near-interface node (40 % of the rise
 /// with a tenth of the time constant), as the paper's sensor behind the teeth sees.
 pub(super) fn temperature_rise_for_drift(p: &Prepared, loss_w: f64, elapsed_s: f64) -> f64 {
     let ss = loss_w / p.alpha_s;

@@ -207,9 +207,10 @@ pub struct Solution {
     pub phase_lag_rad: f64,
     /// Effective modal stiffness including effects [N/m].
     pub modal_stiffness_n_per_m: f64,
-    /// Steady-state temperature rise of the motor over ambient [K] (seed 000 eq. 11, t → ∞).
+    /// Steady-state temperature rise of the motor over ambient [K] (Chen et al. 2020 eq.
+    /// 11, t → ∞).
     pub temperature_rise_k: f64,
-    /// Temperature rise at the point's elapsed time [K] (seed 000 eq. 11).
+    /// Temperature rise at the point's elapsed time [K] (Chen et al. 2020 eq. 11).
     pub temperature_rise_at_elapsed_k: f64,
     /// Standard deviation of speed over a revolution [rev/min] (nonzero with `eccentricity`).
     pub speed_std_rpm: f64,

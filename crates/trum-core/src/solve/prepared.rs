@@ -43,7 +43,8 @@ pub struct Prepared {
     pub(crate) heat_cap: f64,
     /// `preload_stiffening`: scale s of the contact stiffness added to the mode [-] (0: off).
     pub(crate) stiffening: f64,
-    /// `preload_stiffening`'s modal fraction: 0 seed 001 eq. 8, 1 seed 002's modal projection.
+    /// `preload_stiffening`'s modal fraction: 0 Sun et al. 2021 eq. 8, 1 the
+    /// radial-friction paper's modal projection.
     pub(crate) modal_fraction: f64,
     /// `hertz_softening`: cubic coefficient β at zero preload [N/m³] (0: off).
     pub(crate) beta: f64,

@@ -291,16 +291,15 @@ fn stiffness_crossing_is_where_the_elastic_detuning_changes_sign() {
     assert!(found >= 100 && none >= 100, "{found} crossings, {none} without");
 }
 
-/// Points a review found on a lower branch or clamped (stop 15): the truth form's
-/// stiffening had no spike probe (generic60); the softening spike at Re Z = 0 missed
-/// a window of r < 0 just below it, near the fold (trum60-qut). That truth form was seed
-/// 002's modal projection, which is now the candidate at `modal_fraction = 1`.
-/// Preload stiffening by seed 002's modal projection (the truth form until stop 34).
+/// Preload stiffening by the modal projection of the radial-friction paper (`modal_fraction
+/// = 1`) at strength 3.3046, where the descent needs the spike probe of the stiffness
+/// crossing to reach the upper branch (generic60).
 const MODAL_3_3: &str = "preload_stiffening:stiffness_scale=3.3046,modal_fraction=1";
+/// The same projection at strength 1.
 const MODAL_1: &str = "preload_stiffening:stiffness_scale=1,modal_fraction=1";
 
 #[test]
-fn review_points_reach_the_upper_branch() {
+fn points_near_the_fold_reach_the_upper_branch() {
     for (name, fx, op) in [
         ("generic60", MODAL_3_3, OperatingPoint::new(476.2, 0.8427, 112.15, 44467.8)),
         (
@@ -313,7 +312,7 @@ fn review_points_reach_the_upper_branch() {
         let (problem, s, _) = largest_fixed_point_problem(&m, &op);
         assert!(problem.is_none(), "{name} {fx}: {problem:?}");
         assert!(s.status.is_valid(), "{name}: {:?}", s.status);
-        // the stable branch the review found: 10.12 µm; at the fold, 0.9997 of the
+        // the stable upper branch: 10.12 µm; at the fold, 0.9997 of the
         // stiffness crossing (5.96 µm; the log scan alone saw only 0.546 µm)
         let expected = if name == "generic60" { 10.12e-6 } else { 5.96e-6 };
         assert!((s.amplitude_m / expected - 1.0).abs() < 2e-3, "{name}: {:e} m", s.amplitude_m);
@@ -322,15 +321,14 @@ fn review_points_reach_the_upper_branch() {
     }
 }
 
-/// Points whose largest root lies in a window of r < 0 the descent did not reach first,
-/// found by a stop-25 review's random run and a 200 000-point census (and fixed with
-/// `highest_window`):
+/// Points whose largest root lies in a window of r < 0 that the descent does not reach
+/// first (from a random run and a 200 000-point census), which `highest_window` finds:
 /// - above the stiffness crossing (friction damping falls with W, so |Z| keeps falling
-///   past it), where searching the fold window below the crossing first ended on the
-///   lower branch (the first point: 0.478 µm instead of 2.18 µm), or the descent's
-///   capped steps went over a window 0.7-3 % wide and it ended clamped;
-/// - below it, where the fold window's search found the lower branch's window and not
-///   the one above it (the first of those: 1.24 µm instead of 2.26 µm).
+///   past it), where searching the fold window below the crossing first would end on the
+///   lower branch (the first point: 0.478 µm instead of 2.18 µm), or the descent's capped
+///   steps go over a window 0.7-3 % wide and it would end clamped;
+/// - below it, where the fold window's search finds the lower branch's window and not the
+///   one above it (the first of those: 1.24 µm instead of 2.26 µm).
 #[test]
 fn windows_the_descent_steps_over_still_hold_the_largest_root() {
     const BOTH: &str = "preload_stiffening=1;hertz_softening=1e18";
@@ -341,11 +339,11 @@ fn windows_the_descent_steps_over_still_hold_the_largest_root() {
         ("trum60a", "hertz_softening=1e18", false, OperatingPoint::new(492.619, 0.701395, 162.961, 40361.9), true),
         ("trum60a", "hertz_softening=1e18", false, OperatingPoint::new(598.512, 0.555832, 170.570, 38155.7), true),
         ("trum60a", BOTH, true, OperatingPoint::new(596.554, 0.228730, 168.347, 42206.1), true),
-        // a window 0.4 % wide at 1.047 of the crossing (a review; the reference scan
-        // went only to 1.02 of the crossing then and passed the clamped-like 1.98e-8 m)
+        // a window 0.4 % wide at 1.047 of the crossing (a reference scan that ends at
+        // 1.02 of the crossing misses it and accepts the clamped-like 1.98e-8 m)
         ("trum60a", BOTH, true, OperatingPoint::new(488.149312, 0.6318092, 154.291230, 43570.8501), true),
         // r < 0 at the crossing itself, and a higher window above it than the one the
-        // bracket [crossing, top] converged in (a review; the second 12-25× the crossing)
+        // bracket [crossing, top] would converge in (the second 12-25× the crossing)
         (
             "trum60a",
             "hertz_softening=1e18",
@@ -360,7 +358,7 @@ fn windows_the_descent_steps_over_still_hold_the_largest_root() {
             OperatingPoint::new(310.906458, 0.28872648, 100.388775, 40749.024),
             true,
         ),
-        // (the truth form of stop 25 was seed 002's projection: the candidate at λ = 1)
+        // (the modal projection of the radial-friction paper: the candidate at λ = 1)
         ("trum60a", MODAL_1, false, OperatingPoint::new(194.551, 1.386416, 80.8638, 44049.04), false),
         (
             "trum60-qut",
@@ -460,7 +458,7 @@ fn a_sag_fixed_point_at_a_fold_settles_within_the_amplitude_solves_noise() {
 /// state (its current sags the electrode voltage below the fold) but a stalled one (its
 /// smaller current lets the voltage recover, and the rotor at rest stays at rest): the
 /// point is a stall, a lower fixed point of the amplitude map at its own sagged
-/// voltage. These three were `no_convergence` before the lower branch was searched.
+/// voltage. Without the lower-branch search these three end `no_convergence`.
 #[test]
 fn a_sagging_drive_stalls_where_its_running_state_sags_past_the_fold() {
     let m = motor_with("trum60a", "voltage_sag=10", false);
@@ -526,11 +524,11 @@ fn a_sagging_drive_stalls_just_above_clamping_where_a_clamped_stator_would_start
 }
 
 /// Where the electrode voltage's passes hunt between states (150 Ω, 380 N, 0.2 N·m,
-/// 150 V, 41 kHz; a stop-32 review), the sagging drive's steady state is the middle
+/// 150 V, 41 kHz), the sagging drive's steady state is the middle
 /// root of the amplitude map at its own voltage: unstable with the voltage held there
 /// (a slightly larger amplitude grows towards the upper root, which the descent from the
 /// top takes), stable with the sag acting (that larger amplitude draws the voltage down
-/// until it shrinks back). It was `no_convergence`.
+/// until it shrinks back). The electrode voltage's passes alone end `no_convergence`.
 #[test]
 fn a_sagging_drive_settles_on_the_middle_root_where_its_passes_hunt() {
     let (p, op, s) = sagging_trum60a(150.0, OperatingPoint::new(380.0, 0.2, 150.0, 41_000.0));
@@ -554,8 +552,8 @@ fn a_sagging_drive_settles_on_the_middle_root_where_its_passes_hunt() {
 /// Where the passes find no state, a sagging drive takes the largest root of its balance
 /// h(W) = W − Θ·V_e(W)/|Z(W)| (the upper-branch convention). A point of the trum60a map
 /// at 150 Ω and 41 kHz (grid 300-560 N × 120-180 V: 458.6 N, 0 N·m, 166.7 V): there h
-/// dips below zero at 3.45 µm over less than one step ×0.8, and the scan of stop 33
-/// passed over it to a root at 1.35 µm, 31.9 rpm, where its neighbours at lower preload
+/// dips below zero at 3.45 µm over less than one step ×0.8, so a scan in such steps
+/// passes over it to a root at 1.35 µm, 31.9 rpm, where its neighbours at lower preload
 /// run at 174-227 rpm. A dense scan (×0.999) finds no root above the answer.
 #[test]
 fn a_sagging_drive_takes_the_largest_root_of_its_balance() {
@@ -578,8 +576,8 @@ fn a_sagging_drive_takes_the_largest_root_of_its_balance() {
 /// within 2 ± 0.0085, narrower than the triple's spacing (1.9, 1.98, 2.15): the search
 /// moves its bracket (two probes that miss) before it lands in the dip, and brackets the
 /// top root. With 0.8 in place of 1.2 there is no root: none. A dip away from the
-/// triple's least point, narrower than the probes near it, is not found (a review's
-/// case: 1 + 10(w − 1.99)² − 1.5·exp(−((w − 2.045)/0.004)²) about the sample at 2.0).
+/// triple's least point, narrower than the probes near it, is not found
+/// (1 + 10(w − 1.99)² − 1.5·exp(−((w − 2.045)/0.004)²) about the sample at 2.0).
 /// A non-finite value is an error.
 #[test]
 fn the_dip_search_brackets_the_top_root_of_a_narrow_dip() {
@@ -608,9 +606,9 @@ fn the_dip_search_brackets_the_top_root_of_a_narrow_dip() {
 }
 
 /// Every point of a sagging trum60a near resonance has a steady state that is a fixed
-/// point of both maps: 150 Ω, 41 kHz, 360-520 N, 0-1.4 N·m, 120-165 V. Before the
-/// amplitude-root route (`settle_on_amplitude`) 73 of these 288 points were
-/// `no_convergence`; every other point keeps its state.
+/// point of both maps: 150 Ω, 41 kHz, 360-520 N, 0-1.4 N·m, 120-165 V. Without the
+/// amplitude-root route (`settle_on_amplitude`) 73 of these 288 points end
+/// `no_convergence`.
 #[test]
 fn a_sagging_drive_near_resonance_has_a_steady_state_everywhere() {
     let m = motor_with("trum60a", "voltage_sag=150", false);
@@ -696,9 +694,9 @@ fn every_sagging_state_is_a_fixed_point_of_both_maps() {
 
 /// Just past a fold, where r has a minimum a hair above zero, the descent goes on down
 /// instead of crawling on noisy secants: this drive (a rise of 40 K and 131.064 V on the
-/// electrode, reached inside the sag and thermal fixed point) took 82 trials and ended
-/// in no convergence before the secant's noise floor; 64 now (the stretched steps
-/// double from r = 2.6e-18 m).
+/// electrode, reached inside the sag and thermal fixed point) takes 64 trials with the
+/// secant's noise floor (the stretched steps double from r = 2.6e-18 m); without it, 82
+/// trials and no convergence.
 #[test]
 fn the_descent_does_not_crawl_just_past_a_fold() {
     let (_, p) = sag_and_drift_trum60a();
@@ -716,7 +714,7 @@ fn the_descent_does_not_crawl_just_past_a_fold() {
 const MULTI_BRANCH_CONFIGS: [(&str, &str, bool); 12] = [
     ("generic60", "preload_stiffening=0.504", false),
     ("trum60a", "preload_stiffening=1", false),
-    // the candidate's other forms: seed 002's projection, and a blend
+    // the candidate's other forms: the radial-friction paper's projection, and a blend
     ("generic60", MODAL_3_3, false),
     ("trum60a", "preload_stiffening:stiffness_scale=1,modal_fraction=0.5", false),
     ("trum60a", "hertz_softening=1e18", false),
@@ -733,10 +731,10 @@ const MULTI_BRANCH_CONFIGS: [(&str, &str, bool); 12] = [
 /// truth forms, alone and together) the cold solve still reports the largest fixed
 /// point, the state reached from above; 1000 random points per configuration, each
 /// with its own seed (≈ 15 s in release, mostly the reference's dense scan;
-/// `-- --nocapture` prints the census with the mean amplitude evaluations). Before the capped descent and the softening spike
-/// probe, 118 of 600 candidate-form points were on a lower branch or clamped; before
-/// the truth-form crossing and the fold search, a stop-15 review found 26 of 4000
-/// truth-form points so, and about 8 % with both effects on.
+/// `-- --nocapture` prints the census with the mean amplitude evaluations). Without the
+/// capped descent and the softening spike probe, 118 of 600 candidate-form points end on
+/// a lower branch or clamped; without the truth-form crossing and the fold search, 26 of
+/// 4000 truth-form points, and about 8 % with both effects on.
 #[test]
 fn multi_branch_stators_report_the_largest_fixed_point() {
     let mut all = Vec::new();

@@ -18,20 +18,21 @@ use std::f64::consts::PI;
 /// So do preload stiffening and Hertz softening: G then need not rise with W, the previous
 /// amplitude is no bound of the largest fixed point (the cold descent is capped for them,
 /// docs/EFFECTS.md), and a sweep carrying the branch of its chunk's first point would
-/// differ from the cold solve by whole branches and make maps depend on their chunking (found in review: generic60 with a strong softening,
-/// 394 rpm in the sweep, 70 rpm cold). A sweep gives the cold answer.
+/// differ from the cold solve by whole branches and make maps depend on their chunking
+/// (generic60 with a strong softening: 394 rpm in such a sweep, 70 rpm cold). A sweep
+/// gives the cold answer.
 ///
 /// `last` = the solution of the point solved just before (it warm-starts the inner angle
 /// solves); `history` = the points solved before this one, oldest first, the newest being
-/// `last`'s (a sweep keeps the last [`SWEEP_HISTORY`]). The newest is the warm start's bound. Where earlier ones lie on
-/// this point's torque line too, the amplitude extrapolated through them (Lagrange, up to
-/// quadratic) is tried first: within about 1e-6 of the root, where the bound is a whole
-/// torque step (1e-3) away. The first Newton step from there takes the trial's exact slope
-/// of r (every warm trial has one: the baseline Coulomb interface), and lands
-/// within the tolerance at 99 % of the running points of trum60a's 100-torque rows (2.02
-/// trials a point). The contact and stick angles are extrapolated the same way for the first
-/// trial's angle solves. Where r ≥ 0 at the prediction it is the top of the descent,
-/// else it and the bound bracket the root.
+/// `last`'s (a sweep keeps the last [`SWEEP_HISTORY`]). The newest is the warm start's
+/// bound. Where earlier ones lie on this point's torque line too, the amplitude
+/// extrapolated through them (Lagrange, up to quadratic) is tried first: within about 1e-6
+/// of the root, where the bound is a whole torque step (1e-3) away. The first Newton step
+/// from there takes the trial's exact slope of r (every warm trial has one: the baseline
+/// Coulomb interface), and lands within the tolerance at 99 % of the running points of
+/// trum60a's 100-torque rows (2.02 trials a point). The contact and stick angles are
+/// extrapolated the same way for the first trial's angle solves. Where r ≥ 0 at the
+/// prediction it is the top of the descent, else it and the bound bracket the root.
 pub(crate) fn solve_in_sweep(
     p: &Prepared,
     motor: &Motor,
