@@ -14,7 +14,7 @@ same operating points of the trum60a preset (200 V, 43 kHz, preload x load torqu
 
 It checks that all three give the same status and the same numbers to 1e-9 relative, and
 prints the time per point and the ratios (relative differences: against the value, or
-against 1e-3 of the quantity's largest value over the grid where the value is smaller). Equations (seed 000/001, docs/MODEL.md):
+against 1e-3 of the quantity's largest value over the grid where the value is smaller). Equations (Chen et al. 2020/001, docs/MODEL.md):
 
   k = N/R0, k_f = E_f b_f/h_f, A = 2N k_f W/k, y = F/A
   contact: sin φ0 − φ0 cos φ0 = y (φ0 < π, c = cos φ0); y ≥ π: φ0 = π, c = −y/π

@@ -1,4 +1,4 @@
-"""The transient stick-slip model of trum-core (seed 004; crates/trum-core/src/dynamics/
+"""The transient stick-slip model of trum-core (the bar-type transient paper; crates/trum-core/src/dynamics/
 transient.rs) written again with SciPy's solve_ivp, to compare speed and the settled result
 with the Rust integrator (called through `trum.step`).
 

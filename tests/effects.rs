@@ -45,7 +45,7 @@ fn zero_strength_reproduces_the_baseline_exactly() {
     }
 }
 
-/// Seed 002: radial friction is over half the interface loss at low torque, and
+/// the radial-friction paper: radial friction is over half the interface loss at low torque, and
 /// neglecting it over-predicts no-load speed and stall torque.
 #[test]
 fn radial_friction_matches_seed002_claims() {
@@ -83,7 +83,7 @@ fn speed_optimal_frequency(m: &Motor, f_n: f64) -> f64 {
     0.5 * (a + b)
 }
 
-/// Seed 001 eq. 8/14, seed 002 section 5.3: the contact stiffens the mode, so the
+/// Sun et al. 2021 eq. 8/14, the radial-friction paper section 5.3: the contact stiffens the mode, so the
 /// speed-optimal frequency moves up with preload (the baseline's does not move).
 #[test]
 fn preload_stiffening_moves_the_optimal_frequency_up_with_preload() {
@@ -97,7 +97,7 @@ fn preload_stiffening_moves_the_optimal_frequency_up_with_preload() {
     assert!(s1.modal_stiffness_n_per_m > at(&base, 250.0, 0.0).modal_stiffness_n_per_m);
 }
 
-/// Seed 003: the softening cubic term lowers the resonance, more at higher voltage.
+/// the Hertzian driving-circuit paper (2022): the softening cubic term lowers the resonance, more at higher voltage.
 #[test]
 fn hertz_softening_shifts_resonance_down_with_amplitude() {
     let base = preset("trum60a").unwrap();
@@ -110,7 +110,7 @@ fn hertz_softening_shifts_resonance_down_with_amplitude() {
     assert!(hi < lo, "softening grows with voltage: {hi} vs {lo}");
 }
 
-/// Seed 003 section 3: a softening stator has a band below its linear resonance where
+/// the Hertzian driving-circuit paper (2022) section 3: a softening stator has a band below its linear resonance where
 /// three steady amplitudes coexist (the middle one unstable); the band widens towards
 /// lower frequencies with the drive voltage; outside it, and without the effect, there is
 /// one. The solver's amplitude is always one of the stable branches.
@@ -150,7 +150,7 @@ fn hertz_softening_has_a_multivalued_band_with_jump_frequencies() {
     assert_eq!(jump_frequencies_hz(&base, &op(200.0, 0.0), 30e3, 46e3, 160), None);
 }
 
-/// Seed 000 eq. 11 and section 4.2: the motor warms over a run and the speed drifts down.
+/// Chen et al. 2020 eq. 11 and section 4.2: the motor warms over a run and the speed drifts down.
 #[test]
 fn thermal_drift_makes_speed_fall_over_a_run() {
     let m = typical(Effect::ThermalDrift);
@@ -199,7 +199,7 @@ fn thermal_drift_damping_grows_with_temperature_and_slows_the_rotor() {
     }
 }
 
-/// Seed 001 section 3.1: the electrode voltage falls as the load current grows with
+/// Sun et al. 2021 section 3.1: the electrode voltage falls as the load current grows with
 /// preload and torque.
 #[test]
 fn voltage_sag_grows_with_preload_and_torque() {
@@ -213,7 +213,7 @@ fn voltage_sag_grows_with_preload_and_torque() {
     assert!(at(&m, 250.0, 0.3).speed_rpm < at(&preset("trum60a").unwrap(), 250.0, 0.3).speed_rpm);
 }
 
-/// Seed 000 section 4.3: an eccentric rotor makes the speed fluctuate once per revolution;
+/// Chen et al. 2020 section 4.3: an eccentric rotor makes the speed fluctuate once per revolution;
 /// the fluctuation grows with the runout.
 #[test]
 fn eccentricity_makes_speed_fluctuate() {
@@ -227,7 +227,7 @@ fn eccentricity_makes_speed_fluctuate() {
     assert!(bal.abs() < 1e-8 * s2.input_power_w);
 }
 
-/// Storck and Wallaschek / seed 004: shear compliance lets the contact slip partially
+/// Storck and Wallaschek / the bar-type transient paper: shear compliance lets the contact slip partially
 /// around the stick points, lowering the speed at every load and rounding the
 /// speed–torque curve (no corner at stall).
 #[test]

@@ -10,7 +10,7 @@ fn no_load(motor: &str, f_n: f64, v: f64, f_hz: f64) -> trum_core::Solution {
     solve(&m, &OperatingPoint::new(f_n, 0.0, v, f_hz))
 }
 
-/// Seed 000 section 4.3: contact angle 24.15° at 150 N and 28.94° at 200 N (200 V,
+/// Chen et al. 2020 section 4.3: contact angle 24.15° at 150 N and 28.94° at 200 N (200 V,
 /// 43 kHz). The preset's friction-layer modulus is calibrated on the first value, so it
 /// must match to the calibration's rounding (0.05°); the second is a prediction, within
 /// 1.2° (the paper's own polynomial eq. 12 gives 28.58°, 0.36° off its quoted value).
@@ -28,7 +28,7 @@ fn trum60a_contact_angle_matches_seed000() {
     assert!(slope > 0.025 && slope < 0.05, "slope {slope} deg/N");
 }
 
-/// Seed 001 Table 2: no-load speed and feedback voltage of the TRUM-60 at four preloads
+/// Sun et al. 2021 Table 2: no-load speed and feedback voltage of the TRUM-60 at four preloads
 /// (assumed 150 V, 42 kHz). The preset is a least-squares fit of the baseline to these
 /// eight numbers; the baseline cannot follow the speed rise from 100 N to 200 N (see
 /// docs/DIAGNOSIS.md), so the stated tolerances are 25 % on speed and 20 % on voltage.
@@ -44,7 +44,7 @@ fn trum60_qut_reproduces_seed001_table2_within_stated_tolerance() {
 }
 
 /// Zero load without rotor damping: the driving and braking integrals balance,
-/// 2χ(θs) = χ(φ0) (seed 001 eq. 11 with M_T = 0).
+/// 2χ(θs) = χ(φ0) (Sun et al. 2021 eq. 11 with M_T = 0).
 #[test]
 fn zero_load_balances_driving_and_braking() {
     let mut m = preset("generic60").unwrap();

@@ -170,7 +170,7 @@ fn voltage_sag_maps_converge_everywhere() {
 /// damped → fewer losses → cooler, so the temperature passes alternated (88 K, 10 K, 73 K,
 /// … at 450 N, 250 V, 600 s) and 100 of them were reported as converged 1e-7 away. Every
 /// point must now settle, and the reported temperature rise must be the one its own losses
-/// produce: ΔT(t) = P_loss/(h·S)·(1 − e^(−t·h·S/C)) (seed 000 eq. 11, the candidate form).
+/// produce: ΔT(t) = P_loss/(h·S)·(1 − e^(−t·h·S/C)) (Chen et al. 2020 eq. 11, the candidate form).
 #[test]
 fn thermal_drift_fixed_point_is_self_consistent() {
     use trum_core::effects::Effect;

@@ -176,12 +176,7 @@ impl Case {
         // residuals are (prediction − reading)/σ; a point without a solution counts 50 σ
         let z = trum_core::calibrate::residuals(&truth, rows);
         let sigmas = rows.iter().flat_map(|r| r.readings.iter().map(|x| (x.0, x.2)));
-        let clip = trum_core::diagnose::OUTLIER_Z2;
-        let sum: f64 = z
-            .iter()
-            .zip(sigmas)
-            .map(|(z, (o, s))| (z * s / scale[&o]).powi(2).min(clip * (s / scale[&o]).powi(2)))
-            .sum();
+        let sum: f64 = z.iter().zip(sigmas).map(|(z, (o, s))| (z * s / scale[&o]).powi(2)).sum();
         (sum / z.len().max(1) as f64).sqrt()
     }
 
@@ -391,9 +386,7 @@ pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
 
 /// `1 − oracle/before` for the case whose data file is `data` and diagnosis JSON `v`: the
 /// true motor's held-out NRMSE against the baseline's, both from the JSON's held-out
-/// readings on the diagnosis's quantity scales, each reading's miss counted at most as a
-/// [`trum_core::diagnose::OUTLIER_Z2`]-σ one as the diagnosis counts it (σ: the stated
-/// default noise level).
+/// readings on the diagnosis's quantity scales.
 fn oracle_shrink(case: &Case, data: &std::path::Path, v: &serde_json::Value, _before: f64) -> f64 {
     use trum_core::calibrate::Observable;
     let bytes = std::fs::read(data).expect("case CSV");
@@ -401,7 +394,6 @@ fn oracle_shrink(case: &Case, data: &std::path::Path, v: &serde_json::Value, _be
     let bench = trum_core::bench::observations(&m, &nominal());
     let scale = trum_core::diagnose::nrmse_scales(&bench.rows, &bench.groups);
     let held = v["heldout"].as_array().expect("heldout");
-    let clip = trum_core::diagnose::OUTLIER_Z2;
     let sum: f64 = held
         .iter()
         .map(|h| {
@@ -409,7 +401,7 @@ fn oracle_shrink(case: &Case, data: &std::path::Path, v: &serde_json::Value, _be
             let o = Observable::ALL.into_iter().find(|o| o.column() == q).expect("known quantity");
             // a point the baseline cannot solve is predicted as 0, as in the diagnosis
             let (y, b) = (h["measured"].as_f64().expect("measured"), h["baseline"].as_f64().unwrap_or(0.0));
-            ((b - y) / scale[&o]).powi(2).min(clip * (o.default_sigma(y) / scale[&o]).powi(2))
+            ((b - y) / scale[&o]).powi(2)
         })
         .sum();
     let before = (sum / held.len() as f64).sqrt();

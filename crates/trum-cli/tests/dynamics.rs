@@ -94,7 +94,7 @@ fn resonance_csv_has_every_branch_the_jumps_and_status_rows() {
     let eff = o.effective(&op).expect("valid");
     assert!((bb[0].0 - eff.linear_resonance_hz()).abs() < 1e-9 && bb[0].1 == 0.0);
     assert!(bb.windows(2).all(|w| w[1].0 < w[0].0 && w[1].1 > w[0].1));
-    // hysteresis grows with voltage (seed 003 Fig. 11a)
+    // hysteresis grows with voltage (the Hertzian driving-circuit paper (2022) Fig. 11a)
     let band = |v: &str| {
         let f = |b: &str| rows.iter().find(|r| r[0] == v && r[3] == b).map(|r| num(&r[2])).expect("jump row");
         f("jump_up") - f("jump_down")
@@ -128,7 +128,7 @@ fn resonance_plots_and_preload_family() {
         "-",
     ]);
     assert!(std::fs::read_to_string(&svg).expect("svg").starts_with("<svg"));
-    // the peak amplitude grows with preload (seed 003 Fig. 12)
+    // the peak amplitude grows with preload (the Hertzian driving-circuit paper (2022) Fig. 12)
     let (_, rows) = csv_rows(&csv);
     let peak =
         |n: &str| rows.iter().filter(|r| r[1] == n && r[3] != "backbone").map(|r| num(&r[5])).fold(0.0, f64::max);
@@ -315,7 +315,7 @@ fn step_prints_metrics_against_the_steady_solver_and_writes_files() {
             s => assert_eq!(s, "stick"),
         }
     }
-    // full contact at 20 us, all three zones once running (seed 004 Fig. 10)
+    // full contact at 20 us, all three zones once running (the bar-type transient paper Fig. 10)
     assert!(rows[..64].iter().all(|r| r[7] != "no_contact"));
     for s in ["stick", "slip", "no_contact"] {
         assert!(rows[64..].iter().any(|r| r[7] == s), "no {s} node at 3.5 ms");

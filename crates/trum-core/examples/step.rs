@@ -1,4 +1,4 @@
-//! Step response of the rotor speed (transient model, seed 004) and the timing figure.
+//! Step response of the rotor speed (transient model, the bar-type transient paper) and the timing figure.
 //!
 //! `cargo run --release -p trum-core --example step [preset] [voltage_v] [frequency_hz] [phase_deg] [ratio]`
 

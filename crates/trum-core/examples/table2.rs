@@ -1,4 +1,4 @@
-//! Diagnosis of seed 001 Table 2 (no-load speed and feedback voltage at four preloads)
+//! Diagnosis of Sun et al. 2021 Table 2 (no-load speed and feedback voltage at four preloads)
 //! with the trum60-qut preset; prints what docs/DIAGNOSIS.md reports.
 use trum_core::*;
 fn main() {

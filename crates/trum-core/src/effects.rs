@@ -94,7 +94,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         name: "radial_friction",
         summary: "stator surface points also slip radially; friction acts along the total slip, \
                   driving force drops and radial slip dissipates power",
-        source: "seed 002 (radial friction in the contact mechanism), eq. 19-21 and 27",
+        source: "the radial-friction paper (radial friction in the contact mechanism), eq. 19-21 and 27",
         params: &[EffectParam {
             name: "radial_velocity_ratio",
             doc: "peak radial surface speed over peak tangential surface speed [-]",
@@ -109,7 +109,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         name: "preload_stiffening",
         summary: "the pressed friction layer adds stiffness to the stator mode: resonance moves up \
                   and amplitude changes with preload",
-        source: "seed 001 eq. 8 and 14; seed 002 section 5.3",
+        source: "Sun et al. 2021 eq. 8 and 14; the radial-friction paper section 5.3",
         params: &[
             EffectParam {
                 name: "stiffness_scale",
@@ -122,8 +122,8 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
             EffectParam {
                 name: "modal_fraction",
                 doc: "how the pressure becomes modal stiffness [-]: 0 the axial force over the \
-                      amplitude (seed 001 eq. 8), 1 its projection on the mode shape (seed 002 \
-                      section 5.3), between a blend of the two",
+                      amplitude (Sun et al. 2021 eq. 8), 1 its projection on the mode shape \
+                      (the radial-friction paper, section 5.3), between a blend of the two",
                 typical: 0.0,
                 min: 0.0,
                 max: 1.0,
@@ -136,7 +136,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         name: "hertz_softening",
         summary: "softening cubic restoring force at high amplitude: resonance shifts down with \
                   amplitude, growing with preload",
-        source: "seed 003 eq. 2-4 and 10-12",
+        source: "the Hertzian driving-circuit paper (2022) eq. 2-4 and 10-12",
         params: &[
             EffectParam {
                 name: "beta_n_per_m3",
@@ -161,7 +161,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         name: "thermal_drift",
         summary: "losses heat the stator over a run; modal stiffness, modal damping and friction \
                   change with temperature, so speed drifts",
-        source: "seed 000 eq. 11 and section 4.2",
+        source: "Chen et al. 2020 eq. 11 and section 4.2",
         params: &[
             EffectParam {
                 name: "stiffness_coefficient_per_k",
@@ -196,7 +196,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         name: "voltage_sag",
         summary: "the driver cannot hold the set voltage: the electrode voltage falls with the \
                   load current through the driver's output impedance",
-        source: "seed 001 section 3.1",
+        source: "Sun et al. 2021 section 3.1",
         params: &[EffectParam {
             name: "source_resistance_ohm",
             doc: "output resistance of the drive electronics per phase [ohm]",
@@ -211,7 +211,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         name: "eccentricity",
         summary: "assembly error makes the preload vary once per revolution; contact angle and \
                   speed fluctuate and the mean speed shifts",
-        source: "seed 000 section 4.3 and eq. 12",
+        source: "Chen et al. 2020 section 4.3 and eq. 12",
         params: &[EffectParam {
             name: "runout_m",
             doc: "once-per-revolution axial runout of the rotor [m]",
@@ -226,7 +226,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         name: "tangential_compliance",
         summary: "shear compliance of the friction layer: partial stick inside the contact and a \
                   smooth speed-torque curve instead of a sharp stall",
-        source: "seed 004 eq. 1-2; Storck and Wallaschek, Int. J. Non-Linear Mech. 38 (2003)",
+        source: "the bar-type transient paper eq. 1-2; Storck and Wallaschek, Int. J. Non-Linear Mech. 38 (2003)",
         params: &[EffectParam {
             name: "shear_compliance_ratio",
             doc: "ratio of tangential to normal compliance of the friction layer [-]",
@@ -541,7 +541,7 @@ impl Effects {
                         seen[idx] = true;
                     }
                     // a shape parameter left out keeps its typical value (files written before
-                    // `preload_stiffening` had one stay valid, with seed 001 eq. 8); a strength
+                    // `preload_stiffening` had one stay valid, with Sun et al. 2021 eq. 8); a strength
                     // left out is an error
                     for ((p, x), s) in info.params.iter().zip(v.iter_mut()).zip(seen.iter_mut()) {
                         if p.shape && !*s {
@@ -684,7 +684,7 @@ mod tests {
     }
 
     /// A motor file's effect table may leave out a shape parameter (files written before
-    /// `preload_stiffening` had `modal_fraction` stay valid, with seed 001 eq. 8), not a
+    /// `preload_stiffening` had `modal_fraction` stay valid, with Sun et al. 2021 eq. 8), not a
     /// strength; `to_toml` writes every parameter and reads back the same.
     #[test]
     fn a_table_may_leave_out_a_shape_parameter_not_a_strength() {

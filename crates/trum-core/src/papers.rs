@@ -1,9 +1,9 @@
 //! Closed forms of the source papers, each implemented **exactly as printed** and, where the
 //! printed form disagrees with its own defining integral, also in a corrected form.
 //!
-//! * [`chen2020`]: seed 000, Chen, Zheng, Fan, *Pre-pressure optimization for ultrasonic
+//! * [`chen2020`]: Chen et al. 2020, Chen, Zheng, Fan, *Pre-pressure optimization for ultrasonic
 //!   motors based on multi-sensor fusion*, Sensors 2020, 20, 2096.
-//! * [`sun2021`]: seed 001, Sun, Yin, Liu, Zhang, *Efficiency model for traveling wave-type
+//! * [`sun2021`]: Sun et al. 2021, Sun, Yin, Liu, Zhang, *Efficiency model for traveling wave-type
 //!   ultrasonic motors based on contact variables and preload*, Actuators 2021, 10, 158.
 //!
 //! Every closed form is checked in the module tests against adaptive Gauss–Kronrod

@@ -1,5 +1,5 @@
 //! `trum synth`: bench data with known effects. Generates measurement campaigns like a
-//! real test bench (seed 000 section 3-4, seed 001 section 3): the "true" motor is the
+//! real test bench (Chen et al. 2020 section 3-4, Sun et al. 2021 section 3): the "true" motor is the
 //! nominal one with its uncertain parameters perturbed (so calibration has something to
 //! absorb) and the chosen effects switched on — by default in their **truth forms**,
 //! which differ in form from the candidates the diagnosis fits — and every reading gets

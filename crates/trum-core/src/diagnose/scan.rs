@@ -5,8 +5,8 @@
 //! strength, so that the solves stay easy; a real motor's effect need not be small, and a
 //! fit can end in a valley far from the effect's own. The scan evaluates the objective
 //! (nothing fitted) on a subsample of the rows at the effect's strengths on a logarithmic
-//! grid from a tenth of typical to the top of its valid range, at each end and the middle
-//! of every shape parameter, from each given base motor (the calibrated baseline and the
+//! grid from a tenth of typical to the top of its valid range, at each end, the fit start
+//! and the middle of every shape parameter, from each given base motor (the calibrated baseline and the
 //! nominal motor). A valley that lies beyond the fit's bounds, or lower on the scan's rows
 //! than where the fit ended, is handed back as a start.
 
@@ -54,7 +54,7 @@ fn factors(e: Effect) -> Vec<f64> {
 }
 
 /// The effect's parameter vectors of the grid: every strength at `factor` × typical,
-/// each shape parameter at its minimum, middle and maximum.
+/// each shape parameter at its minimum, its fit start, its middle and its maximum.
 fn grid(e: Effect) -> Vec<(f64, Vec<f64>)> {
     let info = e.info();
     let shapes: Vec<usize> = info.params.iter().enumerate().filter(|(_, p)| p.shape).map(|(i, _)| i).collect();
@@ -64,7 +64,10 @@ fn grid(e: Effect) -> Vec<(f64, Vec<f64>)> {
         shape_sets = shape_sets
             .into_iter()
             .flat_map(|v| {
-                [p.min, 0.5 * (p.min + p.max), p.max].into_iter().map(move |x| {
+                let mut levels = vec![p.min, p.start(), 0.5 * (p.min + p.max), p.max];
+                levels.sort_by(f64::total_cmp);
+                levels.dedup();
+                levels.into_iter().map(move |x| {
                     let mut w = v.clone();
                     w[i] = x;
                     w

@@ -124,7 +124,8 @@ pub(crate) fn overlap(a: &Signature, b: &Signature) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calibrate::{baseline_params, calibrate, FitOptions};
+    use crate::calibrate::tests::classic_params;
+    use crate::calibrate::{calibrate, FitOptions};
 
     fn rows_of(truth: &crate::Motor) -> Vec<ObservedRow> {
         crate::calibrate::tests::rows_on_grid(truth, &[100.0, 175.0, 250.0, 325.0, 400.0], &[0.0, 0.15, 0.3, 0.45])
@@ -150,7 +151,7 @@ mod tests {
             assert!(other.matched < 0.8 && other.linear_chi2_drop < 0.6 * sig.linear_chi2_drop, "{e}: {other:?}");
         }
         // a full refit with the effect: χ² falls to ~0 (noise-free data)
-        let mut params = baseline_params(&nominal, &rows);
+        let mut params = classic_params(&nominal, &rows);
         params.extend(crate::calibrate::effect_params(Effect::RadialFriction));
         let mut start = base.motor.clone();
         start.effects.set(Effect::RadialFriction, &[0.1]);
@@ -164,7 +165,7 @@ mod tests {
 
         // baseline data: the calibrated baseline fits exactly, nothing is left to explain
         let clean = rows_of(&nominal);
-        let base0 = calibrate(&nominal, &clean, &baseline_params(&nominal, &clean), &fit).unwrap();
+        let base0 = calibrate(&nominal, &clean, &classic_params(&nominal, &clean), &fit).unwrap();
         let s0 = signature(&base0, &clean, Effect::RadialFriction).unwrap();
         assert!(s0.linear_chi2_drop < 1e-6 * sig.linear_chi2_drop.max(1.0), "{}", s0.linear_chi2_drop);
         // overlap is symmetric, 1 with itself, within [0, 1]
@@ -242,7 +243,7 @@ mod tests {
             .collect();
         let fit = FitOptions::default();
         let score = |rows: &[ObservedRow]| {
-            let base = calibrate(&nominal, rows, &baseline_params(&nominal, rows), &fit).unwrap();
+            let base = calibrate(&nominal, rows, &classic_params(&nominal, rows), &fit).unwrap();
             let s = signature(&base, rows, Effect::VoltageSag).unwrap();
             (s.linear_chi2_drop, s.matched, base.chi2)
         };

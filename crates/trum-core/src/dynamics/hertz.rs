@@ -1,6 +1,6 @@
-//! Single-sided Hertzian-contact forced oscillator of a TRUM stator (seed 003).
+//! Single-sided Hertzian-contact forced oscillator of a TRUM stator (the Hertzian driving-circuit paper (2022)).
 //!
-//! Model (seed 003 eq. 2-3, with the linear modal stiffness `k` the printed eq. 2 omits):
+//! Model (the Hertzian driving-circuit paper (2022) eq. 2-3, with the linear modal stiffness `k` the printed eq. 2 omits):
 //!
 //! ```text
 //! m·w'' + c·w' + k·w + β(N, V)·w³ = F_n + F_d,
@@ -16,7 +16,7 @@
 //! coefficient 3β·w_s and cubic coefficient β. For the first-order amplitude–frequency
 //! response the quadratic term folds into the equivalent cubic
 //! β_eq = β − 10·(3β·w_s)²/(9·k_eff) (Nayfeh & Mook, *Nonlinear Oscillations*, §4.1.4;
-//! this is the `−5β²/12ω̄³` term of seed 003's coefficient `C`, eq. 11).
+//! this is the `−5β²/12ω̄³` term of the Hertzian driving-circuit paper (2022)'s coefficient `C`, eq. 11).
 //!
 //! Sub-modules: [`sim`] (RK4 time simulation, sweeps), [`ident`] (harmonic-balance
 //! identification of β, eq. 5-9). All functions validate their inputs and return
@@ -148,16 +148,16 @@ pub(crate) fn check_non_negative(name: &'static str, value: f64) -> HertzResult<
     }
 }
 
-/// Parameters of the single-sided Hertzian-contact forced oscillator (seed 003, eq. 2-4),
+/// Parameters of the single-sided Hertzian-contact forced oscillator (the Hertzian driving-circuit paper (2022), eq. 2-4),
 /// reduced to the stator's B09 modal coordinate `w` (m).
 ///
 /// Defaults: a 60 mm TRUM (see [`HertzOscillator::default`] and `docs/DYNAMICS.md`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HertzOscillator {
-    /// Modal mass m, kg (seed 003 §3: 0.0577809 kg from an impedance analyzer). > 0.
+    /// Modal mass m, kg (the Hertzian driving-circuit paper (2022) §3: 0.0577809 kg from an impedance analyzer). > 0.
     pub modal_mass_kg: f64,
-    /// Modal viscous damping c, N·s/m (seed 003 §3: 1 N·s/m). > 0.
+    /// Modal viscous damping c, N·s/m (the Hertzian driving-circuit paper (2022) §3: 1 N·s/m). > 0.
     pub damping_ns_per_m: f64,
     /// Linear modal stiffness k, N/m (not in the printed eq. 2; assumed from the linear
     /// resonance, k = m·(2π·41 kHz)²). > 0.
@@ -180,12 +180,12 @@ pub struct HertzOscillator {
 }
 
 /// Default linear resonance of the 60 mm TRUM B09 mode, Hz (assumed, between the
-/// 40.1 kHz high-voltage peak of seed 003 Fig. 5 and the 41.5 kHz drive of Fig. 3).
+/// 40.1 kHz high-voltage peak of the Hertzian driving-circuit paper (2022) Fig. 5 and the 41.5 kHz drive of Fig. 3).
 pub const DEFAULT_LINEAR_RESONANCE_HZ: f64 = 41_000.0;
 
 impl Default for HertzOscillator {
-    /// 60 mm TRUM: m, c from seed 003 §3; k from an assumed 41.0 kHz linear resonance;
-    /// β_ref = −1.0e19 N/m³ at 400 N (seed 003's test preload) and 200 V (assumed: gives
+    /// 60 mm TRUM: m, c from the Hertzian driving-circuit paper (2022) §3; k from an assumed 41.0 kHz linear resonance;
+    /// β_ref = −1.0e19 N/m³ at 400 N (the Hertzian driving-circuit paper (2022)'s test preload) and 200 V (assumed: gives
     /// ≈130 Hz softening shift at ≈1.8 µm); A = 2.1e-3 N/V and k_c = 1.25e-4 (assumed:
     /// peak amplitude ≈1.0 / 1.8 / 2.6 µm at 100 / 200 / 300 V, 400 N); p_N = p_V = 1
     /// (assumed, reproduces the monotonic growth of Fig. 9 and 12).
@@ -240,7 +240,7 @@ pub struct EffectiveDuffing {
 
 impl EffectiveDuffing {
     /// Linear (small-amplitude) resonance about the static equilibrium,
-    /// f = √(k_eff/m)/2π, Hz (seed 003 eq. 11: ν̄² = k_eff/m, the linearised restoring
+    /// f = √(k_eff/m)/2π, Hz (the Hertzian driving-circuit paper (2022) eq. 11: ν̄² = k_eff/m, the linearised restoring
     /// force about the preload deflection). Always finite for a value built by
     /// [`HertzOscillator::effective`].
     pub fn linear_resonance_hz(&self) -> f64 {
@@ -249,7 +249,7 @@ impl EffectiveDuffing {
 }
 
 impl HertzOscillator {
-    /// Checks every field (finite, positive where required). Seed 003 eq. 2-3.
+    /// Checks every field (finite, positive where required). the Hertzian driving-circuit paper (2022) eq. 2-3.
     pub fn validate(&self) -> HertzResult<()> {
         check_positive("modal_mass_kg", self.modal_mass_kg)?;
         check_positive("damping_ns_per_m", self.damping_ns_per_m)?;
@@ -308,7 +308,7 @@ impl HertzOscillator {
     }
 
     /// Builds an oscillator with the default TRUM values but a given linear resonance
-    /// `frequency_hz` (> 0), i.e. k = m(2πf)². Seed 003 eq. 2.
+    /// `frequency_hz` (> 0), i.e. k = m(2πf)². the Hertzian driving-circuit paper (2022) eq. 2.
     pub fn with_linear_resonance_hz(frequency_hz: f64) -> HertzResult<Self> {
         check_positive("frequency_hz", frequency_hz)?;
         let mut o = Self::default();
@@ -317,12 +317,12 @@ impl HertzOscillator {
         Ok(o)
     }
 
-    /// Linear resonance without preload, f0 = √(k/m)/2π, Hz. Seed 003 eq. 2 with β = 0.
+    /// Linear resonance without preload, f0 = √(k/m)/2π, Hz. the Hertzian driving-circuit paper (2022) eq. 2 with β = 0.
     pub fn linear_resonance_hz(&self) -> f64 {
         (self.linear_stiffness_n_per_m / self.modal_mass_kg).sqrt() / (2.0 * PI)
     }
 
-    /// Cubic coefficient at an operating point, N/m³ (ASSUMED law, seed 003 gives only the
+    /// Cubic coefficient at an operating point, N/m³ (ASSUMED law, the Hertzian driving-circuit paper (2022) gives only the
     /// trend "nonlinearity grows with preload and voltage", Fig. 9, 11, 12):
     /// β(N, V) = β_ref·(N/N_ref)^p_N·(V/V_ref)^p_V. Valid for N, V >= 0.
     pub fn beta_at_n_per_m3(&self, op: &OperatingPoint) -> HertzResult<f64> {
@@ -335,7 +335,7 @@ impl HertzOscillator {
         check_finite("beta_n_per_m3 at operating point", beta)
     }
 
-    /// Harmonic force amplitude F = A·V + k_c·N (seed 003 eq. 3, both terms taken in phase
+    /// Harmonic force amplitude F = A·V + k_c·N (the Hertzian driving-circuit paper (2022) eq. 3, both terms taken in phase
     /// at the drive frequency), N. Valid for N, V >= 0.
     pub fn forcing_amplitude_n(&self, op: &OperatingPoint) -> HertzResult<f64> {
         self.validate()?;
@@ -345,7 +345,7 @@ impl HertzOscillator {
         check_finite("forcing_amplitude_n", f)
     }
 
-    /// Static equilibrium and the equivalent Duffing oscillator about it (seed 003 eq. 2-3
+    /// Static equilibrium and the equivalent Duffing oscillator about it (the Hertzian driving-circuit paper (2022) eq. 2-3
     /// with the constant part N of F_n; Nayfeh & Mook §4.1.4 for β_eq). Errors with
     /// [`HertzError::NoStaticEquilibrium`] if a softening spring cannot carry N.
     pub fn effective(&self, op: &OperatingPoint) -> HertzResult<EffectiveDuffing> {
@@ -385,7 +385,7 @@ fn scaled_power(x: f64, p: f64) -> f64 {
 
 /// Static deflection w_s ≥ 0 of k·w + β·w³ = N on the branch through the origin, m.
 /// For β < 0 the spring folds at w* = √(k/(3|β|)) with force (2/3)k·w*; larger N has no
-/// equilibrium. Seed 003 eq. 2-3 (constant part of F_n).
+/// equilibrium. the Hertzian driving-circuit paper (2022) eq. 2-3 (constant part of F_n).
 pub fn static_deflection_m(stiffness_n_per_m: f64, beta_n_per_m3: f64, preload_n: f64) -> HertzResult<f64> {
     let k = check_positive("stiffness_n_per_m", stiffness_n_per_m)?;
     let beta = check_finite("beta_n_per_m3", beta_n_per_m3)?;
@@ -443,7 +443,7 @@ pub(crate) fn bisect<F: Fn(f64) -> f64>(f: F, mut lo: f64, mut hi: f64, iters: u
 /// Which first-order approximation of the steady state is used.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum ResponseMethod {
-    /// Multiple scales, seed 003 eq. 10-12 (corrected, see `docs/DYNAMICS.md`):
+    /// Multiple scales, the Hertzian driving-circuit paper (2022) eq. 10-12 (corrected, see `docs/DYNAMICS.md`):
     /// σ = Ω − ω0, κ = 3β_eq/(8mω0), H = F/(2mω0), μ = c/(2m).
     #[default]
     MultipleScales,
@@ -478,7 +478,7 @@ impl Branch {
     }
 }
 
-/// One steady-state solution of the amplitude equation (seed 003 eq. 12).
+/// One steady-state solution of the amplitude equation (the Hertzian driving-circuit paper (2022) eq. 12).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ResponsePoint {
     /// Drive frequency, Hz.
@@ -645,7 +645,7 @@ fn response_at(eff: &EffectiveDuffing, frequency_hz: f64, method: ResponseMethod
 }
 
 impl HertzOscillator {
-    /// Amplitude–frequency response at `op` (seed 003 eq. 10-12, corrected): every real
+    /// Amplitude–frequency response at `op` (the Hertzian driving-circuit paper (2022) eq. 10-12, corrected): every real
     /// amplitude (1 or 3) at each frequency in `frequencies_hz` (Hz, > 0), with slow-flow
     /// stability. Amplitudes in m about the static deflection.
     pub fn frequency_response(
@@ -664,7 +664,7 @@ impl HertzOscillator {
     }
 
     /// Backbone curve (free nonlinear frequency versus amplitude) at `op`: multiple scales
-    /// f = f0 + 3β_eq a²/(16π m ω0) (seed 003 eq. 11-12 with H = 0, μ = 0); harmonic balance
+    /// f = f0 + 3β_eq a²/(16π m ω0) (the Hertzian driving-circuit paper (2022) eq. 11-12 with H = 0, μ = 0); harmonic balance
     /// f = √(ω0² + ¾β_eq a²/m)/2π. Amplitudes in m (>= 0). Points where the softening
     /// backbone reaches zero frequency are omitted.
     pub fn backbone(
@@ -701,7 +701,7 @@ impl HertzOscillator {
     /// Jump (saddle-node) frequencies at `op`, or `None` if the response is single valued.
     ///
     /// Found numerically for either method as the frequencies where the discriminant of
-    /// the cubic (in a²) of seed 003 eq. 12 changes sign (8000-point scan over the band
+    /// the cubic (in a²) of the Hertzian driving-circuit paper (2022) eq. 12 changes sign (8000-point scan over the band
     /// that can be bistable, plus bisection). A band narrower than the scan step (only
     /// just above the hysteresis threshold |κ|H²/μ³ = 8/(3√3)) is reported as `None`.
     /// For the multiple-scales method the closed form
@@ -759,7 +759,7 @@ impl HertzOscillator {
         Ok(Some(jf))
     }
 
-    /// Closed-form multiple-scales saddle nodes (seed 003 eq. 12 with d(σ)/d(a) = 0).
+    /// Closed-form multiple-scales saddle nodes (the Hertzian driving-circuit paper (2022) eq. 12 with d(σ)/d(a) = 0).
     ///
     /// With u = σ − κa², the saddle-node condition μ² + (σ−κa²)(σ−3κa²) = 0 and eq. 12 give
     /// (μ² + u²)² = 2κH²u, a² = (μ² + u²)/(2κu), σ = u + κa². The quartic has two roots of
@@ -805,7 +805,7 @@ impl HertzOscillator {
     }
 
     /// Response curves for several voltage amplitudes `voltages_v` (V, >= 0) at a fixed
-    /// preload `preload_n` (N, >= 0): seed 003 Fig. 11a, eq. 12 with β(N, V).
+    /// preload `preload_n` (N, >= 0): the Hertzian driving-circuit paper (2022) Fig. 11a, eq. 12 with β(N, V).
     pub fn response_vs_voltage(
         &self,
         preload_n: f64,
@@ -820,7 +820,7 @@ impl HertzOscillator {
     }
 
     /// Response curves for several preloads `preloads_n` (N, >= 0) at a fixed voltage
-    /// amplitude `voltage_v` (V, >= 0): seed 003 Fig. 11b, eq. 12 with β(N, V).
+    /// amplitude `voltage_v` (V, >= 0): the Hertzian driving-circuit paper (2022) Fig. 11b, eq. 12 with β(N, V).
     pub fn response_vs_preload(
         &self,
         voltage_v: f64,
@@ -835,7 +835,7 @@ impl HertzOscillator {
     }
 
     /// One [`ResponseCurve`]: branches, equivalent β and jump points at `op`
-    /// (seed 003 eq. 10-12). Frequencies in Hz (> 0).
+    /// (the Hertzian driving-circuit paper (2022) eq. 10-12). Frequencies in Hz (> 0).
     pub fn response_curve(
         &self,
         op: &OperatingPoint,
@@ -889,7 +889,7 @@ impl HertzOscillator {
         Some(((lo - margin).max(0.5 * lo), hi + margin))
     }
 
-    /// Response curves with backbones for every operating point of `ops` (seed 003
+    /// Response curves with backbones for every operating point of `ops` (the Hertzian driving-circuit paper (2022)
     /// Fig. 11, eq. 10-12). A point without a response is kept with its error; invalid
     /// frequencies are an error of the whole family.
     pub fn response_family(

@@ -1,6 +1,6 @@
 //! Nonlinear stator dynamics.
 //!
-//! * [`hertz`]: the single-sided Hertzian-contact forced oscillator of seed 003
+//! * [`hertz`]: the single-sided Hertzian-contact forced oscillator of the Hertzian driving-circuit paper (2022)
 //!   (m·w'' + c·w' + k·w + β·w³ = F_n + F_d, eq. 2-4): softening backbone, amplitude–
 //!   frequency response with jumps (multiple scales, eq. 10-12, and one-term harmonic
 //!   balance), harmonic-balance identification of β from the isolated-electrode

@@ -1,26 +1,26 @@
-//! Transient (step) response of a TRUM with a discretised stick-slip contact (seed 004).
+//! Transient (step) response of a TRUM with a discretised stick-slip contact (the bar-type transient paper).
 //!
-//! Degrees of freedom (seed 000 Appendix A, eq. A1-A4 with ε = 0; seed 004 eq. 3-5):
+//! Degrees of freedom (Chen et al. 2020 Appendix A, eq. A1-A4 with ε = 0; the bar-type transient paper eq. 3-5):
 //!
 //! ```text
 //! stator modes  m·q̈_A + c·q̇_A + k_s·q_A = Θ·V·cos ωt        + Q_A
 //!               m·q̈_B + c·q̇_B + k_s·q_B = Θ·V·cos(ωt − Δφ) + Q_B
-//! rotor, axial  m_r·z̈ + d_z·ż + k_sp·(z − z₀) = F_c − F_N      (seed 004 eq. 5)
-//! rotor, turn   J_r·Ω̇ + d_r·Ω = T_c − T_load                   (seed 004 eq. 4)
+//! rotor, axial  m_r·z̈ + d_z·ż + k_sp·(z − z₀) = F_c − F_N      (the bar-type transient paper eq. 5)
+//! rotor, turn   J_r·Ω̇ + d_r·Ω = T_c − T_load                   (the bar-type transient paper eq. 4)
 //! ```
 //!
 //! The surface displacement is w(x, t) = q_A·cos kx + q_B·sin kx (k = N/R0); Δφ = +90°
 //! gives a wave travelling towards +x. One wavelength is cut into `nodes_per_wavelength`
-//! nodes (256 in seed 004); all N waves are identical, so every sum is multiplied by N.
-//! Node j carries a Winkler spring (seed 000 eq. 3, seed 001 eq. 5)
+//! nodes (256 in the bar-type transient paper); all N waves are identical, so every sum is multiplied by N.
+//! Node j carries a Winkler spring (Chen et al. 2020 eq. 3, Sun et al. 2021 eq. 5)
 //! p_j = k_f·Δx·max(0, w(x_j) − z) with k_f = E_f·b_f/h_f, and a tangential spring of
-//! stiffness k_t·Δx (the rotor-side springs of seed 004, Fig. 7) whose deflection δ_j
+//! stiffness k_t·Δx (the rotor-side springs of the bar-type transient paper, Fig. 7) whose deflection δ_j
 //! follows the relative surface displacement u_s − u_r. The stator surface moves
 //! tangentially by u_s = h0·∂w/∂x, i.e. with speed h0·∂²w/∂x∂t, counted positive in the
 //! rotor's positive sense (the surface at a crest moves against the wave, so the
 //! rotor turns opposite to the wave; for Δφ = +90° its speed is positive).
 //!
-//! **Coulomb stick-slip per node (seed 004 eq. 1-2), by return mapping.** Each step the
+//! **Coulomb stick-slip per node (the bar-type transient paper eq. 1-2), by return mapping.** Each step the
 //! trial force f* = k_t·Δx·(δ_j + Δu_s − Δu_r) is the tangential force that keeps the node
 //! from slipping over the step. If |f*| ≤ μ·p_j the node sticks (f = f*, eq. 2 not
 //! satisfied); otherwise it slips with f = μ·p_j·sign(f*) (eq. 1; the sign of f* is the
@@ -28,7 +28,7 @@
 //! is Coulomb's law exactly, for a friction layer with tangential compliance 1/k_t; no
 //! velocity threshold or smoothing is involved. As k_t → ∞ the stick zones shrink to
 //! the two stick points of the rigid steady model ([`crate::contact`]) and the result
-//! converges to [`crate::solve`]; seed 004's wide stick zones appear for a soft layer
+//! converges to [`crate::solve`]; the bar-type transient paper's wide stick zones appear for a soft layer
 //! (k_t ≈ G·b_f/h_f ≈ k_f/2.6). See [`TransientConfig::tangential_stiffness_ratio`].
 //!
 //! Generalised contact forces (virtual work, mode shapes cos kx and sin kx at the
@@ -52,7 +52,7 @@ mod tests;
 
 pub use metrics::step_metrics;
 
-/// Default axial damping of the rotor d_z [N·s/m] (seed 000 Table A1).
+/// Default axial damping of the rotor d_z [N·s/m] (Chen et al. 2020 Table A1).
 pub const DEFAULT_AXIAL_DAMPING_NS_PER_M: f64 = 1.5e4;
 
 /// Default tangential penalty stiffness of a node, as a multiple of the Winkler stiffness k_f.
@@ -67,7 +67,7 @@ pub struct TransientConfig {
     pub duration_s: f64,
     /// Time steps per drive period (≥ 16; 64-128 recommended).
     pub steps_per_period: usize,
-    /// Contact nodes over one wavelength (≥ 8; 256 in seed 004).
+    /// Contact nodes over one wavelength (≥ 8; 256 in the bar-type transient paper).
     pub nodes_per_wavelength: usize,
     /// Phase of phase B behind phase A [rad]; π/2 = travelling wave, 0 = standing wave.
     pub phase_difference_rad: f64,
@@ -83,7 +83,7 @@ pub struct TransientConfig {
     pub record_every: usize,
     /// Times [s] at which to return the contact state per node (each in [0, duration]).
     pub snapshot_times_s: Vec<f64>,
-    /// Axial damping of the rotor d_z [N·s/m], > 0 (default 1.5e4, seed 000 Table A1).
+    /// Axial damping of the rotor d_z [N·s/m], > 0 (default 1.5e4, Chen et al. 2020 Table A1).
     pub axial_damping_ns_per_m: f64,
     /// Tangential stiffness of the contact layer per unit length as a multiple of
     /// k_f = E_f·b_f/h_f, > 0. The default 300 is a penalty stiffness: the settled speed
@@ -91,7 +91,7 @@ pub struct TransientConfig {
     /// physical shear stiffness of a solid layer.
     pub tangential_stiffness_ratio: f64,
     /// Project the normal contact forces on the stator modes (contact stiffening,
-    /// seed 000 eq. A4 F_dn). Off by default, like the steady model.
+    /// Chen et al. 2020 eq. A4 F_dn). Off by default, like the steady model.
     pub normal_modal_coupling: bool,
 }
 
@@ -182,9 +182,9 @@ pub struct TimeSeries {
 pub enum NodeState {
     /// The stator surface is below the rotor: no force.
     NoContact,
-    /// In contact and not slipping: |f| ≤ μ·p (seed 004 eq. 2 not satisfied).
+    /// In contact and not slipping: |f| ≤ μ·p (the bar-type transient paper eq. 2 not satisfied).
     Stick,
-    /// In contact and slipping: f = μ·p·sign(slip) (seed 004 eq. 1).
+    /// In contact and slipping: f = μ·p·sign(slip) (the bar-type transient paper eq. 1).
     Slip,
 }
 
@@ -214,7 +214,7 @@ pub struct NodeSample {
     pub state: NodeState,
 }
 
-/// Distribution of the contact forces over one wavelength at one instant (seed 004 Fig. 10).
+/// Distribution of the contact forces over one wavelength at one instant (the bar-type transient paper Fig. 10).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Snapshot {
     /// Requested time [s].

@@ -1,4 +1,4 @@
-//! Seed 000: Chen, Zheng, Fan, *Pre-pressure optimization for ultrasonic motors based on
+//! Chen et al. 2020: Chen, Zheng, Fan, *Pre-pressure optimization for ultrasonic motors based on
 //! multi-sensor fusion*, Sensors 2020, 20, 2096 (TRUM60A, N = 9).
 //!
 //! Notation of the paper: ξ modal amplitude, R_sc mode shape at the contact radius (so the
@@ -33,7 +33,7 @@ fn clamped_acos(ratio: f64) -> Option<f64> {
 /// Contact half-angle φ0 = arccos((h − z)/(R_sc·ξ)) \[rad\] in wave phase: the stator surface
 /// w(θ) = R_sc·ξ·cos θ penetrates the rotor plane at height h − z where w > h − z.
 ///
-/// Seed 000, argument of eq. 1 (Xc). Units: lengths in m, `mode_shape_at_contact` \[-\].
+/// Chen et al. 2020, argument of eq. 1 (Xc). Units: lengths in m, `mode_shape_at_contact` \[-\].
 /// Range: returns a value in \[0, π\]; levels above the crest give 0, below the trough π.
 /// `None` if the crest height R_sc·ξ is not a positive finite number or an input is NaN.
 pub fn contact_half_angle_rad(
@@ -49,7 +49,7 @@ pub fn contact_half_angle_rad(
     clamped_acos((half_thickness_m - rotor_axial_position_m) / crest_m)
 }
 
-/// Seed 000 eq. 1 (Xc) **as printed**: Xc = (20/π)·arccos((h − z)/(R_sc·ξ)) \[deg\].
+/// Chen et al. 2020 eq. 1 (Xc) **as printed**: Xc = (20/π)·arccos((h − z)/(R_sc·ξ)) \[deg\].
 ///
 /// The printed prefactor 20/π gives the contact *half*-arc in mechanical degrees (at most
 /// 20°), which contradicts the text (0 ≤ Xs ≤ Xc ≤ 40°), eq. 2 and eq. 12 (24-29° at
@@ -66,7 +66,7 @@ pub fn contact_length_printed_deg(
     Some(20.0 / PI * phi0)
 }
 
-/// Seed 000 eq. 1 (Xc), corrected: full contact arc of one wave in mechanical degrees,
+/// Chen et al. 2020 eq. 1 (Xc), corrected: full contact arc of one wave in mechanical degrees,
 /// Xc = 2·φ0·(360°/N)/(2π) = 360·φ0/(N·π) (= 40·φ0/π for N = 9), the convention under
 /// which eq. 2 gives k·x0 = φ0 and Xc ≤ 360°/N.
 ///
@@ -88,7 +88,7 @@ pub fn contact_length_deg(
     Some(360.0 * phi0 / (wave_number * PI))
 }
 
-/// Seed 000 eq. 1 (Xs) **as printed**: Xs = (20/π)·arccos(Ω_r·R0²/(λ·h·R_sc·ξ·f_s)) \[deg\].
+/// Chen et al. 2020 eq. 1 (Xs) **as printed**: Xs = (20/π)·arccos(Ω_r·R0²/(λ·h·R_sc·ξ·f_s)) \[deg\].
 ///
 /// Besides the 20/π half-arc factor, the printed argument has the dimension 1/m (it is
 /// not invariant when all lengths are scaled), so it is not a speed ratio; see
@@ -112,7 +112,7 @@ pub fn drive_length_printed_deg(
 }
 
 /// Peak tangential speed of the stator surface v_sm = 2π·f_s·k·h·R_sc·ξ \[m/s\] with
-/// k = N/R0 (seed 000 notation; same as seed 001 eq. 12 at the crest).
+/// k = N/R0 (Chen et al. 2020 notation; same as Sun et al. 2021 eq. 12 at the crest).
 ///
 /// Units: `frequency_hz`, lengths in m, N and R_sc dimensionless. Any finite input.
 pub fn peak_surface_speed_m_per_s(
@@ -131,7 +131,7 @@ pub fn peak_surface_speed_m_per_s(
         * modal_amplitude_m
 }
 
-/// Seed 000 eq. 1 (Xs), corrected: full driving arc of one wave in mechanical degrees,
+/// Chen et al. 2020 eq. 1 (Xs), corrected: full driving arc of one wave in mechanical degrees,
 /// Xs = 360·θs/(N·π) with θs = arccos(Ω_r·R0 / v_sm) the stick half-angle where the
 /// stator surface speed v_sm·cos θ equals the rotor surface speed Ω_r·R0 and
 /// v_sm = 2π·f_s·(N/R0)·h·R_sc·ξ ([`peak_surface_speed_m_per_s`]).
@@ -164,7 +164,7 @@ pub fn drive_length_deg(
     Some(360.0 * theta_s / (wave_number * PI))
 }
 
-/// Seed 000 eq. 2 **as printed**: x0 = π·Xc/(40·k) \[m\] (also x1 = π·Xs/(40·k)).
+/// Chen et al. 2020 eq. 2 **as printed**: x0 = π·Xc/(40·k) \[m\] (also x1 = π·Xs/(40·k)).
 ///
 /// Converts a full arc in mechanical degrees to the half arc length at R0. The 40 is 360/N
 /// for N = 9 only; [`half_length_from_arc_m`] holds for any N. Units: `arc_deg`,
@@ -173,7 +173,7 @@ pub fn half_length_printed_m(arc_deg: f64, wavenumber_per_m: f64) -> f64 {
     PI * arc_deg / (40.0 * wavenumber_per_m)
 }
 
-/// Seed 000 eq. 2, any N: x0 = (1/2)·R0·Xc·π/180 = π·N·Xc/(360·k) \[m\], half the arc length
+/// Chen et al. 2020 eq. 2, any N: x0 = (1/2)·R0·Xc·π/180 = π·N·Xc/(360·k) \[m\], half the arc length
 /// at the mean radius of a full arc of `arc_deg` mechanical degrees.
 ///
 /// Units: `arc_deg` \[deg\], `mean_radius_m` \[m\]. Any finite input.
@@ -181,7 +181,7 @@ pub fn half_length_from_arc_m(arc_deg: f64, mean_radius_m: f64) -> f64 {
     0.5 * mean_radius_m * arc_deg.to_radians()
 }
 
-/// Parameters of the seed 000 contact model (eq. 3-6).
+/// Parameters of the Chen et al. 2020 contact model (eq. 3-6).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Contact {
     /// K_f: contact stiffness per unit area \[N/m³\] (pressure per unit penetration).
@@ -205,7 +205,7 @@ impl Contact {
     }
 }
 
-/// Seed 000 eq. 3: contact pressure p(x) = K_f·R_sc·ξ·\[cos(kx) − cos(kx0)\] \[Pa\].
+/// Chen et al. 2020 eq. 3: contact pressure p(x) = K_f·R_sc·ξ·\[cos(kx) − cos(kx0)\] \[Pa\].
 ///
 /// Spring compression times stiffness; valid for |x| ≤ x0 (outside it the printed form is
 /// negative, i.e. no contact, and callers take 0). Units: `x_m`, `contact_half_length_m`
@@ -218,7 +218,7 @@ pub fn contact_pressure_pa(c: &Contact, x_m: f64, contact_half_length_m: f64) ->
         * ((k * x_m).cos() - (k * contact_half_length_m).cos())
 }
 
-/// Seed 000 eq. 4: driving friction force of one wave
+/// Chen et al. 2020 eq. 4: driving friction force of one wave
 /// F_R = 2μ·K_f·R_sc·ξ·ε·{2\[(1/k)·sin(kx1) − x1·cos(kx0)\] − \[(1/k)·sin(kx0) − x0·cos(kx0)\]} \[N\].
 ///
 /// Equals μ·∬ sgn(|Ω_s| − |Ω_r|)·p dx dy: the drive zone |x| < x1 counts positive, the two
@@ -241,7 +241,7 @@ pub fn driving_force_n(
         * bracket
 }
 
-/// Seed 000 eq. 5: driving torque
+/// Chen et al. 2020 eq. 5: driving torque
 /// T_R = N·F_R·R0 = 2μ·ε·K_f·R_sc·R0²·ξ·{2\[sin(kx1) − kx1·cos(kx0)\] − \[sin(kx0) − kx0·cos(kx0)\]} \[N·m\].
 ///
 /// The printed R_s² is read as R0² (R_s is not defined; N·R0/k = R0² with k = N/R0).
@@ -265,7 +265,7 @@ pub fn driving_torque_nm(
         * bracket
 }
 
-/// Seed 000 eq. 6: axial force F_z = 2N·K_f·R_sc·ε·ξ·\[(1/k)·sin(kx0) − x0·cos(kx0)\] \[N\],
+/// Chen et al. 2020 eq. 6: axial force F_z = 2N·K_f·R_sc·ε·ξ·\[(1/k)·sin(kx0) − x0·cos(kx0)\] \[N\],
 /// i.e. N·∬ p dx dy over the contact zones of all N waves.
 ///
 /// Range: 0 ≤ x0 ≤ λ/4 (k·x0 ≤ π/2 keeps the stator teeth in contact only near crests).
@@ -282,7 +282,7 @@ pub fn axial_force_n(c: &Contact, contact_half_length_m: f64) -> f64 {
         / k
 }
 
-/// Seed 000 eq. 7 **as printed**: dielectric loss Q1 = 2π·f_s·ε_p·(U_m/h_p)²·V_piezo·tan δ \[W\].
+/// Chen et al. 2020 eq. 7 **as printed**: dielectric loss Q1 = 2π·f_s·ε_p·(U_m/h_p)²·V_piezo·tan δ \[W\].
 ///
 /// Equals the cycle integral f·V·∮E dD for a sinusoidal field only if `voltage_v` is the
 /// RMS voltage; with the peak voltage it is twice the integral ([`dielectric_loss_w`]).
@@ -300,7 +300,7 @@ pub fn dielectric_loss_printed_w(
     2.0 * PI * frequency_hz * permittivity_f_per_m * e * e * piezo_volume_m3 * loss_tangent
 }
 
-/// Seed 000 eq. 7, corrected for a peak voltage: Q1 = π·f_s·ε_p·(U_peak/h_p)²·V_piezo·tan δ \[W\],
+/// Chen et al. 2020 eq. 7, corrected for a peak voltage: Q1 = π·f_s·ε_p·(U_peak/h_p)²·V_piezo·tan δ \[W\],
 /// the time average of V·E·dD/dt for E = (U_peak/h_p)·sin ωt and complex permittivity
 /// ε_p·(1 − j·tan δ). Same as [`dielectric_loss_printed_w`] with U_rms = U_peak/√2.
 /// Units as there. Any finite input.
@@ -322,8 +322,8 @@ pub fn dielectric_loss_w(
     )
 }
 
-/// Damped bending stiffness Σ E·I·η = E_s·I_s·η_s + E_p·I_p·η_p \[N·m²\] of seed 000 eq. 8
-/// (and seed 001 eq. 17). Moduli in Pa, moments of inertia in m⁴, loss factors η \[-\].
+/// Damped bending stiffness Σ E·I·η = E_s·I_s·η_s + E_p·I_p·η_p \[N·m²\] of Chen et al. 2020 eq. 8
+/// (and Sun et al. 2021 eq. 17). Moduli in Pa, moments of inertia in m⁴, loss factors η \[-\].
 pub fn damped_bending_stiffness_n_m2(
     stator_modulus_pa: f64,
     stator_inertia_m4: f64,
@@ -335,7 +335,7 @@ pub fn damped_bending_stiffness_n_m2(
     stator_modulus_pa * stator_inertia_m4 * stator_loss_factor + piezo_modulus_pa * piezo_inertia_m4 * piezo_loss_factor
 }
 
-/// Seed 000 eq. 8 **as printed**: stator damping loss Q2 = 4π⁴·ξ²·N⁴·w·ΣEIη/λ³ \[W\], with
+/// Chen et al. 2020 eq. 8 **as printed**: stator damping loss Q2 = 4π⁴·ξ²·N⁴·w·ΣEIη/λ³ \[W\], with
 /// w read as the angular frequency ω = 2π·f (which makes Q2 a power).
 ///
 /// With λ the wavelength (Table A1: 0.0187 m) this is N³ times the defining integral
@@ -359,8 +359,8 @@ pub fn stator_damping_loss_printed_w(
         / wavelength_m.powi(3)
 }
 
-/// Seed 000 eq. 8, corrected: Q2 = 4π⁴·ξ²·N·ω·ΣEIη/λ³ \[W\] = (ω/2π)·π·∫₀^{Nλ} ΣEIη·(ξ·k²·sin kx)² dx,
-/// k = 2π/λ; identical to f × seed 001 eq. 17 (with its k = N).
+/// Chen et al. 2020 eq. 8, corrected: Q2 = 4π⁴·ξ²·N·ω·ΣEIη/λ³ \[W\] = (ω/2π)·π·∫₀^{Nλ} ΣEIη·(ξ·k²·sin kx)² dx,
+/// k = 2π/λ; identical to f × Sun et al. 2021 eq. 17 (with its k = N).
 ///
 /// Units as in [`stator_damping_loss_printed_w`]. Any finite input.
 pub fn stator_damping_loss_w(
@@ -379,7 +379,7 @@ pub fn stator_damping_loss_w(
         / wavelength_m.powi(3)
 }
 
-/// Coefficients of the seed 000 eq. 9 friction loss, bracket
+/// Coefficients of the Chen et al. 2020 eq. 9 friction loss, bracket
 /// `cross·v_sm·v_r + sm2·v_sm²/2 + r2·v_r²` (the paper's M1, M2, M3).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrictionCoefficients {
@@ -391,7 +391,7 @@ pub struct FrictionCoefficients {
     pub r2: f64,
 }
 
-/// Seed 000 eq. 10 **as printed**, with b = k·x0 the lower integration limit of eq. 9:
+/// Chen et al. 2020 eq. 10 **as printed**, with b = k·x0 the lower integration limit of eq. 9:
 /// M1 = π − 2b + sin 2b, M2 = −0.33·cos 3b + 3·cos b − M1·sin b,
 /// M3 = 2·cos 3b − π·sin b + 2φ·sin b, with the undefined φ read as b.
 ///
@@ -406,12 +406,12 @@ pub fn friction_loss_coefficients_printed(limit_angle_rad: f64) -> FrictionCoeff
     FrictionCoefficients { cross: m1, sm2: m2, r2: m3 }
 }
 
-/// Seed 000 eq. 10, derived from J = ∫_b^{π−b} (sin θ − sin b)·(v_sm·sin θ − v_r)² dθ, the
+/// Chen et al. 2020 eq. 10, derived from J = ∫_b^{π−b} (sin θ − sin b)·(v_sm·sin θ − v_r)² dθ, the
 /// eq. 9 integral with its printed limits and ΔF = K_f·ξ·(sin θ − sin b):
 /// cross = −(π − 2b − sin 2b), sm2 = 3·cos b − (1/3)·cos 3b − (π − 2b + sin 2b)·sin b,
 /// r2 = 2·cos b − (π − 2b)·sin b.
 ///
-/// The limits make b the half-angle *outside* contact (seed 001's ϕ): the contact
+/// The limits make b the half-angle *outside* contact (Sun et al. 2021's ϕ): the contact
 /// half-angle is φ0 = π/2 − b, not the k·x0 of eq. 2-3. Range: b ∈ \[0, π/2\].
 pub fn friction_loss_coefficients(limit_angle_rad: f64) -> FrictionCoefficients {
     let b = limit_angle_rad;
@@ -428,7 +428,7 @@ fn friction_bracket(m: FrictionCoefficients, peak_stator_speed_m_per_s: f64, rot
     m.cross * vs * vr + m.sm2 * vs * vs / 2.0 + m.r2 * vr * vr
 }
 
-/// Seed 000 eq. 9 **as printed** (right-hand side): Q3 = N·ξ·K_f·μ·\[M1·v_sm·v_r + M2·v_sm²/2 + M3·v_r²\]
+/// Chen et al. 2020 eq. 9 **as printed** (right-hand side): Q3 = N·ξ·K_f·μ·\[M1·v_sm·v_r + M2·v_sm²/2 + M3·v_r²\]
 /// with M from [`friction_loss_coefficients_printed`] \[W\].
 ///
 /// For Q3 to be a power, K_f here is per unit length \[N/m²\] and μ a viscous coefficient
@@ -452,7 +452,7 @@ pub fn friction_loss_printed_w(
         * friction_bracket(m, peak_stator_speed_m_per_s, rotor_speed_m_per_s)
 }
 
-/// Seed 000 eq. 9, corrected: Q3 = N·(λ/2π)·ξ·K_f·μ·J \[W\], the left-hand side
+/// Chen et al. 2020 eq. 9, corrected: Q3 = N·(λ/2π)·ξ·K_f·μ·J \[W\], the left-hand side
 /// N·(λ/2π)·∫_b^{π−b} μ·ΔF·(v_s − v_r)² dθ with ΔF = K_f·ξ·(sin θ − sin b),
 /// v_s = v_sm·sin θ, evaluated with [`friction_loss_coefficients`].
 ///
@@ -478,7 +478,7 @@ pub fn friction_loss_w(
         * friction_bracket(m, peak_stator_speed_m_per_s, rotor_speed_m_per_s)
 }
 
-/// Seed 000 eq. 11: shell temperature T = T_air + Q/(α·S)·(1 − exp(−α·S·t/C)) \[K\], the
+/// Chen et al. 2020 eq. 11: shell temperature T = T_air + Q/(α·S)·(1 − exp(−α·S·t/C)) \[K\], the
 /// solution of C·dT/dt = Q − α·S·(T − T_air), T(0) = T_air, for a constant total loss Q.
 ///
 /// Units: temperatures in K (or °C, differences are the same), `total_loss_w` Q1+Q2+Q3,
@@ -504,7 +504,7 @@ pub fn shell_temperature_k(
 /// Coefficients of eq. 12 in ascending powers of F_z, as printed.
 const EQ12_COEFFS: [f64; 8] = [0.72, 0.65, -0.0088, 6.4e-5, -2.5e-7, 5.4e-10, -6e-13, 2.7e-16];
 
-/// Seed 000 eq. 12 as printed: contact length (full arc, mechanical degrees) from axial
+/// Chen et al. 2020 eq. 12 as printed: contact length (full arc, mechanical degrees) from axial
 /// force, Xc = 2.7e-16·F⁷ − 6e-13·F⁶ + 5.4e-10·F⁵ − 2.5e-7·F⁴ + 6.4e-5·F³ − 0.0088·F² + 0.65·F + 0.72.
 ///
 /// A fit with 2-digit coefficients and heavy cancellation: it gives 24.29° at 150 N and

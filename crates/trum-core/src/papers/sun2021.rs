@@ -1,4 +1,4 @@
-//! Seed 001: Sun, Yin, Liu, Zhang, *Efficiency model for traveling wave-type ultrasonic
+//! Sun et al. 2021: Sun, Yin, Liu, Zhang, *Efficiency model for traveling wave-type ultrasonic
 //! motors based on contact variables and preload*, Actuators 2021, 10, 158 (TRUM-60).
 //!
 //! Notation of the paper: W stator surface amplitude, n number of waves, k wave number
@@ -14,7 +14,7 @@ fn chi(theta_rad: f64, half_angle_rad: f64) -> f64 {
     theta_rad.sin() - theta_rad * half_angle_rad.cos()
 }
 
-/// Seed 001 eq. 1 **as printed** (right-hand side): V_f = (√2/2)·K_WV·W·cos(ωt + π/4) \[V\].
+/// Sun et al. 2021 eq. 1 **as printed** (right-hand side): V_f = (√2/2)·K_WV·W·cos(ωt + π/4) \[V\].
 ///
 /// Wrong in amplitude and phase: the left-hand side K_WV·W·(sin ωt + cos ωt) equals
 /// √2·K_WV·W·cos(ωt − π/4) ([`feedback_voltage_closed_form_v`]). Units:
@@ -29,14 +29,14 @@ pub fn feedback_voltage_printed_v(
     FRAC_1_SQRT_2 * conversion_v_per_m * amplitude_m * (angular_frequency_rad_s * time_s + FRAC_PI_4).cos()
 }
 
-/// Seed 001 eq. 1, left-hand side (the definition): V_f = K_WV·(W·sin ωt + W·cos ωt) \[V\],
+/// Sun et al. 2021 eq. 1, left-hand side (the definition): V_f = K_WV·(W·sin ωt + W·cos ωt) \[V\],
 /// the sum of the two phase feedback signals. Units as in [`feedback_voltage_printed_v`].
 pub fn feedback_voltage_v(conversion_v_per_m: f64, amplitude_m: f64, angular_frequency_rad_s: f64, time_s: f64) -> f64 {
     let (s, c) = (angular_frequency_rad_s * time_s).sin_cos();
     conversion_v_per_m * amplitude_m * (s + c)
 }
 
-/// Seed 001 eq. 1, corrected right-hand side: V_f = √2·K_WV·W·cos(ωt − π/4) \[V\].
+/// Sun et al. 2021 eq. 1, corrected right-hand side: V_f = √2·K_WV·W·cos(ωt − π/4) \[V\].
 /// Units as in [`feedback_voltage_printed_v`]. Any finite input.
 pub fn feedback_voltage_closed_form_v(
     conversion_v_per_m: f64,
@@ -56,7 +56,7 @@ pub fn amplitude_from_feedback_peak_m(feedback_peak_v: f64, conversion_v_per_m: 
     w.is_finite().then_some(w)
 }
 
-/// Seed 001 eq. 2: normalised drive frequency ω̄ = ω/ω_n = ω·√(m_s/k_s) \[-\] (the paper
+/// Sun et al. 2021 eq. 2: normalised drive frequency ω̄ = ω/ω_n = ω·√(m_s/k_s) \[-\] (the paper
 /// writes ω for both sides). Units: `angular_frequency_rad_s`, `modal_mass_kg`,
 /// `modal_stiffness_n_per_m`. `None` unless m_s > 0 and k_s > 0.
 pub fn frequency_ratio(angular_frequency_rad_s: f64, modal_mass_kg: f64, modal_stiffness_n_per_m: f64) -> Option<f64> {
@@ -64,7 +64,7 @@ pub fn frequency_ratio(angular_frequency_rad_s: f64, modal_mass_kg: f64, modal_s
         .then(|| angular_frequency_rad_s * (modal_mass_kg / modal_stiffness_n_per_m).sqrt())
 }
 
-/// Seed 001 eq. 3: damping ratio ζ = c_s/(2·√(m_s·k_s)) \[-\] (printed as ξ, used as ζ in
+/// Sun et al. 2021 eq. 3: damping ratio ζ = c_s/(2·√(m_s·k_s)) \[-\] (printed as ξ, used as ζ in
 /// eq. 9 and 14). Units: `modal_damping_n_s_per_m` c_s, mass, stiffness. `None` unless
 /// m_s > 0 and k_s > 0.
 pub fn damping_ratio(modal_damping_n_s_per_m: f64, modal_mass_kg: f64, modal_stiffness_n_per_m: f64) -> Option<f64> {
@@ -72,7 +72,7 @@ pub fn damping_ratio(modal_damping_n_s_per_m: f64, modal_mass_kg: f64, modal_sti
         .then(|| modal_damping_n_s_per_m / (2.0 * (modal_mass_kg * modal_stiffness_n_per_m).sqrt()))
 }
 
-/// Contact parameters shared by seed 001 eq. 5-9 and 22-26.
+/// Contact parameters shared by Sun et al. 2021 eq. 5-9 and 22-26.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Contact {
     /// n: number of waves around the ring \[-\].
@@ -84,13 +84,13 @@ pub struct Contact {
 }
 
 impl Contact {
-    /// Seed 001 eq. 23: H = k_f/k \[N/m\], force per unit amplitude per radian of wave phase.
+    /// Sun et al. 2021 eq. 23: H = k_f/k \[N/m\], force per unit amplitude per radian of wave phase.
     pub fn h_coefficient_n_per_m(&self) -> f64 {
         self.friction_layer_stiffness_n_per_m2 / self.wavenumber_per_m
     }
 }
 
-/// Seed 001 eq. 5 (closed form as used in eq. 7-9): preload
+/// Sun et al. 2021 eq. 5 (closed form as used in eq. 7-9): preload
 /// F_N = 2n·∫₀^{x0} k_f·W·(cos kx − cos kx0) dx = 2n·(k_f·W/k)·\[sin kx0 − kx0·cos kx0\] \[N\].
 ///
 /// x0 is the contact *half*-length (the text calls it the full length; the integral from 0
@@ -100,7 +100,7 @@ pub fn axial_force_n(c: &Contact, amplitude_m: f64, contact_half_length_m: f64) 
     2.0 * c.wave_number * c.friction_layer_stiffness_n_per_m2 * amplitude_m / c.wavenumber_per_m * chi(phi0, phi0)
 }
 
-/// Seed 001 eq. 8: additional stator stiffness from contact
+/// Sun et al. 2021 eq. 8: additional stator stiffness from contact
 /// k_s' = N21·(2n·k_f/k)·\[sin kx0 − kx0·cos kx0\] \[N/m\], i.e. N21·F_N/W with F_N of eq. 5.
 ///
 /// `n21` \[-\] is the paper's fitted force coefficient. Range: 0 ≤ x0 < λ/4. Any finite input.
@@ -108,7 +108,7 @@ pub fn added_stiffness_n_per_m(c: &Contact, n21: f64, contact_half_length_m: f64
     n21 * axial_force_n(c, 1.0, contact_half_length_m)
 }
 
-/// Seed 001 eq. 14: amplitude under preload
+/// Sun et al. 2021 eq. 14: amplitude under preload
 /// W = \[(N1·V_d − N22·F_N)/k_s\] / √((1 + k_s'/k_s − ω̄²)² + (2ζω̄)²) \[m\], the steady-state
 /// amplitude of m_s·Ẅ + c_s·Ẇ + (k_s + k_s')·W = (N1·V_d − N22·F_N)·cos ωt.
 ///
@@ -133,7 +133,7 @@ pub fn amplitude_under_preload_m(
     (den > 0.0 && w.is_finite()).then_some(w)
 }
 
-/// Seed 001 eq. 9: preload implied by a contact half-length,
+/// Sun et al. 2021 eq. 9: preload implied by a contact half-length,
 /// F_N = W(x0)·(2n·k_f/k)·\[sin kx0 − kx0·cos kx0\] \[N\] with W(x0) from eq. 14 and
 /// k_s'(x0) from eq. 8; eq. 9 is solved for x0 given F_N.
 ///
@@ -159,13 +159,13 @@ pub fn preload_from_contact_n(
     Some(axial_force_n(c, w, contact_half_length_m))
 }
 
-/// Seed 001 eq. 10: χ(x) = sin(kx) − kx·cos(kx0) \[-\].
+/// Sun et al. 2021 eq. 10: χ(x) = sin(kx) − kx·cos(kx0) \[-\].
 /// Units: `wavenumber_per_m` k, `x_m`, `contact_half_length_m` x0. Any finite input.
 pub fn torque_shape(wavenumber_per_m: f64, x_m: f64, contact_half_length_m: f64) -> f64 {
     chi(wavenumber_per_m * x_m, wavenumber_per_m * contact_half_length_m)
 }
 
-/// Seed 001 eq. 11: output torque M_T = r·μ·F_N·\[2χ(x_r) − χ(x0)\]/χ(x0) \[N·m\]: the drive
+/// Sun et al. 2021 eq. 11: output torque M_T = r·μ·F_N·\[2χ(x_r) − χ(x0)\]/χ(x0) \[N·m\]: the drive
 /// zone |x| < x_r pushes, the rest of the contact brakes, pressure normalised to F_N.
 ///
 /// Units: `rotor_radius_m` r, `preload_n` F_N, lengths in m, k \[1/m\]. Range:
@@ -184,7 +184,7 @@ pub fn output_torque_nm(
     (chi0 != 0.0 && t.is_finite()).then_some(t)
 }
 
-/// Seed 001 eq. 12: tangential speed of the stator surface v_s(x) = k·W·h0·ω·cos(kx) \[m/s\]
+/// Sun et al. 2021 eq. 12: tangential speed of the stator surface v_s(x) = k·W·h0·ω·cos(kx) \[m/s\]
 /// (magnitude; the surface moves against the wave). Units: k \[1/m\], `amplitude_m` W,
 /// `neutral_distance_m` h0, ω \[rad/s\], `x_m` (from the crest). Any finite input.
 pub fn stator_surface_speed_m_per_s(
@@ -197,7 +197,7 @@ pub fn stator_surface_speed_m_per_s(
     wavenumber_per_m * amplitude_m * neutral_distance_m * angular_frequency_rad_s * (wavenumber_per_m * x_m).cos()
 }
 
-/// Seed 001 eq. 15: dielectric loss tangent tan δ = 1/(ω·C·R_n) \[-\] of a capacitance C in
+/// Sun et al. 2021 eq. 15: dielectric loss tangent tan δ = 1/(ω·C·R_n) \[-\] of a capacitance C in
 /// parallel with a dielectric resistance R_n. Units: ω \[rad/s\], `capacitance_f`,
 /// `dielectric_resistance_ohm`. `None` if ω·C·R_n is zero or the result not finite.
 pub fn loss_tangent(angular_frequency_rad_s: f64, capacitance_f: f64, dielectric_resistance_ohm: f64) -> Option<f64> {
@@ -217,7 +217,7 @@ pub fn parallel_impedance_ohm(
         .then(|| 1.0 / (1.0 / dielectric_resistance_ohm).hypot(angular_frequency_rad_s * capacitance_f))
 }
 
-/// Seed 001 eq. 16 **as printed**: dielectric loss per drive cycle W1 = V_d²·sin δ·T/R_d \[J\].
+/// Sun et al. 2021 eq. 16 **as printed**: dielectric loss per drive cycle W1 = V_d²·sin δ·T/R_d \[J\].
 ///
 /// Equals ∫₀ᵀ v·i dt for the parallel C–R_n dielectric only if V_d is the RMS voltage and
 /// R_d = |Z| ([`parallel_impedance_ohm`]); with the peak voltage it is twice the integral
@@ -233,7 +233,7 @@ pub fn dielectric_loss_per_cycle_printed_j(
     w.is_finite().then_some(w)
 }
 
-/// Seed 001 eq. 16, corrected for a peak voltage: W1 = V_peak²·sin δ·T/(2·R_d) \[J\]
+/// Sun et al. 2021 eq. 16, corrected for a peak voltage: W1 = V_peak²·sin δ·T/(2·R_d) \[J\]
 /// (= V_peak²·T/(2·R_n) with R_d = |Z|). Units and `None` as in
 /// [`dielectric_loss_per_cycle_printed_j`].
 pub fn dielectric_loss_per_cycle_j(
@@ -246,7 +246,7 @@ pub fn dielectric_loss_per_cycle_j(
         .map(|w| 0.5 * w)
 }
 
-/// Seed 001 eq. 17 **as printed**: damping loss per cycle of the composite stator
+/// Sun et al. 2021 eq. 17 **as printed**: damping loss per cycle of the composite stator
 /// W2 = 8π⁵·W²·k⁴·ΣEIη/(2πr)³ \[J\], with the printed k taken as the number of waves n.
 ///
 /// Only with k = n is eq. 17 dimensionally consistent, and then it equals its integral
@@ -264,14 +264,14 @@ pub fn composite_damping_loss_printed_j(
         / (2.0 * PI * rotor_radius_m).powi(3)
 }
 
-/// Seed 001 eq. 18: ring moment of inertia about the neutral layer
+/// Sun et al. 2021 eq. 18: ring moment of inertia about the neutral layer
 /// I_e = b_e·\[D³ + (h_e − D)³\]/3 \[m⁴\] = b_e·∫₀^{h_e} (z − D)² dz (z down from the ring top).
 /// Units: widths and heights in m. Any finite input.
 pub fn ring_moment_of_inertia_m4(ring_width_m: f64, ring_height_m: f64, neutral_depth_m: f64) -> f64 {
     ring_width_m * (neutral_depth_m.powi(3) + (ring_height_m - neutral_depth_m).powi(3)) / 3.0
 }
 
-/// Seed 001 eq. 19 **as printed**: I_p = b_p·\[(h − D)³ + (h_e − D)³\]/12 \[m⁴\].
+/// Sun et al. 2021 eq. 19 **as printed**: I_p = b_p·\[(h − D)³ + (h_e − D)³\]/12 \[m⁴\].
 ///
 /// Wrong: b_p·∫_{h_e}^{h} (z − D)² dz = b_p·\[(h − D)³ − (h_e − D)³\]/3
 /// ([`piezo_moment_of_inertia_m4`]). Units: m. Any finite input.
@@ -284,7 +284,7 @@ pub fn piezo_moment_of_inertia_printed_m4(
     piezo_width_m * ((total_height_m - neutral_depth_m).powi(3) + (ring_height_m - neutral_depth_m).powi(3)) / 12.0
 }
 
-/// Seed 001 eq. 19, corrected: I_p = b_p·\[(h − D)³ − (h_e − D)³\]/3 \[m⁴\], the second moment
+/// Sun et al. 2021 eq. 19, corrected: I_p = b_p·\[(h − D)³ − (h_e − D)³\]/3 \[m⁴\], the second moment
 /// of the piezo layer h_e ≤ z ≤ h about the neutral layer at depth D. Units: m. Any finite
 /// input.
 pub fn piezo_moment_of_inertia_m4(
@@ -296,12 +296,12 @@ pub fn piezo_moment_of_inertia_m4(
     piezo_width_m * ((total_height_m - neutral_depth_m).powi(3) - (ring_height_m - neutral_depth_m).powi(3)) / 3.0
 }
 
-/// Seed 001 eq. 20: stator height h = h_e + h_p \[m\].
+/// Sun et al. 2021 eq. 20: stator height h = h_e + h_p \[m\].
 pub fn total_height_m(ring_height_m: f64, piezo_height_m: f64) -> f64 {
     ring_height_m + piezo_height_m
 }
 
-/// Seed 001 eq. 21: depth of the neutral layer below the ring top
+/// Sun et al. 2021 eq. 21: depth of the neutral layer below the ring top
 /// D = (E_eq·h_e²·b_e + 2E_p·h_p·h_e·b_p + E_p·h_p²·b_p)/(2·(E_eq·h_e·b_e + E_p·h_p·b_p)) \[m\]
 /// = ∫E·z dA/∫E dA. Units: moduli in Pa, lengths in m. `None` if the axial stiffness
 /// E_eq·h_e·b_e + E_p·h_p·b_p is zero or the result not finite.
@@ -319,7 +319,7 @@ pub fn neutral_layer_depth_m(
     d.is_finite().then_some(d)
 }
 
-/// Coefficients of seed 001 eq. 24-26 (bracket M1·v_m² − M2·v_s0·v_m + M3·v_s0²/2).
+/// Coefficients of Sun et al. 2021 eq. 24-26 (bracket M1·v_m² − M2·v_s0·v_m + M3·v_s0²/2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrictionCoefficients {
     /// M1 = 2·sin(φ/2) − φ·cos(φ/2) \[-\].
@@ -330,7 +330,7 @@ pub struct FrictionCoefficients {
     pub m3: f64,
 }
 
-/// Seed 001 eq. 24-26 as printed, for the full contact angle φ = π − 2ϕ = 2·k·x0 \[rad\].
+/// Sun et al. 2021 eq. 24-26 as printed, for the full contact angle φ = π − 2ϕ = 2·k·x0 \[rad\].
 /// They agree with the integral of eq. 22 (tested). Range: φ ∈ \[0, π\].
 pub fn friction_loss_coefficients(contact_angle_rad: f64) -> FrictionCoefficients {
     let p = contact_angle_rad;
@@ -342,7 +342,7 @@ pub fn friction_loss_coefficients(contact_angle_rad: f64) -> FrictionCoefficient
     }
 }
 
-/// Seed 001 eq. 22: friction loss per drive cycle
+/// Sun et al. 2021 eq. 22: friction loss per drive cycle
 /// W3 = k·ε·W·H·(2π/ω)·\[M1·v_m² − M2·v_s0·v_m + M3·v_s0²/2\] \[J\], with the prefactor k
 /// read as the number of waves n and H = k_f/k with k the wave number (eq. 23).
 ///
@@ -503,7 +503,7 @@ mod tests {
         for (phi0, phis) in [(0.4, 0.2), (1.0, 0.7), (1.5, 0.3)] {
             let (x0, x1) = (phi0 / k, phis / k);
             let f_n = chen2020::axial_force_n(&cc, x0);
-            // seed 001 eq. 5 is seed 000 eq. 6 with k_f = K_f·ε and W = R_sc·ξ
+            // Sun et al. 2021 eq. 5 is Chen et al. 2020 eq. 6 with k_f = K_f·ε and W = R_sc·ξ
             let sc = Contact {
                 wave_number: cc.wave_number,
                 friction_layer_stiffness_n_per_m2: cc.contact_stiffness_n_per_m3 * cc.contact_width_m,
@@ -592,7 +592,7 @@ mod tests {
             let printed_kw = composite_damping_loss_printed_j(kw, w, eih, R);
             let w2_n = composite_damping_loss_printed_j(n, w, eih, R);
             assert!(rel(printed_kw, w2_n) > 1.0 && rel(w2_kw, w2_n) > 0.5, "{printed_kw} {w2_kw} {w2_n}");
-            // and f·W2 is seed 000 eq. 8 (corrected) with λ = 2πr/n
+            // and f·W2 is Chen et al. 2020 eq. 8 (corrected) with λ = 2πr/n
             let f = 42e3;
             let q = chen2020::stator_damping_loss_w(w, n, 2.0 * PI * f, eih, 2.0 * PI * R / n);
             assert!(rel(f * w2_n, q) < 1e-12);
@@ -643,7 +643,7 @@ mod tests {
                 N * lambda / om * integral(|t| eps * kf * w * d(t) * (vs0 * t.sin() - vm).powi(2), lo, PI - lo);
             let w3 = friction_loss_per_cycle_j(&c, eps, w, om, vs0, vm, phi);
             assert!(rel(w3, w3_true) < 1e-10, "{w3} vs {w3_true}");
-            // seed 000 eq. 9 (corrected) with b = ϕ is the same loss as a power
+            // Chen et al. 2020 eq. 9 (corrected) with b = ϕ is the same loss as a power
             let q3 = chen2020::friction_loss_w(N, lambda, w, kf, eps, vs0, vm, lo);
             assert!(rel(q3 * 2.0 * PI / om, w3) < 1e-10);
         }

@@ -1,7 +1,7 @@
 //! Harmonic-balance identification of β from a sampled isolated-electrode (feedback)
-//! voltage (seed 003 eq. 5-9).
+//! voltage (the Hertzian driving-circuit paper (2022) eq. 5-9).
 //!
-//! The feedback voltage is v(t) = g·w(t) (seed 003 eq. 1, g = κ/C_0 in V/m). With the
+//! The feedback voltage is v(t) = g·w(t) (the Hertzian driving-circuit paper (2022) eq. 1, g = κ/C_0 in V/m). With the
 //! complex Fourier coefficients a_n of w, b_n of w³ and c_n of the forcing, eq. 2 balances
 //! harmonic by harmonic (eq. 8, with the linear stiffness the printed form omits):
 //!
@@ -75,7 +75,7 @@ pub struct BetaIdentification {
 }
 
 /// Linear stiffness from a linear resonance, k = m(2πf)², N/m. m in kg (> 0), f in Hz
-/// (> 0). Seed 003 eq. 2 with β = 0.
+/// (> 0). the Hertzian driving-circuit paper (2022) eq. 2 with β = 0.
 pub fn linear_stiffness_from_resonance_n_per_m(modal_mass_kg: f64, frequency_hz: f64) -> HertzResult<f64> {
     check_positive("modal_mass_kg", modal_mass_kg)?;
     check_positive("frequency_hz", frequency_hz)?;
@@ -165,7 +165,7 @@ fn cube_coefficients(a: &[C], h: usize) -> Vec<C> {
 }
 
 /// Identifies β by harmonic balance from a sampled feedback-electrode voltage
-/// (seed 003 eq. 5-9, corrected; see module docs).
+/// (the Hertzian driving-circuit paper (2022) eq. 5-9, corrected; see module docs).
 ///
 /// Errors: [`HertzError::TooShort`] (fewer than 4 drive periods, fewer than
 /// 4(2H+1) samples or fewer than 2H+2 samples per period on average),

@@ -1,4 +1,4 @@
-//! Fixed-step RK4 time simulation of the Hertzian oscillator (seed 003 eq. 2-3) with a
+//! Fixed-step RK4 time simulation of the Hertzian oscillator (the Hertzian driving-circuit paper (2022) eq. 2-3) with a
 //! constant-frequency drive or a slow linear frequency sweep.
 //!
 //! Why a hand-written fixed-step RK4 and no ODE crate: the system has two smooth,
@@ -282,7 +282,7 @@ impl HertzOscillator {
     }
 
     /// State at t = 0 of the first-order periodic solution w = w_s + a·cos(Ωt − φ) of a
-    /// response point (seed 003 eq. 10-12), used to start a simulation on a chosen branch.
+    /// response point (the Hertzian driving-circuit paper (2022) eq. 10-12), used to start a simulation on a chosen branch.
     pub fn branch_state(&self, op: &OperatingPoint, point: &super::ResponsePoint) -> HertzResult<OscillatorState> {
         let eff = self.effective(op)?;
         check_positive("frequency_hz", point.frequency_hz)?;
@@ -295,7 +295,7 @@ impl HertzOscillator {
         })
     }
 
-    /// Time simulation of seed 003 eq. 2-3 at constant drive frequency `frequency_hz`
+    /// Time simulation of the Hertzian driving-circuit paper (2022) eq. 2-3 at constant drive frequency `frequency_hz`
     /// (Hz, > 0) for `duration_s` (s, > 0) from `initial`, drive F·cos(2πft) starting at
     /// t = 0. Steps selected by `record` are returned. Fixed-step RK4 with
     /// `settings.steps_per_period` steps per period.
@@ -348,7 +348,7 @@ impl HertzOscillator {
 
     /// Steady-state fundamental amplitude at constant frequency: integrates `settle_s`
     /// (s, >= 0) from `initial`, then projects w onto cos/sin over `measure_periods`
-    /// (>= 1) whole drive periods (exact DFT on the step grid). Seed 003 eq. 2-3.
+    /// (>= 1) whole drive periods (exact DFT on the step grid). the Hertzian driving-circuit paper (2022) eq. 2-3.
     pub fn steady_state(
         &self,
         op: &OperatingPoint,
@@ -400,7 +400,7 @@ impl HertzOscillator {
         })
     }
 
-    /// Slow linear frequency sweep (seed 003 §2.2 experiment, eq. 2-3): drive
+    /// Slow linear frequency sweep (the Hertzian driving-circuit paper (2022) §2.2 experiment, eq. 2-3): drive
     /// F·cos φ(t), φ = 2π(f_start·t + ½·r·t²), r = (f_end − f_start)/T. Returns the envelope
     /// (half peak-to-peak over windows of `periods_per_window` >= 1 drive periods).
     pub fn simulate_sweep(
@@ -461,7 +461,7 @@ fn step_count(steps: f64, settings: &SimulationSettings) -> HertzResult<u64> {
     Ok((steps as u64).max(1))
 }
 
-/// Largest jump of the requested direction in a sweep envelope (seed 003 Fig. 5 /
+/// Largest jump of the requested direction in a sweep envelope (the Hertzian driving-circuit paper (2022) Fig. 5 /
 /// eq. 12 jump phenomenon): the consecutive window pair with the largest amplitude change
 /// a_{i+1} − a_i of the requested sign (`upward`: increase, else decrease), in metres so
 /// that the beating of small free transients does not count. The steepest step lags the

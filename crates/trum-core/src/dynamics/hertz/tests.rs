@@ -246,7 +246,7 @@ fn jump_points_closed_form_matches_discriminant_and_root_count() {
 }
 
 /// Softening: backbone frequency decreases with amplitude; the resonance shift and the
-/// hysteresis band grow with voltage and with preload (seed 003 Fig. 11).
+/// hysteresis band grow with voltage and with preload (the Hertzian driving-circuit paper (2022) Fig. 11).
 #[test]
 fn softening_trends_with_voltage_and_preload() {
     let o = HertzOscillator::default();

@@ -15,7 +15,7 @@ fn first_crossing(time_s: &[f64], speed: &[f64], level: f64) -> Option<f64> {
 
 /// Delay (50 %), rise time (10-90 %), overshoot and settling time (±2 % band) of a
 /// speed history against its final value. Control-textbook definitions (Ogata,
-/// *Modern Control Engineering*, §5-3); seed 004 reports delay and overshoot without
+/// *Modern Control Engineering*, §5-3); the bar-type transient paper reports delay and overshoot without
 /// defining them. All are `None` when the final speed is not positive or the record has
 /// fewer than two samples; the settling time is `None` while the speed is still outside
 /// the band at the last sample.

@@ -101,7 +101,7 @@ impl Model {
                 continue;
             }
             let p = self.kf_node * pen;
-            // seed 004 eq. 2: trial (no-slip) force against the Coulomb limit
+            // the bar-type transient paper eq. 2: trial (no-slip) force against the Coulomb limit
             let trial = *delta + self.h0k * (dqb * c - dqa * sn) - dur;
             let f_trial = self.kt_node * trial;
             let limit = self.mu * p;
@@ -111,7 +111,7 @@ impl Model {
                 n_stick += 1;
                 f_trial
             } else {
-                // seed 004 eq. 1: slip at μ·p in the direction of the slip
+                // the bar-type transient paper eq. 1: slip at μ·p in the direction of the slip
                 let f = limit.copysign(f_trial);
                 *delta = f / self.kt_node;
                 *state = NodeState::Slip;

@@ -66,7 +66,7 @@ fn converges_in_time_step_and_node_count() {
     assert!(rel(fine_x, base) < 5e-3, "{fine_x} vs {base}");
 }
 
-/// 0° phase difference drives a standing wave: no net rotation (seed 004, section III.C);
+/// 0° phase difference drives a standing wave: no net rotation (the bar-type transient paper, section III.C);
 /// −90° reverses the rotor.
 #[test]
 fn standing_wave_does_not_turn_the_rotor_and_minus_90_reverses() {
@@ -83,7 +83,7 @@ fn standing_wave_does_not_turn_the_rotor_and_minus_90_reverses() {
     assert!(standing.metrics.delay_s.is_none());
 }
 
-/// Trends of seed 004 Fig. 3-5: speed grows with voltage and near resonance; the
+/// Trends of the bar-type transient paper Fig. 3-5: speed grows with voltage and near resonance; the
 /// response is a lightly damped second-order-like step with overshoot, settling in a few ms.
 #[test]
 fn step_metrics_follow_voltage_and_frequency() {
@@ -137,7 +137,7 @@ fn snapshots_show_the_contact_zones() {
             NodeState::NoContact => assert_eq!(n.pressure_n_per_m, 0.0),
             NodeState::Slip => {
                 assert!(rel(n.tangential_force_n_per_m.abs(), bound) < 1e-9);
-                // the friction force on the rotor follows the slip v_s − v_r (seed 004 eq. 1);
+                // the friction force on the rotor follows the slip v_s − v_r (the bar-type transient paper eq. 1);
                 // within one step of a slip reversal the node re-sticks first, so a mismatch
                 // is only possible at slip speeds below |d(slip)/dt|·h ≈ 5 mm/s
                 let agrees = n.tangential_force_n_per_m * n.slip_speed_m_s >= 0.0;
