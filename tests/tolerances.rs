@@ -1,0 +1,56 @@
+//! The `[tolerances]` table of a motor file: the baseline calibration's priors
+//! (docs/MOTOR_FILE.md, docs/DIAGNOSIS.md).
+
+use trum_core::params::tolerances_from_toml_str;
+use trum_core::Motor;
+
+const MOTOR: &str = include_str!("data/motors/ring60.toml");
+
+#[test]
+fn dotted_keys_and_sub_tables_are_read_and_the_motor_still_reads() {
+    let text = format!(
+        "{MOTOR}\n[tolerances]\n\"geometry.neutral_plane_distance_m\" = 0.02\n\"stator.resonance_frequency_hz\" = 0\n\
+         \"friction_layer.youngs_modulus_pa\" = inf\n[tolerances.electrical]\ndielectric_loss_tangent = 0.2\n"
+    );
+    let t = tolerances_from_toml_str(&text, "m.toml").expect("valid table");
+    assert_eq!(t.get("geometry.neutral_plane_distance_m"), Some(&0.02));
+    assert_eq!(t.get("stator.resonance_frequency_hz"), Some(&0.0));
+    assert_eq!(t.get("friction_layer.youngs_modulus_pa"), Some(&f64::INFINITY));
+    assert_eq!(t.get("electrical.dielectric_loss_tangent"), Some(&0.2));
+    // the motor reader accepts the table (it ignores it)
+    let m = Motor::from_toml_str(&text, "m.toml").expect("motor");
+    assert_eq!(m, Motor::from_toml_str(MOTOR, "m.toml").expect("motor"));
+    // without a table: no overrides
+    assert!(tolerances_from_toml_str(MOTOR, "m.toml").expect("no table").is_empty());
+}
+
+#[test]
+fn a_tolerance_on_a_parameter_that_is_not_fitted_or_negative_is_an_error_naming_it() {
+    let unknown = format!("{MOTOR}\n[tolerances]\n\"rotor.mass_kg\" = 0.1\n");
+    let e = tolerances_from_toml_str(&unknown, "m.toml").expect_err("rotor mass is not calibrated").to_string();
+    assert!(e.contains("m.toml") && e.contains("tolerances.rotor.mass_kg") && e.contains("valid keys"), "{e}");
+    let negative = format!("{MOTOR}\n[tolerances]\n\"geometry.mean_radius_m\" = -0.1\n");
+    let e = tolerances_from_toml_str(&negative, "m.toml").expect_err("negative").to_string();
+    assert!(e.contains("tolerances.geometry.mean_radius_m") && e.contains(">= 0"), "{e}");
+}
+
+#[test]
+fn a_zero_tolerance_holds_the_parameter_and_others_keep_their_priors() {
+    use trum_core::calibrate::{baseline_params, baseline_params_with, Observable, ObservedRow};
+    let m = Motor::from_toml_str(MOTOR, "m.toml").expect("motor");
+    let rows: Vec<ObservedRow> = (0..4)
+        .map(|i| ObservedRow {
+            op: trum_core::OperatingPoint::new(100.0 + 50.0 * i as f64, 0.0, 200.0, 43e3),
+            readings: vec![(Observable::SpeedRpm, 100.0, 1.0)],
+            ambient_c: 25.0,
+            speed_std_clipped: false,
+        })
+        .collect();
+    let all = baseline_params(&m, &rows);
+    let held: std::collections::BTreeMap<String, f64> =
+        [("stator.resonance_frequency_hz".to_string(), 0.0)].into_iter().collect();
+    let fewer = baseline_params_with(&m, &rows, &held);
+    assert_eq!(fewer.len() + 1, all.len());
+    assert!(!fewer.iter().any(|p| p.param.name() == "stator.resonance_frequency_hz"));
+    assert!(fewer.iter().all(|p| p.prior.is_some()));
+}
