@@ -1146,7 +1146,9 @@ pub fn diagnose(
         // on a subsample of the rows. A valley the fits above did not reach — beyond their
         // bounds, or simply lower on the scan's rows than where they ended — is fitted
         // from, with the bounds widened to hold it (`scan`).
-        if nested.is_none() && effects.len() == 1 {
+        // (a fit already at the noise has nothing left for another valley to explain)
+        let at_noise_now = cal.as_ref().is_ok_and(|c| !c.abandoned && c.chi2 <= 1.5 * n_read as f64);
+        if nested.is_none() && effects.len() == 1 && !at_noise_now {
             let fit_motor = match &cal {
                 Ok(c) if !c.abandoned => c.motor.clone(),
                 _ => start.clone(),

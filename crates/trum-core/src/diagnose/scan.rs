@@ -20,6 +20,12 @@ const SCAN_ROWS: usize = 120;
 /// Most valleys handed back (each costs a fit).
 const MAX_VALLEYS: usize = 2;
 
+/// Largest strength of the grid, × typical: two decades above the typical strength, the
+/// top of the documented range where that is lower. (`voltage_sag`'s documented range
+/// reaches 1e5 Ω, where the electrode voltage is all but gone and every solve of the
+/// sagging drive is slow; 100 × typical is 15 kΩ.)
+const MAX_FACTOR: f64 = 100.0;
+
 /// Ratio between neighbouring strengths of the grid (√10: two points a decade).
 const GRID_RATIO: f64 = 3.162_277_660_168_379;
 
@@ -46,7 +52,7 @@ fn factors(e: Effect) -> Vec<f64> {
         .fold(f64::INFINITY, f64::min);
     let mut out = Vec::new();
     let mut f = 0.1;
-    while f <= top * (1.0 + 1e-9) && out.len() < 16 {
+    while f <= top.min(MAX_FACTOR) * (1.0 + 1e-9) {
         out.push(f);
         f *= GRID_RATIO;
     }
