@@ -110,6 +110,25 @@ def svg_plot(path, title, xlabel, ylabel, curves, points=(), vlines=(), band=Non
     print(f"wrote {os.path.relpath(path, ROOT)}", file=sys.stderr)
 
 
+def png_plot(path, name, xcol, ycol, model, paper_pts):
+    """The same comparison as a PNG drawn by `trum plot --map`: the model curve is group
+    `paper = 0`, the paper's numbers group `paper = 1` (joined by a line; a peak is a
+    vertical line from 0 to the curve's maximum)."""
+    tmp = os.path.join(OUT, name + ".csv")
+    with open(tmp, "w") as f:
+        f.write(f"{xcol},{ycol},paper\n")
+        for x, y in model:
+            if y == y:
+                f.write(f"{x},{y},0\n")
+        for x, y in paper_pts:
+            f.write(f"{x},{y},1\n")
+    print(f"$ trum plot --map {name}.csv --x {xcol} --y {ycol} --group paper -o {os.path.basename(path)}", file=sys.stderr)
+    subprocess.run([TRUM, "plot", "--map", name + ".csv", "--x", xcol, "--y", ycol, "--group", "paper", "-o", path],
+                   check=True, cwd=OUT, capture_output=True)
+    os.remove(tmp)
+    print(f"wrote {os.path.relpath(path, ROOT)}", file=sys.stderr)
+
+
 def num(rows, col):
     return [float(r[col]) if r[col] not in ("", "nan", "NaN") else float("nan") for r in rows]
 
@@ -131,6 +150,13 @@ def main():
               ("trum: max efficiency × 5", f, [5 * e for e in num(opt, "max_efficiency")], "#27ae60")],
              vlines=[("Chen 2020: stall peak 260 N", float(get(chen, "stall_torque_peak_n")[0]["value"]), paper_c),
                      ("Chen 2020: efficiency peak 320 N", float(get(chen, "max_efficiency_peak_n")[0]["value"]), "#8e44ad")])
+    st = num(opt, "stall_torque_nm")
+    top = max(y for y in st if y == y)
+    png_plot(os.path.join(OUT, "papers_trum60a_stall_torque.png"), "TRUM60A 200 V 42 kHz (paper 1 = Chen 2020 peak)", "preload_n", "stall_torque_nm",
+             list(zip(f, st)), [(260.0, 0.0), (260.0, top)])
+    ef = num(opt, "max_efficiency")
+    png_plot(os.path.join(OUT, "papers_trum60a_max_efficiency.png"), "TRUM60A 200 V 42 kHz (paper 1 = Chen 2020 peak)", "preload_n", "max_efficiency",
+             list(zip(f, ef)), [(320.0, 0.0), (320.0, max(y for y in ef if y == y))])
     svg_plot(os.path.join(OUT, "papers_trum60a_region.svg"),
              "TRUM60A at 200 V, 42 kHz: criterion score and optimum region",
              "preload [N]", "score [-]",
@@ -150,6 +176,8 @@ def main():
                [num(pts, "contact_angle_deg")[xs.index(100.0)], num(pts, "contact_angle_deg")[xs.index(100.0)] + 0.033 * 470], paper_c)],
              points=[("Chen 2020: Xc (Fig. 7)", float(r["preload_n"]), float(r["value"]), paper_c) for r in ang],
              ylim=(0, 42))
+    png_plot(os.path.join(OUT, "papers_trum60a_contact_angle.png"), "TRUM60A 200 V 43 kHz (paper 1 = Chen 2020 Fig. 7)", "preload_n", "contact_angle_deg",
+             list(zip(xs, num(pts, "contact_angle_deg"))), [(float(r["preload_n"]), float(r["value"])) for r in ang])
     fl = table(trum("optimize", "--motor", "trum60a", "--preload-n", "150:500:36", "--frequency-hz", "43000", "-q", "-o", "-"))
     svg_plot(os.path.join(OUT, "papers_trum60a_fluctuation.svg"),
              "TRUM60A at 200 V, 43 kHz: speed fluctuation from a 5 µm runout",
@@ -170,6 +198,10 @@ def main():
              [("trum: speed", qx, num(q, "speed_rpm"), trum_c), ("trum: feedback", qx, num(q, "feedback_v"), "#27ae60")],
              points=[("Sun 2021 Table 2: speed", float(r["preload_n"]), float(r["speed_rpm"]), paper_c) for r in t2]
              + [("Sun 2021 Table 2: feedback", float(r["preload_n"]), float(r["feedback_v"]), "#8e44ad") for r in t2])
+    png_plot(os.path.join(OUT, "papers_qut_speed.png"), "TRUM-60 150 V 42 kHz (paper 1 = Sun 2021 Table 2)", "preload_n", "speed_rpm",
+             list(zip(qx, num(q, "speed_rpm"))), [(float(r["preload_n"]), float(r["speed_rpm"])) for r in t2])
+    png_plot(os.path.join(OUT, "papers_qut_feedback.png"), "TRUM-60 150 V 42 kHz (paper 1 = Sun 2021 Table 2)", "preload_n", "feedback_v",
+             list(zip(qx, num(q, "feedback_v"))), [(float(r["preload_n"]), float(r["feedback_v"])) for r in t2])
     cur = get(sun, "current_a")
     amp = get(sun, "amplitude_peak_um")[0]
     svg_plot(os.path.join(OUT, "papers_qut_current_amplitude.svg"),

@@ -149,7 +149,7 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
         let rows: Vec<Vec<String>> = res.rows.iter().map(|r| row_cells(r, &|v| fmt_sig(v, 5))).collect();
         let header: Vec<String> = COLUMNS
             .iter()
-            .map(|c| match crate::args::unit_of(c) {
+            .map(|c| match crate::args::unit_of(c).or((*c == "temperature_rise_after_run_k").then_some("K")) {
                 Some(u) if u != "-" => format!("{c} [{}]", u.replace(' ', "·")),
                 _ => c.to_string(),
             })
