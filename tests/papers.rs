@@ -342,3 +342,44 @@ fn sun2021_efficiency_grid() {
     assert!(EFFICIENCY_BAND.0 <= emax && emax <= EFFICIENCY_BAND.1, "largest efficiency {emax}");
     assert!(share <= 0.10, "{clamped} of {total} clamped");
 }
+
+// ---- `trum optimize`: the drive, the edge and the comparison ----
+
+fn run_cli(args: &[&str]) -> (i32, String, String) {
+    let argv = std::iter::once("trum").chain(args.iter().copied());
+    let (mut out, mut err) = (Vec::new(), Vec::new());
+    let code = trum_cli::run_with_io(argv, &mut out, &mut err);
+    (code, String::from_utf8_lossy(&out).into_owned(), String::from_utf8_lossy(&err).into_owned())
+}
+
+/// A bare `trum optimize --motor trum60a` runs at the preset's drive (200 V, 42 kHz) and
+/// compares its region with the paper's by overlap; an optimum on the edge of the range is
+/// reported with a wider range to try; the CLI's numbers are the library's.
+#[test]
+fn optimize_uses_the_drive_reports_edges_and_compares() {
+    let (code, out, err) = run_cli(&["optimize", "--motor", "trum60a", "--preload-n", "150:450:7", "-q"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("at 200 V, 42000 Hz (the motor's [drive])"), "{out}");
+    let m = trum60a();
+    let cfg = CriterionConfig {
+        preload_n: Axis::linspace(150.0, 450.0, 7),
+        voltage_v: 200.0,
+        frequency_hz: 42e3,
+        ..CriterionConfig::seed000()
+    };
+    let r = evaluate(&m, &cfg, &mut |_, _| {}).expect("criterion");
+    let (ov, frac) = region_overlap(r.region_n, (260.0, 320.0));
+    assert!(out.contains(&format!("optimum region {}-{} N", r.region_n.0, r.region_n.1)), "{out}");
+    assert!(out.contains(&format!("overlap {ov} N ({}% of the paper's region)", 100.0 * frac)), "{out}");
+    // the command line wins over the drive
+    let (_, out43, _) =
+        run_cli(&["optimize", "--motor", "trum60a", "--preload-n", "150:450:4", "--frequency-hz", "43000", "-q"]);
+    assert!(out43.contains("at 200 V, 43000 Hz (voltage from the motor's [drive]):"), "{out43}");
+    // a range whose best candidate is its lowest (the stall torque alone, from 300 N up)
+    let (_, edge, _) =
+        run_cli(&["optimize", "--motor", "trum60a", "--preload-n", "360:500:8", "--weights", "1,0,0,0", "-q"]);
+    assert!(edge.contains("warning: the optimum is the lowest running candidate (360 N)"), "{edge}");
+    // generic60 has no drive and no published region
+    let (_, g, _) = run_cli(&["optimize", "--motor", "generic60", "--preload-n", "150:450:4", "-q"]);
+    assert!(g.contains("at 200 V, 43000 Hz:") && !g.contains("paper ("), "{g}");
+}

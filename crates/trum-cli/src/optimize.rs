@@ -165,8 +165,10 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
         "at {} V, {} Hz{}: optimum preload {} N; optimum region {}-{} N (score within {}% of the best; weights {})",
         fmt_sig(cfg.voltage_v, 5),
         fmt_sig(cfg.frequency_hz, 6),
-        match (a.voltage_v.is_none() || a.frequency_hz.is_none(), drive) {
-            (true, Some(_)) => " (the motor's [drive])",
+        match (drive.is_some(), a.voltage_v.is_none(), a.frequency_hz.is_none()) {
+            (true, true, true) => " (the motor's [drive])",
+            (true, true, false) => " (voltage from the motor's [drive])",
+            (true, false, true) => " (frequency from the motor's [drive])",
             _ => "",
         },
         fmt_sig(res.optimum_preload_n, 5),

@@ -372,4 +372,61 @@ mod tests {
             assert!((row.torque_at_max_efficiency_nm - at).abs() <= 0.1 * h, "{row:?} vs the peak at {at}");
         }
     }
+
+    /// For every preset at its drive: just below the loaded stall torque the rotor turns,
+    /// just above it the steady state is `stall`, and the loaded rotor stops no later than
+    /// the rotor-at-rest torque at the no-load amplitude.
+    #[test]
+    fn loaded_stall_torque_is_where_the_status_turns_to_stall() {
+        for preset in crate::presets::PRESETS {
+            let motor = preset.motor();
+            let d = preset.drive().map_or((200.0, 43_000.0), |d| (d.voltage_v, d.frequency_hz));
+            let p = Prepared::new(&motor);
+            for f in [150.0, 300.0] {
+                let t = loaded_stall_torque_nm(&p, &motor, f, d.0, d.1);
+                let at = |t: f64| solve_prepared(&p, &motor, &OperatingPoint::new(f, t, d.0, d.1), None);
+                assert!(t > 0.0, "{} {f} N: {t}", preset.name);
+                assert_eq!(at(t * (1.0 - 1e-6)).status, Status::Ok, "{} {f} N: {t}", preset.name);
+                assert_eq!(at(t * (1.0 + 1e-6)).status, Status::Stall, "{} {f} N: {t}", preset.name);
+                let formula = at(0.0).stall_torque_nm;
+                assert!(t <= formula * (1.0 + 1e-9), "{} {f} N: loaded {t} above {formula}", preset.name);
+            }
+        }
+    }
+
+    /// Overlap of preload regions: contained, partial, disjoint, a point reference.
+    #[test]
+    fn region_overlap_measures_the_shared_interval() {
+        assert_eq!(region_overlap((150.0, 360.0), (260.0, 320.0)), (60.0, 1.0));
+        assert_eq!(region_overlap((150.0, 290.0), (260.0, 320.0)), (30.0, 0.5));
+        assert_eq!(region_overlap((100.0, 200.0), (260.0, 320.0)), (0.0, 0.0));
+        assert_eq!(region_overlap((100.0, 300.0), (260.0, 260.0)), (0.0, 1.0));
+    }
+
+    /// The optimum's place in the searched range, with disqualified candidates at the ends
+    /// not counted as searched.
+    #[test]
+    fn optimum_edge_is_judged_among_running_candidates() {
+        let row = |f: f64, score: f64| CriterionRow {
+            preload_n: f,
+            status: if score.is_finite() { Status::Ok } else { Status::Clamped },
+            stall_torque_nm: 1.0,
+            max_efficiency: 0.3,
+            torque_at_max_efficiency_nm: 0.5,
+            temperature_rise_after_run_k: 1.0,
+            speed_std_rpm: 0.1,
+            no_load_speed_rpm: 100.0,
+            score,
+            in_region: false,
+        };
+        let res = |opt: f64, scores: [f64; 4]| CriterionResult {
+            rows: [100.0, 200.0, 300.0, 400.0].iter().zip(scores).map(|(&f, s)| row(f, s)).collect(),
+            optimum_preload_n: opt,
+            region_n: (opt, opt),
+        };
+        assert_eq!(res(100.0, [0.9, 0.5, 0.4, 0.3]).optimum_edge(), Edge::Low);
+        assert_eq!(res(400.0, [0.1, 0.5, 0.6, 0.9]).optimum_edge(), Edge::High);
+        assert_eq!(res(300.0, [0.1, 0.5, 0.9, f64::NAN]).optimum_edge(), Edge::High);
+        assert_eq!(res(200.0, [0.1, 0.9, 0.6, 0.3]).optimum_edge(), Edge::Interior);
+    }
 }
