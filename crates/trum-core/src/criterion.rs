@@ -374,7 +374,7 @@ mod tests {
     }
 
     /// For every preset at its drive: just below the loaded stall torque the rotor turns,
-    /// just above it the steady state is `stall`, and the loaded rotor stops no later than
+    /// just above it the rotor is at rest (`stall`, or `clamped`), and the loaded rotor stops no later than
     /// the rotor-at-rest torque at the no-load amplitude.
     #[test]
     fn loaded_stall_torque_is_where_the_status_turns_to_stall() {
@@ -387,7 +387,9 @@ mod tests {
                 let at = |t: f64| solve_prepared(&p, &motor, &OperatingPoint::new(f, t, d.0, d.1), None);
                 assert!(t > 0.0, "{} {f} N: {t}", preset.name);
                 assert_eq!(at(t * (1.0 - 1e-6)).status, Status::Ok, "{} {f} N: {t}", preset.name);
-                assert_eq!(at(t * (1.0 + 1e-6)).status, Status::Stall, "{} {f} N: {t}", preset.name);
+                // at rest: stalled, or clamped where the rotor at rest takes the wave's power
+                let above = at(t * (1.0 + 1e-6)).status;
+                assert!(matches!(above, Status::Stall | Status::Clamped), "{} {f} N: {t}: {above}", preset.name);
                 let formula = at(0.0).stall_torque_nm;
                 assert!(t <= formula * (1.0 + 1e-9), "{} {f} N: loaded {t} above {formula}", preset.name);
             }

@@ -147,6 +147,24 @@ pub fn find(name: &str) -> Result<&'static Preset, ParamError> {
     })
 }
 
+/// The motors the model's own unit tests were written for: frozen baseline copies of the
+/// paper presets (`tests/data/motors/`, no effects), so a recalibration of `trum60a` or
+/// `trum60-qut` does not move the solver's regression points; other names are the presets.
+#[cfg(test)]
+pub(crate) fn frozen(name: &str) -> Result<Motor, ParamError> {
+    match name {
+        "trum60a" => Motor::from_toml_str(
+            include_str!("../../../tests/data/motors/trum60a_baseline.toml"),
+            "trum60a_baseline.toml",
+        ),
+        "trum60-qut" => Motor::from_toml_str(
+            include_str!("../../../tests/data/motors/trum60-qut_baseline.toml"),
+            "trum60-qut_baseline.toml",
+        ),
+        other => preset(other),
+    }
+}
+
 /// The motor of a preset by name.
 pub fn preset(name: &str) -> Result<Motor, ParamError> {
     find(name).map(|p| p.motor())

@@ -282,7 +282,7 @@ pub fn synthesize(motor: &Motor, cfg: &SynthConfig) -> Result<Vec<SynthRow>, Tru
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::presets::preset;
+    use crate::presets::frozen as preset;
 
     #[test]
     fn same_seed_same_data_and_zero_noise_is_exact() {
