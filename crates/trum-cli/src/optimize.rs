@@ -194,6 +194,16 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
             cfg.preload_n.n + cfg.preload_n.n / 2
         )),
     }
+    if res.optimum_edge() == Edge::Interior {
+        let running: Vec<f64> = res.rows.iter().filter(|r| r.score.is_finite()).map(|r| r.preload_n).collect();
+        let (lo, hi) = (running.first().copied(), running.last().copied());
+        if lo == Some(res.region_n.0) {
+            summary.push_str("\nnote: the optimum region reaches the lowest running candidate; it may extend below the searched range");
+        }
+        if hi == Some(res.region_n.1) {
+            summary.push_str("\nnote: the optimum region reaches the highest running candidate; it may extend above the searched range");
+        }
+    }
     if let Some((_, paper, source)) = PAPER_REGIONS_N.iter().find(|(n, _, _)| motor.preset.as_deref() == Some(*n)) {
         let (overlap, frac) = region_overlap(res.region_n, *paper);
         let mid = |r: (f64, f64)| 0.5 * (r.0 + r.1);
