@@ -2,17 +2,23 @@
 //! zero strength reproduces the baseline exactly; truth forms differ from candidate forms.
 
 use trum_core::effects::{Effect, ALL};
-use trum_core::presets::preset;
 use trum_core::{solve, Motor, OperatingPoint, Solution, Status};
 
+/// The baseline motor the effects are switched on in: a frozen TRUM60A without effects
+/// (tests/data/motors/trum60a_baseline.toml), independent of the presets' calibration.
+fn baseline() -> Motor {
+    let text = include_str!("data/motors/trum60a_baseline.toml");
+    Motor::from_toml_str(text, "trum60a_baseline.toml").expect("frozen baseline motor")
+}
+
 fn with(effect: Effect, params: &[f64]) -> Motor {
-    let mut m = preset("trum60a").unwrap();
+    let mut m = baseline();
     m.effects.set(effect, params);
     m
 }
 
 fn typical(effect: Effect) -> Motor {
-    let mut m = preset("trum60a").unwrap();
+    let mut m = baseline();
     m.effects.set_strength(effect, effect.info().params[0].typical);
     m
 }
@@ -23,7 +29,7 @@ fn at(m: &Motor, f: f64, t: f64) -> Solution {
 
 #[test]
 fn zero_strength_reproduces_the_baseline_exactly() {
-    let base = preset("trum60a").unwrap();
+    let base = baseline();
     for e in ALL {
         for (truth, form_b) in [(false, false), (true, false), (true, true)] {
             let mut m = with(e, &[0.0, 0.0]);
@@ -49,7 +55,7 @@ fn zero_strength_reproduces_the_baseline_exactly() {
 /// neglecting it over-predicts no-load speed and stall torque.
 #[test]
 fn radial_friction_matches_seed002_claims() {
-    let base = preset("trum60a").unwrap();
+    let base = baseline();
     let m = typical(Effect::RadialFriction);
     for t in [0.0, 0.2, 0.35] {
         let s = at(&m, 250.0, t);
@@ -87,7 +93,7 @@ fn speed_optimal_frequency(m: &Motor, f_n: f64) -> f64 {
 /// speed-optimal frequency moves up with preload (the baseline's does not move).
 #[test]
 fn preload_stiffening_moves_the_optimal_frequency_up_with_preload() {
-    let base = preset("trum60a").unwrap();
+    let base = baseline();
     let b = speed_optimal_frequency(&base, 300.0) - speed_optimal_frequency(&base, 100.0);
     let m = typical(Effect::PreloadStiffening);
     let s = speed_optimal_frequency(&m, 300.0) - speed_optimal_frequency(&m, 100.0);
@@ -100,7 +106,7 @@ fn preload_stiffening_moves_the_optimal_frequency_up_with_preload() {
 /// the Hertzian driving-circuit paper (2022): the softening cubic term lowers the resonance, more at higher voltage.
 #[test]
 fn hertz_softening_shifts_resonance_down_with_amplitude() {
-    let base = preset("trum60a").unwrap();
+    let base = baseline();
     let m = typical(Effect::HertzSoftening);
     let fb = speed_optimal_frequency(&base, 200.0);
     let fs = speed_optimal_frequency(&m, 200.0);
@@ -146,7 +152,7 @@ fn hertz_softening_has_a_multivalued_band_with_jump_frequencies() {
     let stable_at = |f: f64| amplitude_branches(&m, &op(200.0, f)).iter().filter(|x| x.stable).count();
     assert_eq!((stable_at(up2 - 1.0), stable_at(up2 + 1.0)), (2, 1));
     // no softening, no band
-    let base = preset("trum60a").unwrap();
+    let base = baseline();
     assert_eq!(jump_frequencies_hz(&base, &op(200.0, 0.0), 30e3, 46e3, 160), None);
 }
 
@@ -173,7 +179,7 @@ fn thermal_drift_makes_speed_fall_over_a_run() {
 #[test]
 fn thermal_drift_damping_grows_with_temperature_and_slows_the_rotor() {
     let run = |coefs: &[f64], t: f64| {
-        let mut m = preset("trum60a").unwrap();
+        let mut m = baseline();
         m.effects.set(Effect::ThermalDrift, coefs);
         let mut op = OperatingPoint::new(250.0, 0.3, 200.0, 43e3);
         op.elapsed_s = t;
@@ -210,14 +216,14 @@ fn voltage_sag_grows_with_preload_and_torque() {
     assert!(a.electrode_voltage_v < 200.0);
     assert!(b.electrode_voltage_v < a.electrode_voltage_v, "{} vs {}", b.electrode_voltage_v, a.electrode_voltage_v);
     assert!(c.electrode_voltage_v < b.electrode_voltage_v);
-    assert!(at(&m, 250.0, 0.3).speed_rpm < at(&preset("trum60a").unwrap(), 250.0, 0.3).speed_rpm);
+    assert!(at(&m, 250.0, 0.3).speed_rpm < at(&baseline(), 250.0, 0.3).speed_rpm);
 }
 
 /// Chen et al. 2020 section 4.3: an eccentric rotor makes the speed fluctuate once per revolution;
 /// the fluctuation grows with the runout.
 #[test]
 fn eccentricity_makes_speed_fluctuate() {
-    let base = at(&preset("trum60a").unwrap(), 250.0, 0.2);
+    let base = at(&baseline(), 250.0, 0.2);
     assert_eq!(base.speed_std_rpm, 0.0);
     let s1 = at(&with(Effect::Eccentricity, &[10e-6]), 250.0, 0.2);
     let s2 = at(&with(Effect::Eccentricity, &[40e-6]), 250.0, 0.2);
@@ -232,7 +238,7 @@ fn eccentricity_makes_speed_fluctuate() {
 /// speed–torque curve (no corner at stall).
 #[test]
 fn tangential_compliance_lowers_the_speed_torque_curve() {
-    let base = preset("trum60a").unwrap();
+    let base = baseline();
     let m = typical(Effect::TangentialCompliance);
     for t in [0.0, 0.3, 0.6] {
         let (b, c) = (at(&base, 250.0, t), at(&m, 250.0, t));
@@ -274,11 +280,11 @@ fn tangential_compliance_rounds_the_stall_corner() {
         (t(1e-3) - t(0.1)) / (t(0.5) - t(0.6))
     };
     let compliant = |k: f64| {
-        let mut m = preset("trum60a").unwrap();
+        let mut m = baseline();
         m.effects.set_strength(Effect::TangentialCompliance, k);
         corner(&m)
     };
-    let base = corner(&preset("trum60a").unwrap());
+    let base = corner(&baseline());
     let (c1, c2) = (compliant(1.0), compliant(2.0));
     assert!(base < 0.25, "baseline corner ratio {base}");
     assert!(c1 > 2.0 * base, "typical compliance {c1} vs baseline {base}");

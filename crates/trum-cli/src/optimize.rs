@@ -6,23 +6,25 @@ use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
-use trum_core::criterion::{evaluate, CriterionConfig, CriterionRow};
+use trum_core::criterion::{evaluate, region_overlap, CriterionConfig, CriterionRow, Edge};
+use trum_core::params::Drive;
 use trum_core::sweep::Axis;
 
-/// The paper's optimum preload region for the TRUM60A (seed 000 section 5) [N].
-const PAPER_REGION_TRUM60A_N: (f64, f64) = (260.0, 320.0);
+/// Published optimum preload regions [N], by preset: Chen, Zheng and Fan 2020 section 5
+/// (TRUM60A, 260-320 N; tests/data/papers/chen2020_figures.csv).
+const PAPER_REGIONS_N: &[(&str, (f64, f64), &str)] = &[("trum60a", (260.0, 320.0), "Chen et al. 2020 section 5")];
 
 #[derive(Args, Debug)]
 pub struct OptimizeArgs {
     #[command(flatten)]
     motor: MotorArgs,
-    /// Drive voltage amplitude per phase [V].
-    #[arg(long, default_value_t = 200.0)]
-    voltage_v: f64,
-    /// Drive frequency [Hz].
-    #[arg(long, default_value_t = 43_000.0)]
-    frequency_hz: f64,
-    /// Candidate preloads [N] as START:STOP:N (default 150:500:36, as in seed 000).
+    /// Drive voltage amplitude per phase [V] (default: the motor's [drive], else 200 V).
+    #[arg(long)]
+    voltage_v: Option<f64>,
+    /// Drive frequency [Hz] (default: the motor's [drive], else 43 kHz).
+    #[arg(long)]
+    frequency_hz: Option<f64>,
+    /// Candidate preloads [N] as START:STOP:N (default 150:500:36, as in Chen et al. 2020).
     #[arg(long, value_name = "START:STOP:N", value_parser = parse_axis)]
     preload_n: Option<Axis>,
     /// Weights of stall torque, max efficiency, temperature rise, speed fluctuation.
@@ -52,7 +54,7 @@ pub const COLUMNS: [&str; 10] = [
     "stall_torque_nm",
     "max_efficiency",
     "torque_at_max_efficiency_nm",
-    "temperature_rise_k",
+    "temperature_rise_after_run_k",
     "speed_std_rpm",
     "no_load_speed_rpm",
     "score",
@@ -86,7 +88,7 @@ fn row_cells(r: &CriterionRow, fmt: &dyn Fn(f64) -> String) -> Vec<String> {
         fmt(r.stall_torque_nm),
         ind(r.max_efficiency),
         ind(r.torque_at_max_efficiency_nm),
-        ind(r.temperature_rise_k),
+        ind(r.temperature_rise_after_run_k),
         ind(r.speed_std_rpm),
         fmt(r.no_load_speed_rpm),
         ind(r.score),
@@ -94,14 +96,26 @@ fn row_cells(r: &CriterionRow, fmt: &dyn Fn(f64) -> String) -> Vec<String> {
     ]
 }
 
+/// The drive a motor's source figures were taken at: a file's `[drive]` (or its preset's),
+/// or a preset's.
+fn motor_drive(spec: &str) -> Result<Option<Drive>> {
+    let path = std::path::Path::new(spec);
+    if path.is_file() {
+        let text = std::fs::read_to_string(path).with_context(|| format!("cannot read motor file '{spec}'"))?;
+        return Drive::from_toml_str(&text, spec).map_err(|e| anyhow!("{e}"));
+    }
+    Ok(trum_core::presets::find(spec).ok().and_then(|p| p.drive()))
+}
+
 pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
     let (motor, _) = a.motor.load()?;
+    let drive = motor_drive(&a.motor.motor)?;
     let mut cfg = CriterionConfig::seed000();
     if let Some(p) = a.preload_n {
         cfg.preload_n = p;
     }
-    cfg.voltage_v = a.voltage_v;
-    cfg.frequency_hz = a.frequency_hz;
+    cfg.voltage_v = a.voltage_v.or(drive.map(|d| d.voltage_v)).unwrap_or(cfg.voltage_v);
+    cfg.frequency_hz = a.frequency_hz.or(drive.map(|d| d.frequency_hz)).unwrap_or(cfg.frequency_hz);
     cfg.weights = parse_weights(&a.weights)?;
     cfg.run_time_s = a.run_time_s;
     cfg.runout_m = a.runout_m;
@@ -135,7 +149,7 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
         let rows: Vec<Vec<String>> = res.rows.iter().map(|r| row_cells(r, &|v| fmt_sig(v, 5))).collect();
         let header: Vec<String> = COLUMNS
             .iter()
-            .map(|c| match crate::args::unit_of(c) {
+            .map(|c| match crate::args::unit_of(c).or((*c == "temperature_rise_after_run_k").then_some("K")) {
                 Some(u) if u != "-" => format!("{c} [{}]", u.replace(' ', "·")),
                 _ => c.to_string(),
             })
@@ -148,17 +162,60 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     }
     // The summary goes to stdout after the table, or to stderr when stdout carries the CSV.
     let mut summary = format!(
-        "optimum preload {} N; optimum region {}-{} N (score within {}% of the best; weights {})",
+        "at {} V, {} Hz{}: optimum preload {} N; optimum region {}-{} N (score within {}% of the best; weights {})",
+        fmt_sig(cfg.voltage_v, 5),
+        fmt_sig(cfg.frequency_hz, 6),
+        match (drive.is_some(), a.voltage_v.is_none(), a.frequency_hz.is_none()) {
+            (true, true, true) => " (the motor's [drive])",
+            (true, true, false) => " (voltage from the motor's [drive])",
+            (true, false, true) => " (frequency from the motor's [drive])",
+            _ => "",
+        },
         fmt_sig(res.optimum_preload_n, 5),
         fmt_sig(res.region_n.0, 5),
         fmt_sig(res.region_n.1, 5),
         fmt_sig(100.0 * cfg.region_tolerance, 3),
         a.weights
     );
-    if motor.preset.as_deref() == Some("trum60a") {
+    match res.optimum_edge() {
+        Edge::Interior => {}
+        Edge::Low => summary.push_str(&format!(
+            "\nwarning: the optimum is the lowest running candidate ({} N): the best preload may lie below the searched range; widen it, e.g. --preload-n {}:{}:{}",
+            fmt_sig(res.optimum_preload_n, 5),
+            fmt_sig((res.optimum_preload_n - 0.5 * (cfg.preload_n.stop - cfg.preload_n.start)).max(0.5 * res.optimum_preload_n), 4),
+            fmt_sig(cfg.preload_n.stop, 5),
+            cfg.preload_n.n + cfg.preload_n.n / 2
+        )),
+        Edge::High => summary.push_str(&format!(
+            "\nwarning: the optimum is the highest running candidate ({} N): the best preload may lie above the searched range; widen it, e.g. --preload-n {}:{}:{}",
+            fmt_sig(res.optimum_preload_n, 5),
+            fmt_sig(cfg.preload_n.start, 5),
+            fmt_sig(res.optimum_preload_n + 0.5 * (cfg.preload_n.stop - cfg.preload_n.start), 4),
+            cfg.preload_n.n + cfg.preload_n.n / 2
+        )),
+    }
+    if res.optimum_edge() == Edge::Interior {
+        let running: Vec<f64> = res.rows.iter().filter(|r| r.score.is_finite()).map(|r| r.preload_n).collect();
+        let (lo, hi) = (running.first().copied(), running.last().copied());
+        if lo == Some(res.region_n.0) {
+            summary.push_str("\nnote: the optimum region reaches the lowest running candidate; it may extend below the searched range");
+        }
+        if hi == Some(res.region_n.1) {
+            summary.push_str("\nnote: the optimum region reaches the highest running candidate; it may extend above the searched range");
+        }
+    }
+    if let Some((_, paper, source)) = PAPER_REGIONS_N.iter().find(|(n, _, _)| motor.preset.as_deref() == Some(*n)) {
+        let (overlap, frac) = region_overlap(res.region_n, *paper);
+        let mid = |r: (f64, f64)| 0.5 * (r.0 + r.1);
         summary.push_str(&format!(
-            "; paper (seed 000, TRUM60A): {}-{} N",
-            PAPER_REGION_TRUM60A_N.0, PAPER_REGION_TRUM60A_N.1
+            "\npaper ({source}): optimum region {}-{} N; overlap {} N ({}% of the paper's region); optimum {} N {} the paper's region (centre difference {:+} N)",
+            fmt_sig(paper.0, 5),
+            fmt_sig(paper.1, 5),
+            fmt_sig(overlap, 4),
+            fmt_sig(100.0 * frac, 3),
+            fmt_sig(res.optimum_preload_n, 5),
+            if paper.0 <= res.optimum_preload_n && res.optimum_preload_n <= paper.1 { "inside" } else { "outside" },
+            fmt_sig(mid(res.region_n) - mid(*paper), 4),
         ));
     }
     if to_stdout {

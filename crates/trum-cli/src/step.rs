@@ -134,7 +134,18 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
     for p in [&a.plot, &a.snapshot_plot].into_iter().flatten() {
         crate::plot::check_plot_path(p)?;
     }
-    let (motor, _) = a.motor.load()?;
+    let (mut motor, _) = a.motor.load()?;
+    // A paper preset may carry effects its paper's model includes (docs/PRESETS.md); the
+    // transient model has none of them, so it runs on the preset's baseline and says so.
+    // Effects asked for by --effect or a file's own [effects] are still refused.
+    if let Some(preset) = motor.preset.as_deref().and_then(|n| trum_core::presets::find(n).ok()) {
+        let own = preset.motor().effects;
+        if a.motor.effects.is_empty() && !own.is_none() && motor.effects == own {
+            let names: Vec<&str> = own.active().iter().map(|e| e.name()).collect();
+            writeln!(err, "note: the transient model leaves out the preset's {}", names.join(", "))?;
+            motor.effects = trum_core::Effects::none();
+        }
+    }
     if !motor.effects.is_none() {
         bail!(
             "the transient model does not include unmodelled effects; remove --effect and the motor file's [effects]"

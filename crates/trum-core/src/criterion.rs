@@ -1,6 +1,7 @@
-//! The preload optimisation criterion (seed 000 section 5). For each candidate preload:
-//! stall torque, maximum efficiency over load torque, temperature rise after a set run
-//! time (seed 000 eq. 11) and the speed fluctuation from an assembly runout
+//! The preload optimisation criterion (Chen, Zheng and Fan 2020, section 5). For each
+//! candidate preload: stall torque (the load torque at which the loaded rotor stops),
+//! maximum efficiency over load torque, temperature rise after a set run time (Chen et
+//! al. 2020 eq. 11) and the speed fluctuation from an assembly runout
 //! ([`crate::fluctuation`]). Each indicator is scaled to [0, 1] over the candidates
 //! (1 = best: high stall torque, high efficiency, low temperature rise, low fluctuation),
 //! and the weighted mean is the score. The optimum is the best score; the optimum
@@ -43,8 +44,9 @@ pub struct CriterionConfig {
 }
 
 impl CriterionConfig {
-    /// The paper's TRUM60A setting: 150-500 N, 200 V, 43 kHz (seed 000 section 4),
+    /// The paper's TRUM60A setting: 150-500 N, 200 V, 43 kHz (Chen et al. 2020 section 4),
     /// 10 s no-load runs, 5 µm runout (assumed: typical axial runout of a 60 mm rotor).
+    /// A motor's own drive (`[drive]`) replaces the voltage and frequency in `trum optimize`.
     pub fn seed000() -> CriterionConfig {
         CriterionConfig {
             preload_n: Axis::linspace(150.0, 500.0, 36),
@@ -99,14 +101,16 @@ pub struct CriterionRow {
     pub preload_n: f64,
     /// Status at no load (a clamped stator disqualifies the candidate).
     pub status: Status,
-    /// Stall torque [N·m].
+    /// Stall torque [N·m]: the smallest load torque at which the loaded rotor stops
+    /// ([`loaded_stall_torque_nm`]), the torque where `trum map` turns to `stall`.
     pub stall_torque_nm: f64,
     /// Maximum efficiency over load torque [-].
     pub max_efficiency: f64,
     /// Load torque at the maximum efficiency [N·m].
     pub torque_at_max_efficiency_nm: f64,
-    /// Temperature rise after the run time [K].
-    pub temperature_rise_k: f64,
+    /// Temperature rise after the run time at the run torque [K] (Chen et al. 2020 eq. 11
+    /// at t = run time; not the steady rise `temperature_rise_k` of a solution).
+    pub temperature_rise_after_run_k: f64,
     /// Speed standard deviation over a revolution at no load [rev/min].
     pub speed_std_rpm: f64,
     /// No-load speed [rev/min].
@@ -128,6 +132,81 @@ pub struct CriterionResult {
     pub region_n: (f64, f64),
 }
 
+/// Where the optimum sits in the searched range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Edge {
+    /// Strictly inside: the best score has a worse candidate on each side.
+    Interior,
+    /// On the lowest candidate preload: the true optimum may be lower.
+    Low,
+    /// On the highest candidate preload: the true optimum may be higher.
+    High,
+}
+
+impl CriterionResult {
+    /// Whether the optimum is the first or last running candidate (clamped or stalled
+    /// candidates at the ends do not count as searched).
+    pub fn optimum_edge(&self) -> Edge {
+        let running: Vec<f64> = self.rows.iter().filter(|r| r.score.is_finite()).map(|r| r.preload_n).collect();
+        match (running.first(), running.last()) {
+            (Some(&lo), _) if self.optimum_preload_n <= lo => Edge::Low,
+            (_, Some(&hi)) if self.optimum_preload_n >= hi => Edge::High,
+            _ => Edge::Interior,
+        }
+    }
+}
+
+/// Overlap of two preload intervals [N] (0 when they are disjoint), and the fraction of
+/// `reference` it covers (1 when `reference` is a single point inside `region`).
+pub fn region_overlap(region: (f64, f64), reference: (f64, f64)) -> (f64, f64) {
+    let ov = (region.1.min(reference.1) - region.0.max(reference.0)).max(0.0);
+    let width = reference.1 - reference.0;
+    let frac = if width > 0.0 {
+        ov / width
+    } else if region.0 <= reference.0 && reference.0 <= region.1 {
+        1.0
+    } else {
+        0.0
+    };
+    (ov, frac)
+}
+
+/// The stall torque of the loaded rotor [N·m]: the smallest load torque at which the
+/// steady state is `stall`, by bisection on the status between no load (running) and a
+/// torque that stalls, to a relative 1e-9. Under load the rotor slows, the friction takes
+/// more power from the wave and the amplitude falls, so this is at most the no-load
+/// solution's `stall_torque_nm` (the rotor-at-rest torque at the no-load amplitude) for
+/// the baseline interface, and can be far below it near clamping. Returns NaN when the
+/// rotor does not run at no load or no stalling torque is found below 64 times that value.
+pub fn loaded_stall_torque_nm(p: &Prepared, motor: &Motor, preload_n: f64, voltage_v: f64, frequency_hz: f64) -> f64 {
+    let status = |t: f64| solve_prepared(p, motor, &OperatingPoint::new(preload_n, t, voltage_v, frequency_hz), None);
+    let s0 = status(0.0);
+    if s0.status != Status::Ok || !(s0.stall_torque_nm > 0.0) {
+        return f64::NAN;
+    }
+    let (mut lo, mut hi) = (0.0, s0.stall_torque_nm);
+    let mut grow = 0;
+    loop {
+        match status(hi).status {
+            Status::Stall | Status::Clamped => break,
+            Status::Ok if grow < 6 => {
+                lo = hi;
+                hi *= 2.0;
+                grow += 1;
+            }
+            _ => return f64::NAN,
+        }
+    }
+    while hi - lo > 1e-9 * hi {
+        let mid = 0.5 * (lo + hi);
+        match status(mid).status {
+            Status::Ok => lo = mid,
+            _ => hi = mid,
+        }
+    }
+    hi
+}
+
 /// Evaluates the criterion. `progress(done, total)` is called after each candidate.
 pub fn evaluate(
     motor: &Motor,
@@ -145,23 +224,26 @@ pub fn evaluate(
         let mut row = CriterionRow {
             preload_n: f,
             status: s0.status,
-            stall_torque_nm: s0.stall_torque_nm,
+            stall_torque_nm: f64::NAN,
             max_efficiency: 0.0,
             torque_at_max_efficiency_nm: 0.0,
-            temperature_rise_k: f64::NAN,
+            temperature_rise_after_run_k: f64::NAN,
             speed_std_rpm: f64::NAN,
             no_load_speed_rpm: s0.speed_rpm,
             score: f64::NAN,
             in_region: false,
         };
         if s0.status == Status::Ok {
+            row.stall_torque_nm = loaded_stall_torque_nm(&p, motor, f, cfg.voltage_v, cfg.frequency_hz);
+        }
+        if s0.status == Status::Ok && row.stall_torque_nm.is_finite() {
             // max efficiency: sample torques up to stall, then golden-section refine about
             // the best sample and its neighbours (they bracket the peak; efficiency is 0 at
             // no load and at stall, so a best sample with efficiency above 0 is interior)
             let eff = |t: f64| {
                 solve_prepared(&p, motor, &OperatingPoint::new(f, t, cfg.voltage_v, cfg.frequency_hz), None).efficiency
             };
-            let tmax = s0.stall_torque_nm;
+            let tmax = row.stall_torque_nm;
             let m = cfg.torque_samples;
             let step = tmax / (m - 1) as f64;
             let samples: Vec<(f64, f64)> = (0..m).map(|j| (j as f64 * step, eff(j as f64 * step))).collect();
@@ -181,7 +263,7 @@ pub fn evaluate(
                 &OperatingPoint::new(f, cfg.run_torque_nm, cfg.voltage_v, cfg.frequency_hz),
                 None,
             );
-            row.temperature_rise_k =
+            row.temperature_rise_after_run_k =
                 thermal::temperature_rise_k(run.total_loss_w(), p.alpha_s, p.heat_cap, cfg.run_time_s);
             row.speed_std_rpm = fluctuation_about(motor, &p, &op0, &s0, cfg.runout_m, 16).speed_std_rpm;
         }
@@ -221,11 +303,12 @@ pub fn evaluate(
 }
 
 fn score(rows: &mut [CriterionRow], cfg: &CriterionConfig) {
-    let valid: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].status == Status::Ok).collect();
+    let valid: Vec<usize> =
+        (0..rows.len()).filter(|&i| rows[i].status == Status::Ok && rows[i].stall_torque_nm.is_finite()).collect();
     let metric = |r: &CriterionRow, k: usize| match k {
         0 => r.stall_torque_nm,
         1 => r.max_efficiency,
-        2 => -r.temperature_rise_k,
+        2 => -r.temperature_rise_after_run_k,
         _ => -r.speed_std_rpm,
     };
     let mut ranges = [(f64::INFINITY, f64::NEG_INFINITY); 4];
@@ -288,5 +371,64 @@ mod tests {
             );
             assert!((row.torque_at_max_efficiency_nm - at).abs() <= 0.1 * h, "{row:?} vs the peak at {at}");
         }
+    }
+
+    /// For every preset at its drive: just below the loaded stall torque the rotor turns,
+    /// just above it the rotor is at rest (`stall`, or `clamped`), and the loaded rotor stops no later than
+    /// the rotor-at-rest torque at the no-load amplitude.
+    #[test]
+    fn loaded_stall_torque_is_where_the_status_turns_to_stall() {
+        for preset in crate::presets::PRESETS {
+            let motor = preset.motor();
+            let d = preset.drive().map_or((200.0, 43_000.0), |d| (d.voltage_v, d.frequency_hz));
+            let p = Prepared::new(&motor);
+            for f in [150.0, 300.0] {
+                let t = loaded_stall_torque_nm(&p, &motor, f, d.0, d.1);
+                let at = |t: f64| solve_prepared(&p, &motor, &OperatingPoint::new(f, t, d.0, d.1), None);
+                assert!(t > 0.0, "{} {f} N: {t}", preset.name);
+                assert_eq!(at(t * (1.0 - 1e-6)).status, Status::Ok, "{} {f} N: {t}", preset.name);
+                // at rest: stalled, or clamped where the rotor at rest takes the wave's power
+                let above = at(t * (1.0 + 1e-6)).status;
+                assert!(matches!(above, Status::Stall | Status::Clamped), "{} {f} N: {t}: {above}", preset.name);
+                let formula = at(0.0).stall_torque_nm;
+                assert!(t <= formula * (1.0 + 1e-9), "{} {f} N: loaded {t} above {formula}", preset.name);
+            }
+        }
+    }
+
+    /// Overlap of preload regions: contained, partial, disjoint, a point reference.
+    #[test]
+    fn region_overlap_measures_the_shared_interval() {
+        assert_eq!(region_overlap((150.0, 360.0), (260.0, 320.0)), (60.0, 1.0));
+        assert_eq!(region_overlap((150.0, 290.0), (260.0, 320.0)), (30.0, 0.5));
+        assert_eq!(region_overlap((100.0, 200.0), (260.0, 320.0)), (0.0, 0.0));
+        assert_eq!(region_overlap((100.0, 300.0), (260.0, 260.0)), (0.0, 1.0));
+    }
+
+    /// The optimum's place in the searched range, with disqualified candidates at the ends
+    /// not counted as searched.
+    #[test]
+    fn optimum_edge_is_judged_among_running_candidates() {
+        let row = |f: f64, score: f64| CriterionRow {
+            preload_n: f,
+            status: if score.is_finite() { Status::Ok } else { Status::Clamped },
+            stall_torque_nm: 1.0,
+            max_efficiency: 0.3,
+            torque_at_max_efficiency_nm: 0.5,
+            temperature_rise_after_run_k: 1.0,
+            speed_std_rpm: 0.1,
+            no_load_speed_rpm: 100.0,
+            score,
+            in_region: false,
+        };
+        let res = |opt: f64, scores: [f64; 4]| CriterionResult {
+            rows: [100.0, 200.0, 300.0, 400.0].iter().zip(scores).map(|(&f, s)| row(f, s)).collect(),
+            optimum_preload_n: opt,
+            region_n: (opt, opt),
+        };
+        assert_eq!(res(100.0, [0.9, 0.5, 0.4, 0.3]).optimum_edge(), Edge::Low);
+        assert_eq!(res(400.0, [0.1, 0.5, 0.6, 0.9]).optimum_edge(), Edge::High);
+        assert_eq!(res(300.0, [0.1, 0.5, 0.9, f64::NAN]).optimum_edge(), Edge::High);
+        assert_eq!(res(200.0, [0.1, 0.9, 0.6, 0.3]).optimum_edge(), Edge::Interior);
     }
 }

@@ -104,7 +104,7 @@ pub(crate) fn fluctuation_about(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::presets::preset;
+    use crate::presets::frozen as preset;
 
     #[test]
     fn zero_runout_gives_no_fluctuation_and_small_runout_is_linear() {

@@ -82,7 +82,7 @@ pub fn to_measurements(rows: &[SynthRow]) -> Result<Measurements, TrumError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::presets::preset;
+    use crate::presets::frozen as preset;
     use crate::synth::{synthesize, Campaign, SynthConfig};
 
     #[test]

@@ -240,6 +240,7 @@ struct MotorFile {
     effects: Option<toml::Table>,
     sweep: Option<SweepPatch>,
     tolerances: Option<toml::Table>,
+    drive: Option<DrivePatch>,
 }
 
 /// Reads the `[tolerances]` table of a motor file: how well each uncertain baseline
@@ -297,6 +298,60 @@ pub fn tolerances_from_toml_str(
         out.insert(key, x);
     }
     Ok(out)
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DrivePatch {
+    voltage_v: Option<Num>,
+    frequency_hz: Option<Num>,
+}
+
+/// The `[drive]` table of a motor file: the drive the motor's source figures were taken
+/// at, which commands use when neither the command line nor `[sweep]` sets one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Drive {
+    /// Drive voltage amplitude per phase [V], > 0.
+    pub voltage_v: f64,
+    /// Drive frequency [Hz], > 0.
+    pub frequency_hz: f64,
+}
+
+impl Drive {
+    /// The `[drive]` table of a motor file; without one, the drive of the preset the file
+    /// names (`preset = "..."`); `None` when neither gives one. Both keys are required and
+    /// must be finite and > 0; the error names the file, line and key.
+    pub fn from_toml_str(text: &str, source_name: &str) -> Result<Option<Drive>, ParamError> {
+        let file: MotorFile = toml::from_str(text).map_err(|e| ParamError {
+            source_name: source_name.into(),
+            line: e.span().map(|s| line_of_offset(text, s.start)),
+            key: "drive".into(),
+            reason: e.message().trim().to_string(),
+        })?;
+        let Some(d) = &file.drive else {
+            return match &file.preset {
+                Some(p) => Ok(crate::presets::find(p)?.drive()),
+                None => Ok(None),
+            };
+        };
+        let value = |v: &Option<Num>, key: &str| -> Result<f64, ParamError> {
+            let err = |reason: String| ParamError {
+                source_name: source_name.into(),
+                line: line_of_key(text, "drive", key),
+                key: format!("drive.{key}"),
+                reason,
+            };
+            match v {
+                None => Err(err("missing key ([drive] needs voltage_v and frequency_hz)".into())),
+                Some(Num(x)) if x.is_finite() && *x > 0.0 => Ok(*x),
+                Some(Num(x)) => Err(err(format!("{x} must be a finite number > 0"))),
+            }
+        };
+        Ok(Some(Drive {
+            voltage_v: value(&d.voltage_v, "voltage_v")?,
+            frequency_hz: value(&d.frequency_hz, "frequency_hz")?,
+        }))
+    }
 }
 
 /// One axis in a `[sweep]` table: a single value or `[start, stop, n]`.

@@ -1,13 +1,15 @@
-//! Built-in motors from the papers. Every value carries its provenance: taken from a
-//! paper's table, assumed (the paper leaves it out; a physically reasonable value is
-//! chosen and the reason given), or calibrated (chosen so the preset reproduces a result
-//! the paper publishes; the test that checks it is named).
+//! Built-in motors from the papers. Each preset is an annotated TOML motor file in
+//! `crates/trum-core/presets/` (embedded at build time), read by the motor-file reader:
+//! every value sits beside its provenance comment (taken from a paper's table; assumed,
+//! with the reason and the plausible range; or calibrated, with the figure it was fitted
+//! to and the script that fits it), so a value and its note cannot drift apart. The
+//! figures the presets are checked against are in `tests/data/papers/` and
+//! `tests/papers.rs`; `crates/trum-core/examples/fit_presets.rs` recalibrates them.
 
-use crate::effects::Effects;
 use crate::error::ParamError;
 use crate::params::*;
 
-/// A preset: the motor and the provenance of each value.
+/// A preset: its name, description and annotated motor file.
 #[derive(Clone, Debug)]
 pub struct Preset {
     /// Name used on the command line (`trum60a`).
@@ -16,101 +18,119 @@ pub struct Preset {
     pub summary: &'static str,
     /// Sources.
     pub sources: &'static str,
-    /// (dotted key, provenance) for every numeric value.
-    pub notes: &'static [(&'static str, &'static str)],
-    build: fn() -> Motor,
+    /// The annotated, complete motor file (`crates/trum-core/presets/NAME.toml`).
+    pub toml: &'static str,
 }
 
 impl Preset {
-    /// The motor.
+    fn file_name(&self) -> String {
+        format!("presets/{}.toml", self.name)
+    }
+
+    /// The motor. The embedded files are checked by the tests of this module, so they
+    /// always parse.
     pub fn motor(&self) -> Motor {
-        (self.build)()
+        let mut m = Motor::from_toml_str(self.toml, &self.file_name())
+            .unwrap_or_else(|e| panic!("built-in preset file is invalid: {e}"));
+        m.preset = Some(self.name.to_string());
+        m
     }
-    /// Provenance of one value.
+
+    /// The drive of the preset's source figures (`[drive]` of its file), if it has one.
+    pub fn drive(&self) -> Option<Drive> {
+        // `[drive]` of a complete file never looks up a preset, so this cannot recurse.
+        Drive::from_toml_str(self.toml, &self.file_name()).ok().flatten()
+    }
+
+    /// Provenance of one value: the comment beside `key` in section `[section]` of the
+    /// preset file (`dotted` = `section.key`; for effects `effects.NAME`).
     pub fn note(&self, dotted: &str) -> Option<&'static str> {
-        self.notes.iter().find(|(k, _)| *k == dotted).map(|(_, v)| *v)
+        let (section, key) = dotted.rsplit_once('.')?;
+        let mut current = "";
+        for line in self.toml.lines() {
+            let t = line.trim();
+            if let Some(h) = t.strip_prefix('[') {
+                current = h.split(']').next().unwrap_or("").trim();
+                continue;
+            }
+            if current != section {
+                continue;
+            }
+            let Some((k, rest)) = t.split_once('=') else { continue };
+            if k.trim() == key {
+                return rest.split_once('#').map(|(_, c)| c.trim()).filter(|c| !c.is_empty());
+            }
+        }
+        None
     }
-    /// The preset as a commented TOML motor file that reads back to the same motor.
+
+    /// The text of one `[section]` of the preset file, comments included (empty if absent).
+    fn section_text(&self, section: &str) -> String {
+        let mut out = String::new();
+        let mut inside = false;
+        for line in self.toml.lines() {
+            let t = line.trim();
+            if t.starts_with('[') {
+                inside = t.trim_start_matches('[').split(']').next().map(str::trim) == Some(section);
+            }
+            if inside {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+        out
+    }
+
+    /// The preset as a commented TOML motor file that reads back to the same motor: each
+    /// value with its meaning, unit and provenance, the `[drive]` and `[effects]` tables
+    /// with their notes.
     pub fn to_toml(&self) -> String {
         let header = format!(
             "trum motor file: preset '{}'\n{}\nSources: {}\nEvery value is SI; the comment gives its meaning, unit and provenance.\n",
             self.name, self.summary, self.sources
         );
-        self.motor().to_toml_annotated(&header, &|k| self.note(k).map(str::to_string))
+        let motor = self.motor();
+        let mut s = motor.to_toml_annotated(&header, &|k| self.note(k).map(str::to_string));
+        // the generated effects table carries no notes: use the file's own
+        let fx = self.section_text("effects");
+        if !fx.is_empty() {
+            if let Some(i) = s.find("\n[effects]") {
+                s.truncate(i);
+                s.truncate(s.trim_end().len());
+                s.push_str("\n\n");
+                s.push_str(fx.trim_end());
+                s.push('\n');
+            }
+        }
+        let drive = self.section_text("drive");
+        if !drive.is_empty() {
+            s.push('\n');
+            s.push_str(drive.trim_end());
+            s.push('\n');
+        }
+        s
     }
 }
 
-const PAPER_000: &str = "seed 000 Table A1";
-const _: &str = PAPER_000;
-
 /// All presets.
-pub const PRESETS: &[Preset] = &[
+pub static PRESETS: &[Preset] = &[
     Preset {
         name: "trum60a",
         summary: "TRUM60A (Chunsheng, Nanjing), B09 mode, PTFE friction layer, as simulated by Chen, Zheng and Fan",
-        sources: "seed 000 (Chen et al., Sensors 2020, 20, 2096), Table A1 and section 4",
-        notes: &[
-            ("geometry.wave_number", "seed 000 Table A1"),
-            ("geometry.mean_radius_m", "seed 000 Table A1"),
-            ("geometry.contact_width_m", "assumed: seed 001 Table 1 b_f of the same 60 mm motor family"),
-            ("geometry.neutral_plane_distance_m", "assumed: 2 mm keeps the stator running up to the paper's 570 N preload at 200 V and gives about 100 rpm no-load at 260 N; not in the paper"),
-            ("friction_layer.youngs_modulus_pa", "calibrated: contact angle 24.15 deg at 150 N and 28.94 deg at 200 N (seed 000 section 4.3); PTFE-like modulus"),
-            ("friction_layer.thickness_m", "seed 000 Table A1 (h)"),
-            ("friction_layer.friction_coefficient", "seed 000 Table A1"),
-            ("stator.modal_mass_kg", "seed 000 Table A1 (m_o)"),
-            ("stator.resonance_frequency_hz", "assumed: the printed k_o = 4.56e9 N/m with m_o gives 152 kHz, inconsistent with the 42-43 kHz drive; resonance placed 2.25 kHz below the 43 kHz drive, as usual for TRUMs"),
-            ("stator.modal_damping_ns_per_m", "assumed: the printed d_o = 0.05 N s/m implies Q ~ 3e4; Q ~ 130 for a bronze stator with bonded PZT and teeth"),
-            ("stator.force_factor_n_per_v", "seed 000 Table A1 (k_c)"),
-            ("electrical.clamped_capacitance_f", "seed 000 Table A1 (C_p)"),
-            ("electrical.dielectric_loss_tangent", "assumed: seed 001 Table 1 value of the same motor family"),
-            ("electrical.feedback_gain_v_per_m", "assumed: mean conversion factor of seed 001 Table 2"),
-            ("rotor.viscous_damping_nms", "seed 000 Table A1 (d_r)"),
-            ("rotor.inertia_kg_m2", "seed 000 Table A1 (J_r, printed in kg/m^2)"),
-            ("rotor.mass_kg", "seed 000 Table A1 (m_r)"),
-            ("thermal.heat_transfer_coefficient_w_per_m2k", "seed 000 Table A1 (alpha)"),
-            ("thermal.surface_area_m2", "seed 000 Table A1 (S)"),
-            ("thermal.heat_capacity_j_per_k", "assumed: about 0.25 kg of motor at 600 J/(kg K); not in the paper"),
-            ("thermal.ambient_c", "seed 000 section 4.2 (tests start at 28 degC)"),
-            ("assembly.axial_spring_stiffness_n_per_m", "assumed: disc-spring stiffness of a 60 mm motor; not in the paper"),
-        ],
-        build: trum60a,
+        sources: "Chen, Zheng, Fan 2020, Pre-pressure optimization for ultrasonic motors based on multi-sensor fusion (Sensors 20, 2096), Table A1 and sections 4-5",
+        toml: include_str!("../presets/trum60a.toml"),
     },
     Preset {
         name: "trum60-qut",
         summary: "TRUM-60 as identified by Sun, Yin, Liu and Zhang (Qingdao University of Technology)",
-        sources: "seed 001 (Sun et al., Actuators 2021, 10, 158), Tables 1 and 2",
-        notes: &[
-            ("geometry.wave_number", "assumed: B09 mode of the TRUM-60 family (seed 000)"),
-            ("geometry.mean_radius_m", "seed 001 Table 1 (r)"),
-            ("geometry.contact_width_m", "seed 001 Table 1 (b_f)"),
-            ("geometry.neutral_plane_distance_m", "seed 001 Table 1 (h_0)"),
-            ("friction_layer.youngs_modulus_pa", "seed 001 Table 1 (E_f)"),
-            ("friction_layer.thickness_m", "assumed: h_f is not given; 0.5 mm as in seed 000 Table A1"),
-            ("friction_layer.friction_coefficient", "seed 001 Table 1 (mu)"),
-            ("stator.modal_mass_kg", "assumed: Table 1's m_s = 0.55 g and k_s = 345 N/m belong to a normalised model (their resonance would be 126 Hz); the TRUM60A modal mass of seed 000 is used"),
-            ("stator.resonance_frequency_hz", "calibrated: no-load speeds of seed 001 Table 2 at 150 V, 42 kHz"),
-            ("stator.modal_damping_ns_per_m", "calibrated with the resonance and force factor on seed 001 Table 2 (Q about 260)"),
-            ("stator.force_factor_n_per_v", "calibrated: least squares on the no-load speeds and feedback voltages of seed 001 Table 2"),
-            ("electrical.clamped_capacitance_f", "assumed: seed 000 Table A1 value of the same motor family"),
-            ("electrical.dielectric_loss_tangent", "seed 001 Table 1 (tan delta)"),
-            ("electrical.feedback_gain_v_per_m", "seed 001 Table 2: mean of the four conversion factors"),
-            ("rotor.viscous_damping_nms", "assumed: seed 000 Table A1 value"),
-            ("rotor.inertia_kg_m2", "assumed: seed 000 Table A1 value"),
-            ("rotor.mass_kg", "assumed: seed 000 Table A1 value"),
-            ("thermal.heat_transfer_coefficient_w_per_m2k", "assumed: seed 000 Table A1 value"),
-            ("thermal.surface_area_m2", "assumed: seed 000 Table A1 value"),
-            ("thermal.heat_capacity_j_per_k", "assumed: about 0.25 kg at 600 J/(kg K)"),
-            ("thermal.ambient_c", "assumed: room temperature"),
-            ("assembly.axial_spring_stiffness_n_per_m", "assumed: disc-spring stiffness of a 60 mm motor"),
-        ],
-        build: trum60_qut,
+        sources: "Sun, Yin, Liu, Zhang 2021, Efficiency model for traveling wave-type ultrasonic motors based on contact variables and preload (Actuators 10, 158), Tables 1 and 2, section 3",
+        toml: include_str!("../presets/trum60-qut.toml"),
     },
     Preset {
         name: "generic60",
         summary: "A generic 60 mm, 9-wave traveling-wave motor with round-number parameters, for teaching and tests",
-        sources: "typical values of the 60 mm motor class in seeds 000-002; every value assumed",
-        notes: &[],
-        build: generic60,
+        sources: "typical values of the 60 mm motor class in Chen et al. 2020, Sun et al. 2021 and the radial-friction paper; every value assumed",
+        toml: include_str!("../presets/generic60.toml"),
     },
 ];
 
@@ -127,109 +147,83 @@ pub fn find(name: &str) -> Result<&'static Preset, ParamError> {
     })
 }
 
+/// The motors the model's own unit tests were written for: frozen baseline copies of the
+/// paper presets (`tests/data/motors/`, no effects), so a recalibration of `trum60a` or
+/// `trum60-qut` does not move the solver's regression points; other names are the presets.
+#[cfg(test)]
+pub(crate) fn frozen(name: &str) -> Result<Motor, ParamError> {
+    match name {
+        "trum60a" => Motor::from_toml_str(
+            include_str!("../../../tests/data/motors/trum60a_baseline.toml"),
+            "trum60a_baseline.toml",
+        ),
+        "trum60-qut" => Motor::from_toml_str(
+            include_str!("../../../tests/data/motors/trum60-qut_baseline.toml"),
+            "trum60-qut_baseline.toml",
+        ),
+        other => preset(other),
+    }
+}
+
 /// The motor of a preset by name.
 pub fn preset(name: &str) -> Result<Motor, ParamError> {
     find(name).map(|p| p.motor())
 }
 
-fn trum60a() -> Motor {
-    Motor {
-        name: "TRUM60A".into(),
-        preset: Some("trum60a".into()),
-        geometry: Geometry {
-            wave_number: 9.0,
-            mean_radius_m: 0.02625,
-            contact_width_m: 3.2e-3,
-            neutral_plane_distance_m: 2.0e-3,
-        },
-        friction_layer: FrictionLayer { youngs_modulus_pa: 1.305e8, thickness_m: 0.5e-3, friction_coefficient: 0.3 },
-        stator: Stator {
-            modal_mass_kg: 0.005,
-            resonance_frequency_hz: 40_750.0,
-            modal_damping_ns_per_m: 10.0,
-            force_factor_n_per_v: 0.4147,
-        },
-        electrical: Electrical {
-            clamped_capacitance_f: 5.41e-9,
-            dielectric_loss_tangent: 3.5e-3,
-            feedback_gain_v_per_m: 3.07e7,
-        },
-        rotor: Rotor { viscous_damping_nms: 5.0e-4, inertia_kg_m2: 7.2e-6, mass_kg: 0.03 },
-        thermal: Thermal {
-            heat_transfer_coefficient_w_per_m2k: 10.0,
-            surface_area_m2: 0.02366,
-            heat_capacity_j_per_k: 150.0,
-            ambient_c: 28.0,
-        },
-        assembly: Assembly { axial_spring_stiffness_n_per_m: 2.0e5 },
-        effects: Effects::none(),
-    }
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-fn trum60_qut() -> Motor {
-    Motor {
-        name: "TRUM-60 (QUT)".into(),
-        preset: Some("trum60-qut".into()),
-        geometry: Geometry {
-            wave_number: 9.0,
-            mean_radius_m: 0.030,
-            contact_width_m: 3.2e-3,
-            neutral_plane_distance_m: 4.0e-3,
-        },
-        friction_layer: FrictionLayer { youngs_modulus_pa: 4.3e9, thickness_m: 0.5e-3, friction_coefficient: 0.24 },
-        stator: Stator {
-            modal_mass_kg: 0.005,
-            resonance_frequency_hz: 41_300.0,
-            modal_damping_ns_per_m: 5.0,
-            force_factor_n_per_v: 0.1,
-        },
-        electrical: Electrical {
-            clamped_capacitance_f: 5.41e-9,
-            dielectric_loss_tangent: 3.5e-3,
-            feedback_gain_v_per_m: 3.07e7,
-        },
-        rotor: Rotor { viscous_damping_nms: 5.0e-4, inertia_kg_m2: 7.2e-6, mass_kg: 0.03 },
-        thermal: Thermal {
-            heat_transfer_coefficient_w_per_m2k: 10.0,
-            surface_area_m2: 0.02366,
-            heat_capacity_j_per_k: 150.0,
-            ambient_c: 25.0,
-        },
-        assembly: Assembly { axial_spring_stiffness_n_per_m: 2.0e5 },
-        effects: Effects::none(),
+    /// Every preset file parses, every motor key of every preset has a provenance comment
+    /// of a known kind, and `to_toml` reads back to the same motor and drive.
+    #[test]
+    fn every_preset_file_is_complete_annotated_and_round_trips() {
+        let kinds = ["Chen et al. 2020", "Sun et al. 2021", "assumed", "calibrated"];
+        for p in PRESETS {
+            let m = p.motor();
+            assert_eq!(m.preset.as_deref(), Some(p.name));
+            for info in Motor::all_keys() {
+                let dotted = format!("{}.{}", info.section, info.key);
+                let note = p.note(&dotted).unwrap_or_else(|| panic!("{}: {dotted} has no provenance", p.name));
+                assert!(kinds.iter().any(|k| note.starts_with(k)), "{}: {dotted}: '{note}' names no source", p.name);
+            }
+            let text = p.to_toml();
+            let back = Motor::from_toml_str(&text, "show").unwrap_or_else(|e| panic!("{}: {e}\n{text}", p.name));
+            assert_eq!(back, m, "{}", p.name);
+            assert_eq!(Drive::from_toml_str(&text, "show").expect("drive"), p.drive(), "{}", p.name);
+            for e in m.effects.active() {
+                let dotted = format!("effects.{}", e.name());
+                assert!(p.note(&dotted).is_some_and(|n| n.len() > 20), "{}: {dotted} says not why", p.name);
+            }
+        }
     }
-}
 
-fn generic60() -> Motor {
-    Motor {
-        name: "generic 60 mm TRUM".into(),
-        preset: Some("generic60".into()),
-        geometry: Geometry {
-            wave_number: 9.0,
-            mean_radius_m: 0.027,
-            contact_width_m: 3.0e-3,
-            neutral_plane_distance_m: 3.0e-3,
-        },
-        friction_layer: FrictionLayer { youngs_modulus_pa: 1.0e9, thickness_m: 0.5e-3, friction_coefficient: 0.25 },
-        stator: Stator {
-            modal_mass_kg: 0.01,
-            resonance_frequency_hz: 40_000.0,
-            modal_damping_ns_per_m: 5.0,
-            force_factor_n_per_v: 0.5,
-        },
-        electrical: Electrical {
-            clamped_capacitance_f: 5.0e-9,
-            dielectric_loss_tangent: 5.0e-3,
-            feedback_gain_v_per_m: 3.0e7,
-        },
-        rotor: Rotor { viscous_damping_nms: 2.0e-4, inertia_kg_m2: 1.0e-5, mass_kg: 0.04 },
-        thermal: Thermal {
-            heat_transfer_coefficient_w_per_m2k: 10.0,
-            surface_area_m2: 0.025,
-            heat_capacity_j_per_k: 150.0,
-            ambient_c: 25.0,
-        },
-        assembly: Assembly { axial_spring_stiffness_n_per_m: 2.0e5 },
-        effects: Effects::none(),
+    /// The presets from a paper carry that paper's drive; an override file inherits it,
+    /// its own `[drive]` replaces it and a bad one is an error naming the key and line.
+    #[test]
+    fn drives_come_from_the_papers_and_files_override_them() {
+        let d = find("trum60a").expect("preset").drive().expect("drive");
+        assert_eq!((d.voltage_v, d.frequency_hz), (200.0, 42_000.0));
+        let d = find("trum60-qut").expect("preset").drive().expect("drive");
+        assert_eq!((d.voltage_v, d.frequency_hz), (150.0, 42_000.0));
+        assert_eq!(find("generic60").expect("preset").drive(), None);
+        let inherit = Drive::from_toml_str("preset = \"trum60a\"\n", "f.toml").expect("ok");
+        assert_eq!(inherit.map(|d| d.frequency_hz), Some(42_000.0));
+        let own =
+            Drive::from_toml_str("preset = \"trum60a\"\n[drive]\nvoltage_v = 180\nfrequency_hz = 43000\n", "f.toml")
+                .expect("ok")
+                .expect("drive");
+        assert_eq!((own.voltage_v, own.frequency_hz), (180.0, 43_000.0));
+        let bad =
+            Drive::from_toml_str("preset = \"trum60a\"\n[drive]\nvoltage_v = -1\nfrequency_hz = 43000\n", "f.toml")
+                .expect_err("negative voltage");
+        assert_eq!((bad.key.as_str(), bad.line), ("drive.voltage_v", Some(3)), "{bad}");
+        let missing =
+            Drive::from_toml_str("preset = \"trum60a\"\n[drive]\nvoltage_v = 100\n", "f.toml").expect_err("missing");
+        assert_eq!(missing.key, "drive.frequency_hz", "{missing}");
+        // the motor reader accepts the table too
+        assert!(
+            Motor::from_toml_str("preset = \"trum60a\"\n[drive]\nvoltage_v = 180\nfrequency_hz = 43000\n", "f").is_ok()
+        );
     }
 }

@@ -191,7 +191,7 @@ mod tests {
         // The presets, and trum60a with a softening stator (several amplitude branches; no
         // warm amplitude there, see solve::solve_in_sweep).
         let motors = ["trum60a", "trum60-qut", "generic60", "trum60a+hertz_softening"].map(|name| {
-            let mut m = crate::presets::preset(name.split('+').next().unwrap_or(name)).expect("preset");
+            let mut m = crate::presets::frozen(name.split('+').next().unwrap_or(name)).expect("preset");
             if name.ends_with("softening") {
                 let e = crate::effects::Effect::HertzSoftening;
                 let strong: Vec<f64> = e.info().params.iter().map(|p| 3.0 * p.typical).collect();
@@ -250,7 +250,7 @@ mod tests {
             (Effect::PreloadStiffening, vec![0.504], 389.23, 190.38, 40_880.17, 0.8554),
         ];
         for (e, values, f, v, hz, t_max) in cases {
-            let mut m = crate::presets::preset("generic60").expect("preset");
+            let mut m = crate::presets::frozen("generic60").expect("preset");
             m.effects.set(e, &values);
             let p = Prepared::new(&m);
             let g = Grid {

@@ -462,7 +462,7 @@ fn criterion<'py>(
     table.set_item("stall_torque_nm", PyArray::from_vec(py, col(|r| r.stall_torque_nm)))?;
     table.set_item("max_efficiency", PyArray::from_vec(py, col(|r| r.max_efficiency)))?;
     table.set_item("torque_at_max_efficiency_nm", PyArray::from_vec(py, col(|r| r.torque_at_max_efficiency_nm)))?;
-    table.set_item("temperature_rise_k", PyArray::from_vec(py, col(|r| r.temperature_rise_k)))?;
+    table.set_item("temperature_rise_after_run_k", PyArray::from_vec(py, col(|r| r.temperature_rise_after_run_k)))?;
     table.set_item("speed_std_rpm", PyArray::from_vec(py, col(|r| r.speed_std_rpm)))?;
     table.set_item("no_load_speed_rpm", PyArray::from_vec(py, col(|r| r.no_load_speed_rpm)))?;
     table.set_item("score", PyArray::from_vec(py, col(|r| r.score)))?;

@@ -20,7 +20,7 @@ fn amplitude_map_falls_with_the_load_and_stays_below_the_detuned_bound() {
     let (mut stalled, mut moving) = (0, 0);
     for name in ["trum60a", "trum60-qut", "generic60"] {
         for fx in [None, Some(Effect::PreloadStiffening), Some(Effect::HertzSoftening)] {
-            let mut m = crate::presets::preset(name).expect("preset");
+            let mut m = crate::presets::frozen(name).expect("preset");
             if let Some(e) = fx {
                 let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
                 m.effects.set(e, &typical);
@@ -71,7 +71,7 @@ fn the_trial_slope_is_the_derivative_of_the_amplitude_residual() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(29);
     let mut seen = [0usize; 4]; // running, stalled, full contact, narrow contact
     for name in ["trum60a", "trum60-qut", "generic60"] {
-        let m = crate::presets::preset(name).expect("preset");
+        let m = crate::presets::frozen(name).expect("preset");
         let p = Prepared::new(&m);
         for _ in 0..2000 {
             let op = OperatingPoint::new(
@@ -117,7 +117,7 @@ fn leaving_out_the_stall_torque_changes_nothing_else() {
     let mut skipped = 0;
     for truth in [false, true] {
         for e in std::iter::once(None).chain(crate::effects::ALL.iter().copied().map(Some)) {
-            let mut m = crate::presets::preset("trum60a").expect("preset");
+            let mut m = crate::presets::frozen("trum60a").expect("preset");
             if let Some(e) = e {
                 let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
                 m.effects.set(e, &typical);
@@ -150,7 +150,7 @@ fn leaving_out_the_stall_torque_changes_nothing_else() {
 fn clamped_closed_form_is_the_clamped_solve() {
     let mut clamped = 0;
     for e in std::iter::once(None).chain(crate::effects::ALL.iter().copied().map(Some)) {
-        let mut m = crate::presets::preset("trum60a").expect("preset");
+        let mut m = crate::presets::frozen("trum60a").expect("preset");
         if let Some(e) = e {
             let typical: Vec<f64> = e.info().params.iter().map(|p| p.typical).collect();
             m.effects.set(e, &typical);
@@ -180,7 +180,7 @@ fn clamped_closed_form_is_the_clamped_solve() {
 /// The motor `name` with the effect assignments `fx` ("a=1;b:x=2,y=3") in candidate or
 /// truth form.
 fn motor_with(name: &str, fx: &str, truth: bool) -> Motor {
-    let mut m = crate::presets::preset(name).expect("preset");
+    let mut m = crate::presets::frozen(name).expect("preset");
     for a in fx.split(';') {
         m.effects.parse_assignment(a).expect("effect");
     }
@@ -437,7 +437,7 @@ fn sag_with_thermal_drift_settles_where_the_joint_passes_cycle() {
 /// solves agree, and the state is its own fixed point.
 #[test]
 fn a_sag_fixed_point_at_a_fold_settles_within_the_amplitude_solves_noise() {
-    let mut m = crate::presets::preset("trum60-qut").expect("preset");
+    let mut m = crate::presets::frozen("trum60-qut").expect("preset");
     m.effects.parse_assignment("voltage_sag=150").expect("effect");
     let p = Prepared::new(&m);
     let prev = solve_prepared(&p, &m, &OperatingPoint::new(640.0, 0.05, 194.0, 41562.5), None);

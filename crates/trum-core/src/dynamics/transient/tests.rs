@@ -1,5 +1,5 @@
 use super::*;
-use crate::presets::preset;
+use crate::presets::frozen as preset;
 use crate::solve::{solve, OperatingPoint, Status};
 
 fn motor() -> Motor {
