@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The issue-5 speed benchmark: a diagnosis of about 1000 rows with all seven candidates
+# The diagnosis speed benchmark: a diagnosis of about 1000 rows with all seven candidates
 # and block cross-validation (docs/PERFORMANCE.md). Builds eight `combined` campaigns of
-# one trum60a (radial_friction injected, nominal noise) at drive voltages 165-235 V, joins
+# one ring motor (tests/data/motors/ring60.toml: the TRUM60A values, frozen; radial_friction injected, nominal noise) at drive voltages 165-235 V, joins
 # them into one file (run ids prefixed with the voltage) and times `trum diagnose`.
 #   bash benches/diagnose_1000.sh            # release build, then the timed run
 #   SEED_OFFSET=10 bash benches/diagnose_1000.sh   # noise seeds 11-18, motor seed 11
@@ -14,6 +14,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -q -p trum-cli
 T=target/release/trum
+MOTOR=tests/data/motors/ring60.toml
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 out="$dir/bench1000.csv"
@@ -27,7 +28,7 @@ for v in 165 175 185 195 205 215 225 235; do
     effect=${EFFECT:-radial_friction=1}
     effect_args=(--effect "$effect")
     if [ "$effect" = none ]; then effect_args=(); fi
-    "$T" synth --motor trum60a "${effect_args[@]}" --campaign combined --noise 1 --seed "$((i + off))" \
+    "$T" synth --motor "$MOTOR" "${effect_args[@]}" --campaign combined --noise 1 --seed "$((i + off))" \
         --motor-seed "$motor_seed" --voltage-v "$v" -o "$dir/c$i.csv" > /dev/null
     if [ "$i" = 1 ]; then head -n 1 "$dir/c$i.csv" > "$out"; fi
     # prefix every run id (the last column) with the voltage so runs stay distinct
@@ -35,4 +36,4 @@ for v in 165 175 185 195 205 215 225 235; do
 done
 echo "rows: $(($(wc -l < "$out") - 1))"
 if [ -n "${KEEP:-}" ]; then cp "$out" "$KEEP"; fi
-/usr/bin/time -f "wall %e s, CPU %U s user, peak RSS %M KB" "$T" diagnose --motor trum60a --data "$out" | sed -n 1,40p
+/usr/bin/time -f "wall %e s, CPU %U s user, peak RSS %M KB" "$T" diagnose --motor "$MOTOR" --data "$out" | sed -n 1,40p

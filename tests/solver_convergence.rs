@@ -281,11 +281,9 @@ fn stress_baseline_always_converges() {
 /// With strong `voltage_sag` or `thermal_drift`, alone or together, every valid state is
 /// its own fixed point; `no_convergence` stays rare (a motor hunting between states under
 /// both effects, or a thermal runaway past the resonance far beyond typical strength:
-/// docs/EFFECTS.md), and a sagging drive alone always has a steady state (stop 33: the
-/// largest root of W − Θ·V_e(W)/|Z(W)| where the passes fail; 0 of 50 000 with
-/// `TRUM_STRESS_N=50000`, was 267). At the default size 0 (sag), 4 (drift) and 2 (both)
-/// of 2 000; 12 and 8 at stop 32, which these bounds fail (20 and 17 with the stalled
-/// branch only; both together 58 before the nested fallback of stop 27).
+/// docs/EFFECTS.md), and a sagging drive alone always has a steady state (the largest root
+/// of W − Θ·V_e(W)/|Z(W)| where the passes fail; 0 of 50 000 with `TRUM_STRESS_N=50000`).
+/// At the default size 0 (sag), 4 (drift) and 2 (both) of 2 000.
 #[test]
 fn stress_self_consistent_effects() {
     for (sag, thermal, one_in) in [(true, false, usize::MAX), (false, true, 250), (true, true, 500)] {

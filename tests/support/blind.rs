@@ -1,11 +1,11 @@
-//! The blind benchmark of the diagnosis (issue 5, docs/DIAGNOSIS.md), shared by the
-//! full run (`cargo bench --bench blind`) and its fast slice in the test suite
+//! The blind benchmark of the diagnosis (docs/DIAGNOSIS.md), shared by the full run
+//! (`cargo bench --bench blind`) and its fast slices in the test suite
 //! (`tests/blind_slice.rs`).
 //!
 //! Each case goes through the file interface exactly as outside data would: `trum synth`
 //! writes a measurement CSV with the injected effects in their truth forms (which differ
 //! in form from the candidates the diagnosis fits), and `trum diagnose --json` reads only
-//! that CSV and the nominal preset. Nothing else passes between the two.
+//! that CSV and the nominal motor file. Nothing else passes between the two.
 
 #![allow(dead_code)]
 
@@ -422,8 +422,8 @@ pub const EFFECTS: [&str; 7] = [
 /// The full benchmark: every effect × three strengths (0.3, 1 and 3 × typical) × two
 /// noise levels (0.5 and 1 × the nominal bench noise) × two campaigns (preload-torque and
 /// combined), eight null cases, four two-effect cases at typical strength; every seed
-/// moved by `seed_offset`. The cases at 0.3 and 1 × keep the seeds they had before the
-/// third strength joined (stop 35): the 3 × cases take seeds from 201 on.
+/// moved by `seed_offset`. The cases at 0.3 and 1 × take seeds from 101 on, the 3 × cases
+/// from 201 on.
 pub fn full_cases_at(seed_offset: u64) -> Vec<Case> {
     let mut out = cases_at(&FACTORS, seed_offset);
     let mut seed = 200 + seed_offset;
@@ -518,8 +518,7 @@ pub fn by_strength(outcomes: &[Outcome]) -> Vec<(f64, usize, usize, f64, f64)> {
 }
 
 /// The full benchmark's cases with the single effects at `factors` × typical strength
-/// (`cargo bench --bench blind -- --factors 0.3,1`: the two-strength design of stop 34;
-/// `--factors 3`: the strong-effect run of stop 33, docs/DIAGNOSIS.md)
+/// (`cargo bench --bench blind -- --plain` runs [`full_cases_at`])
 /// and every seed moved by `seed_offset` (`--seed-offset 1000`: another draw of the same
 /// design).
 pub fn cases_at(factors: &[f64], seed_offset: u64) -> Vec<Case> {
@@ -591,11 +590,10 @@ pub fn slice_cases() -> Vec<Case> {
     ]
 }
 
-/// Strong effects in the test suite (3 × typical, half the nominal noise): cases whose
-/// fits ended far from the effect, or named a second effect that only polished the first
-/// one's form error, before stop 33 (docs/DIAGNOSIS.md, strong-effect run). The
-/// `tangential_compliance` and `hertz_softening` cases are the strong-effect run's own
-/// (seeds 107 and 121), where those failures were found; the two others are new seeds.
+/// Strong effects in the test suite (3 × typical, half the nominal noise): cases whose fits
+/// can end far from the effect without the strong-effect starts, or name a second effect
+/// that only polishes the first one's form error (seeds 107 and 121 for
+/// `tangential_compliance` and `hertz_softening`).
 pub fn strong_cases() -> Vec<Case> {
     let one = |e: &'static str, campaign, seed| Case {
         effects: vec![e],

@@ -85,7 +85,9 @@ fn calibrated_toml(cal: &Calibration, nominal: &trum_core::Motor, data: &str, ch
     cal.motor.to_toml_annotated(&header, &|key| {
         cal.params.iter().find(|p| p.name == key).map(|p| {
             let nom = nominal.param(key).map(|v| fmt_sig(v, 6)).unwrap_or_else(|| "-".into());
-            let flag = if !p.identifiable {
+            let flag = if !p.identifiable && p.prior_rel_sd.is_some() {
+                ", held near its prior by this data"
+            } else if !p.identifiable {
                 ", not identifiable from this data"
             } else if p.at_bound {
                 ", at a bound"
@@ -119,7 +121,7 @@ fn print_table(
                 flags.push("at bound");
             }
             if !p.identifiable {
-                flags.push("not identifiable");
+                flags.push(if p.prior_rel_sd.is_some() { "held by its prior" } else { "not identifiable" });
             }
             vec![
                 p.name.clone(),
@@ -169,6 +171,10 @@ fn rescale_uncertainties(cal: &mut Calibration, rows: &[ObservedRow]) {
         for j in 0..n {
             a[i][j] = cols[i].iter().zip(&cols[j]).map(|(x, y)| x * y).sum();
         }
+        // a prior on ln p is one more residual, (ln p − centre)/sd: 1/sd² on the diagonal
+        if let Some(sd) = cal.params[i].prior_rel_sd {
+            a[i][i] += 1.0 / (sd * sd);
+        }
     }
     let d: Vec<f64> = (0..n).map(|i| a[i][i].max(0.0).sqrt()).collect();
     for i in 0..n {
@@ -180,14 +186,16 @@ fn rescale_uncertainties(cal: &mut Calibration, rows: &[ObservedRow]) {
     let s2 = (cal.chi2 / (m - n) as f64).max(1e-300);
     let mut warn = Vec::new();
     for (k, p) in cal.params.iter_mut().enumerate() {
+        // (with a prior: a posterior's covariance, the readings' σ as stated, as the core's)
+        let s2k = if p.prior_rel_sd.is_some() { s2.max(1.0) } else { s2 };
         let var_rel = match &inv {
-            Some(inv) if d[k] > 0.0 => inv[k][k] / (d[k] * d[k]) * s2,
+            Some(inv) if d[k] > 0.0 => inv[k][k] / (d[k] * d[k]) * s2k,
             _ => f64::NAN,
         };
         let rel = if var_rel.is_finite() && var_rel >= 0.0 { var_rel.sqrt() } else { f64::NAN };
         p.std_error = rel * p.value.abs();
-        p.identifiable = rel.is_finite() && rel < 1.0;
-        if !p.identifiable {
+        p.identifiable = rel.is_finite() && rel < p.prior_rel_sd.map_or(1.0, |sd| (0.7 * sd).min(1.0));
+        if !p.identifiable && p.prior_rel_sd.is_none() {
             warn.push(format!(
                 "{} is not identifiable from these data (relative standard error {})",
                 p.name,
@@ -195,7 +203,12 @@ fn rescale_uncertainties(cal: &mut Calibration, rows: &[ObservedRow]) {
             ));
         }
     }
-    cal.warnings.retain(|w| !w.contains("is not identifiable"));
+    cal.warnings.retain(|w| !w.contains("is not identifiable") && !w.starts_with("held near their prior"));
+    let held: Vec<&str> =
+        cal.params.iter().filter(|p| p.prior_rel_sd.is_some() && !p.identifiable).map(|p| p.name.as_str()).collect();
+    if !held.is_empty() {
+        warn.push(format!("held near their prior (the data do not narrow them): {}", held.join(", ")));
+    }
     cal.warnings.extend(warn);
 }
 

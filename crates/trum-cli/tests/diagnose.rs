@@ -30,9 +30,14 @@ fn path(dir: &Path, name: &str) -> String {
     dir.join(name).to_string_lossy().into_owned()
 }
 
+/// The motor these tests synthesise and diagnose: a frozen copy of the TRUM60A values
+/// without effects, so that the null campaigns stay null whatever the built-in preset
+/// carries.
+const MOTOR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/motors/ring60.toml");
+
 fn synth(dir: &Path, name: &str, extra: &[&str]) -> String {
     let p = path(dir, name);
-    let mut args = vec!["synth", "--motor", "trum60a", "-o", &p];
+    let mut args = vec!["synth", "--motor", MOTOR, "-o", &p];
     args.extend_from_slice(extra);
     ok(&args);
     p
@@ -54,7 +59,7 @@ fn synth_writes_a_valid_reproducible_file() {
     assert!(m.warnings.is_empty(), "{:?}", m.warnings);
     assert!(m.has(trum_core::measurements::Column::SpeedStdRpm));
     // stdout gives the same bytes
-    let o = trum(&["synth", "--motor", "trum60a", "-o", "-", &base[0], base[1], base[2], base[3], base[4], base[5]]);
+    let o = trum(&["synth", "--motor", MOTOR, "-o", "-", &base[0], base[1], base[2], base[3], base[4], base[5]]);
     assert_eq!(o.stdout, a);
     // --omit drops columns; effects change the data; truth and candidate forms differ
     let om = synth(d, "om.csv", &[&base[..], &["--omit", "feedback_v,current_a"]].concat());
@@ -100,7 +105,7 @@ fn synth_motor_seed_fixes_the_motor_apart_from_the_noise() {
 fn synth_errors_list_the_valid_names() {
     let dir = tempfile::tempdir().expect("tempdir");
     let o = path(dir.path(), "x.csv");
-    let e = fails(&["synth", "--motor", "trum60a", "--campaign", "sweep", "--noise", "1", "--seed", "1", "-o", &o], 2);
+    let e = fails(&["synth", "--motor", MOTOR, "--campaign", "sweep", "--noise", "1", "--seed", "1", "-o", &o], 2);
     for n in trum_core::synth::Campaign::NAMES {
         assert!(e.contains(n), "{e}");
     }
@@ -108,7 +113,7 @@ fn synth_errors_list_the_valid_names() {
         &[
             "synth",
             "--motor",
-            "trum60a",
+            MOTOR,
             "--effect",
             "radial=1",
             "--campaign",
@@ -130,7 +135,7 @@ fn synth_errors_list_the_valid_names() {
         &[
             "synth",
             "--motor",
-            "trum60a",
+            MOTOR,
             "--campaign",
             "stability",
             "--noise",
@@ -145,8 +150,7 @@ fn synth_errors_list_the_valid_names() {
         1,
     );
     assert!(e.contains("'speed'") && e.contains("input_power_w") && e.contains("speed_std_rpm"), "{e}");
-    let e =
-        fails(&["synth", "--motor", "trum60a", "--campaign", "stability", "--noise", "-1", "--seed", "1", "-o", &o], 1);
+    let e = fails(&["synth", "--motor", MOTOR, "--campaign", "stability", "--noise", "-1", "--seed", "1", "-o", &o], 1);
     assert!(e.contains("noise level -1"), "{e}");
     assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0, "a failed synth leaves no file");
 }
@@ -157,7 +161,7 @@ fn calibrate_writes_a_motor_file_that_point_reads() {
     let d = dir.path();
     let data = synth(d, "pt.csv", &["--campaign", "preload-torque", "--noise", "1", "--seed", "4"]);
     let (toml, json) = (path(d, "cal.toml"), path(d, "cal.json"));
-    let out = ok(&["calibrate", "--motor", "trum60a", "--data", &data, "-o", &toml, "--json", &json]);
+    let out = ok(&["calibrate", "--motor", MOTOR, "--data", &data, "-o", &toml, "--json", &json]);
     assert!(out.contains("friction_layer.friction_coefficient") && out.contains("std error"), "{out}");
     assert!(out.contains("chi2"), "{out}");
     let p = ok(&["point", "--motor", &toml, "--preload-n", "250", "--torque-nm", "0.3", "--json"]);
@@ -174,11 +178,9 @@ fn calibrate_writes_a_motor_file_that_point_reads() {
     assert!(j["chi2_per_reading"].as_f64().expect("chi2") > 0.0);
 }
 
-/// Seed 001 Table 2 (docs/DIAGNOSIS.md): `unexplained`. The JSON's `partial` is null or a
-/// supported ranked effect, and the summary's and the report's verdict lines name it with
-/// its shrink. (Today it is `eccentricity`, supported by a hair: its shrink interval's
-/// lower end is just above zero, and moved there by rounding at stop 30; so either is
-/// accepted.)
+/// Sun et al. 2021 Table 2 (docs/DIAGNOSIS.md): `unexplained`. The JSON's `partial` is null
+/// or a supported ranked effect, and the summary's and the report's verdict lines name it
+/// with its shrink (a supported effect here is supported by a hair, so either is accepted).
 #[test]
 fn an_unexplained_verdict_names_what_explains_part_of_the_gap() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -213,7 +215,7 @@ fn diagnose_without_effect_says_none() {
     let d = dir.path();
     let data = synth(d, "st.csv", &["--campaign", "stability", "--noise", "1", "--seed", "3"]);
     let (json, html) = (path(d, "d.json"), path(d, "d.html"));
-    let out = ok(&["diagnose", "--motor", "trum60a", "--data", &data, "--json", &json, "--report", &html]);
+    let out = ok(&["diagnose", "--motor", MOTOR, "--data", &data, "--json", &json, "--report", &html]);
     assert!(out.contains("verdict     none"), "{out}");
     assert!(out.contains("ranking (evidence = ½·ΔBIC"), "{out}");
     let raw = std::fs::read_to_string(&json).expect("json");
@@ -261,7 +263,7 @@ fn diagnose_without_effect_says_none() {
     assert!(page.starts_with("<!DOCTYPE html>") && page.contains("<svg") && page.contains("Verdict"), "html");
     assert!(!page.contains("src=\"http") && !page.contains("href=\"http"), "self-contained");
     // --json - sends only the JSON to stdout
-    let o = ok(&["diagnose", "--motor", "trum60a", "--data", &data, "--json", "-"]);
+    let o = ok(&["diagnose", "--motor", MOTOR, "--data", &data, "--json", "-"]);
     let again: serde_json::Value = serde_json::from_str(&o).expect("stdout JSON");
     assert_eq!(again["ranking"], j["ranking"], "deterministic");
 }
@@ -276,7 +278,7 @@ fn write(dir: &Path, name: &str, body: &str) -> String {
 fn diagnose_errors_are_clear() {
     let dir = tempfile::tempdir().expect("tempdir");
     let d = dir.path();
-    let diag = |data: &str| fails(&["diagnose", "--motor", "trum60a", "--data", data], 1);
+    let diag = |data: &str| fails(&["diagnose", "--motor", MOTOR, "--data", data], 1);
     let f = write(d, "nospeed.csv", "preload_n,voltage_v,frequency_hz,torque_nm\n250,200,43000,0\n");
     let e = diag(&f);
     assert!(e.contains("nospeed.csv") && e.contains("'speed_rpm'"), "{e}");
@@ -306,14 +308,14 @@ fn diagnose_errors_are_clear() {
     assert!(e.contains("unknown preset 'trum61'"), "{e}");
     // an unwritable output fails at once, before the long run
     let good = synth(d, "st.csv", &["--campaign", "stability", "--noise", "1", "--seed", "1"]);
-    let e = fails(&["diagnose", "--motor", "trum60a", "--data", &good, "--json", &path(d, "no/such/dir/x.json")], 1);
+    let e = fails(&["diagnose", "--motor", MOTOR, "--data", &good, "--json", &path(d, "no/such/dir/x.json")], 1);
     assert!(e.contains("does not exist"), "{e}");
-    fails(&["diagnose", "--motor", "trum60a"], 2);
+    fails(&["diagnose", "--motor", MOTOR], 2);
     let e = fails(
         &[
             "calibrate",
             "--motor",
-            "trum60a",
+            MOTOR,
             "--data",
             &write(d, "h2.csv", "preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n"),
         ],

@@ -1,4 +1,4 @@
-//! Diagnosis speed on a large data set (issue 5's target: 1000 rows, all seven
+//! Diagnosis speed on a large data set (the target: 1000 rows, all seven
 //! candidates, block cross-validation, under 2 s on 2 cores). Seven combined campaigns of
 //! one motor (no parameter perturbation, so they agree; different noise seeds, each its
 //! own bench session with its own run ids) give 980 rows.

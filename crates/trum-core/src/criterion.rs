@@ -29,9 +29,9 @@ pub struct CriterionConfig {
     pub voltage_v: f64,
     /// Drive frequency [Hz].
     pub frequency_hz: f64,
-    /// Run time for the temperature rise [s] (seed 000 section 4.2 uses 10 s).
+    /// Run time for the temperature rise [s] (Chen et al. 2020 section 4.2 uses 10 s).
     pub run_time_s: f64,
-    /// Load torque during the temperature run [N·m] (seed 000: no load).
+    /// Load torque during the temperature run [N·m] (Chen et al. 2020: no load).
     pub run_torque_nm: f64,
     /// Axial runout for the speed fluctuation [m].
     pub runout_m: f64,

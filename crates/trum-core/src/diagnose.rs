@@ -1872,8 +1872,8 @@ mod tests {
     /// On data without any effect a model without error scores the noise alone: the
     /// reported noise NRMSE is the baseline's held-out NRMSE within their scatter (over six
     /// seeds 0.91-1.13 in the preload-torque campaign and 0.98-1.20 in the combined one;
-    /// the weights' upper-bound levels, reported until stop 31, gave 1.5-1.8 and 3.3-4.1),
-    /// and never above the weights' level.
+    /// the weights' upper-bound levels give 1.5-1.8 and 3.3-4.1), and never above the
+    /// weights' level.
     #[test]
     fn the_noise_nrmse_is_what_a_model_without_error_scores() {
         let m = crate::calibrate::tests::reference_motor();
@@ -2144,8 +2144,8 @@ mod tests {
     /// One motor measured at four drive voltages (preload-torque runs, radial friction in its
     /// truth form): calibrated from the nominal motor, the baseline presses the modal damping
     /// onto its upper bound, where the logistic transform holds it (a radial-friction fit
-    /// started there stayed in that valley: held-out χ² 108 per reading, until stop 28's
-    /// second start from the nominal motor). Refitted from its own end, the baseline leaves
+    /// started there stays in that valley, held-out χ² 108 per reading, without the second
+    /// start from the nominal motor). Refitted from its own end, the baseline leaves
     /// the bound at a fraction of the χ²; `calibrate_refitting_bounds` and so the diagnosis
     /// do that, and the diagnosis finds radial friction at its truth.
     #[test]
