@@ -32,7 +32,9 @@ def test_from_dict_forms(motor):
     assert flat.overrides() == {"stator.modal_damping_ns_per_m": 12.0}
     fx = trum.Motor.from_dict({"preset": "trum60a", "effects": {"radial_friction": 0.5}})
     assert fx == motor.with_effects("radial_friction=0.5") == motor.with_effects(radial_friction=0.5)
-    assert fx.active_effects == {"radial_friction": {"radial_velocity_ratio": 0.5}}
+    # (the preset carries its paper's contact stiffening; the added effect joins it)
+    assert fx.active_effects == {**motor.active_effects, "radial_friction": {"radial_velocity_ratio": 0.5}}
+    assert "preload_stiffening" in motor.active_effects
     hs = {"beta_n_per_m3": 1e19, "preload_gain_per_n": 0.001}
     a = trum.Motor.from_dict({"preset": "trum60a", "effects": {"hertz_softening": hs}})
     b = motor.with_effects("hertz_softening:beta_n_per_m3=1e19,preload_gain_per_n=0.001")
@@ -47,7 +49,8 @@ def test_from_dict_forms(motor):
 
 
 def test_repr_shows_preset_effects_overrides(motor):
-    assert repr(motor) == "Motor(preset='trum60a', effects='none')"
+    assert repr(motor) == f"Motor(preset='trum60a', effects='{motor.effects}')"
+    assert repr(trum.Motor("generic60")) == "Motor(preset='generic60', effects='none')"
     m = motor.with_effects("radial_friction=0.5").with_params({"stator.modal_damping_ns_per_m": 12})
     r = repr(m)
     assert "preset='trum60a'" in r and "radial_friction(radial_velocity_ratio=0.5)" in r

@@ -37,13 +37,14 @@ def test_parallel_equals_serial_bitwise(motor):
 
 
 def test_known_values_match_cli_snapshot(motor):
-    # `trum point --motor trum60a --preload-n 250 --torque-nm 0.3` (docs/CLI.md, 6 significant digits).
+    # `trum point --motor trum60a --preload-n 250 --torque-nm 0.3` (the CLI's snapshot
+    # crates/trum-cli/tests/snapshots/point_trum60a_250n_0.3nm.txt, 6 significant digits).
     r = motor.solve(preload_n=250.0, torque_nm=0.3, voltage_v=200.0, frequency_hz=43000.0)
-    expect = dict(speed_rpm=85.6024, speed_rad_s=8.96427, efficiency=0.162702, output_power_w=2.68928,
-                  input_power_w=16.5289, stall_torque_nm=1.4039, amplitude_m=2.08996e-6,
-                  contact_angle_deg=32.9593, driving_angle_deg=11.6831, driving_ratio=0.354472,
-                  contact_half_angle_rad=2.58862, stick_half_angle_rad=0.917592, contact_length_m=0.0151003,
-                  crest_speed_m_s=0.387195)
+    expect = dict(speed_rpm=206.944, speed_rad_s=21.6711, efficiency=0.109038, output_power_w=6.50134,
+                  input_power_w=59.6247, stall_torque_nm=1.68659, amplitude_m=4.40871e-6,
+                  contact_angle_deg=27.0226, driving_angle_deg=10.19, driving_ratio=0.377091,
+                  contact_half_angle_rad=2.12235, stick_half_angle_rad=0.800318, contact_length_m=0.0123804,
+                  crest_speed_m_s=0.816776)
     assert r.status.item() == "ok"
     for q, v in expect.items():
         assert r[q].item() == pytest.approx(v, rel=6e-6), q

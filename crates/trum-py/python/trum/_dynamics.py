@@ -5,6 +5,7 @@ the stick-slip step response ([BarTransient]; keys of docs/REFERENCES.md):
 from __future__ import annotations
 
 import numbers
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -214,6 +215,12 @@ class StepResult:
         return (self.averages["speed_rpm"] - self.steady["speed_rpm"]) / self.steady["speed_rpm"]
 
 
+def _require_name(motor: Any) -> str:
+    if isinstance(motor, str):
+        return motor
+    raise TypeError(f"expected a trum.Motor or a preset name, got {type(motor).__name__}")
+
+
 def step(
     motor: Union[Motor, str],
     *,
@@ -238,8 +245,19 @@ def step(
                     ("record_every", record_every)):
         if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 0:
             raise InputError(f"{name}: expected a whole number, got {v!r}")
+    m = motor if isinstance(motor, Motor) else Motor(_require_name(motor))
+    # A paper preset may carry effects its paper's model includes (docs/PRESETS.md); the
+    # transient model has none of them, so it runs on the preset's baseline and says so,
+    # as `trum step` does. Effects a user switched on are still refused.
+    if m.preset_name is not None and m.active_effects and m.active_effects == Motor(m.preset_name).active_effects:
+        warnings.warn(
+            f"the transient model has no unmodelled effects: {m.preset_name} runs without its "
+            f"{', '.join(m.active_effects)}",
+            stacklevel=2,
+        )
+        m = m.with_effects("none")
     d = _trum.step(
-        _motor(motor), float(voltage_v), float(frequency_hz), float(phase_difference_deg), float(preload_n),
+        _motor(m), float(voltage_v), float(frequency_hz), float(phase_difference_deg), float(preload_n),
         float(torque_nm), float(duration_s), int(steps_per_period), int(nodes_per_wavelength),
         float(tangential_stiffness_ratio), int(record_every), [float(t) for t in snapshot_at_s],
     )
