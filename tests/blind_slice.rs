@@ -29,22 +29,7 @@ mod blind;
 #[test]
 fn blind_slice_meets_the_issue_criteria() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let cases = blind::slice_cases();
-    // two workers: the CI machine has two cores
-    let outcomes: Vec<blind::Outcome> = std::thread::scope(|s| {
-        let halves: Vec<_> = [0usize, 1]
-            .into_iter()
-            .map(|w| {
-                let (cases, dir) = (&cases, dir.path());
-                s.spawn(move || {
-                    cases.iter().skip(w).step_by(2).map(|c| (c.seed, blind::run_case(c, dir))).collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        let mut all: Vec<(u64, blind::Outcome)> = halves.into_iter().flat_map(|h| h.join().expect("worker")).collect();
-        all.sort_by_key(|x| x.0);
-        all.into_iter().map(|x| x.1).collect()
-    });
+    let outcomes = run_two_workers(&blind::slice_cases(), dir.path());
     let report = blind::cases_csv(&outcomes);
     let sum = blind::summarise(&outcomes);
     assert!(sum.non_null >= 4, "too few visible cases to judge:\n{report}");
