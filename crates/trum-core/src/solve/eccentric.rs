@@ -8,8 +8,9 @@ use std::f64::consts::PI;
 /// `eccentricity`: the preload varies once per revolution by ΔF = δ/(1/k_sp + 1/K_z)
 /// (crate::contact::contact_normal_stiffness_n_per_m); every additive quantity is averaged
 /// over the revolution with the time spent at each angle (∝ 1/Ω), so the energy balance
-/// still holds, and the speed's time-weighted standard deviation is reported. The truth
-/// form adds a twice-per-revolution component of 30 % (tilted as well as offset rotor).
+/// still holds, and the speed's time-weighted standard deviation is reported. The first
+/// truth family adds a twice-per-revolution component of 30 % (tilted as well as offset
+/// rotor), the second a three-lobed one of 40 %.
 /// `solve_at(op, guess)` is the steady-state solve at each preload (the nominal one first,
 /// then the ripple samples in order): [`solve_effects`] in [`solve_prepared`];
 /// crate::sensitivity records those solves, or passes linearised ones.
