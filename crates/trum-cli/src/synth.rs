@@ -105,6 +105,19 @@ pub fn parse_omit(spec: Option<&str>) -> Result<Vec<Observable>> {
 
 pub fn run(a: &SynthArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
     let (motor, _) = a.motor.load()?;
+    // Truth forms apply to every switched-on effect, the motor's own (a paper preset's
+    // contact stiffening) included: a diagnosis against the same motor then sees their
+    // form difference as a gap. Said before the data are written.
+    let own = crate::motor::load_motor(&a.motor.motor)?.0.effects;
+    if !a.candidate_forms && !own.is_none() {
+        writeln!(
+            err,
+            "warning: the motor's own effects ({}) are simulated in their truth forms too, so a diagnosis against \
+             this motor can name them; use --candidate-forms, or a motor file without effects, for data whose only \
+             unmodelled effects are those given with --effect",
+            own.active().iter().map(|e| e.name()).collect::<Vec<_>>().join(", ")
+        )?;
+    }
     for (flag, v) in [("--voltage-v", a.voltage_v), ("--frequency-hz", a.frequency_hz)] {
         if !(v.is_finite() && v > 0.0) {
             bail!("{flag} {v} must be a finite number > 0");
