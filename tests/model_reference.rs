@@ -1,5 +1,6 @@
 //! Reference values of the steady-state model: published results the presets must
 //! reproduce (with the tolerance stated and why) and analytic limits.
+#![allow(clippy::unwrap_used)] // tests: a panic is the failure report
 
 use std::f64::consts::PI;
 use trum_core::presets::preset;

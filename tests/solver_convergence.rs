@@ -5,6 +5,7 @@
 //! checked against an independent route: `amplitude_branches`, a 400-point scan of the
 //! amplitude map with bisection, whose largest stable root is the steady amplitude; no
 //! root at all means the stator is clamped.
+#![allow(clippy::unwrap_used)] // tests: a panic is the failure report
 
 #[path = "support/scaled.rs"]
 mod scaled;

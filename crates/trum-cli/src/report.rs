@@ -89,11 +89,11 @@ fn summary(h: &mut String, d: &Diagnosis) {
         ),
         None => String::new(),
     };
-    let _ = write!(
+    let _ = writeln!(
         h,
         "<div class=\"box\"><div class=\"verdict\">Verdict: {}</div>\
          <p>Confounded with: {}<br>Held-out gap (NRMSE): baseline <b>{}</b>{after}; the noise alone gives {}.<br>\
-         Held-out χ² per reading of the baseline: {} (1 = the baseline misses by exactly the noise).</p></div>\n",
+         Held-out χ² per reading of the baseline: {} (1 = the baseline misses by exactly the noise).</p></div>",
         esc(&verdict_words(d)),
         esc(&conf),
         fmt_sig(d.baseline_heldout_nrmse, 3),
@@ -103,7 +103,7 @@ fn summary(h: &mut String, d: &Diagnosis) {
 }
 
 fn method(h: &mut String, d: &Diagnosis) {
-    let _ = write!(
+    let _ = writeln!(
         h,
         "<h2>How to read this report</h2>\
 <p>The motor model (the <em>baseline</em>) is first <b>calibrated</b> to the data: its uncertain parameters \
@@ -123,7 +123,7 @@ when it is strong and brings the held-out error to about the noise level; two ef
 the pair does; <code>unexplained</code> when a real gap remains that no candidate closes. <b>Confounded</b> effects explain \
 the data about as well as the verdict and cannot be told apart from it with these operating points.</p>\
 <p><b>Where</b>: the residuals (measured &minus; model) of the calibrated baseline are grouped by quantity and by thirds of \
-each operating coordinate; a group is listed when its mean is more than 3.5 standard errors from zero.</p>\n",
+each operating coordinate; a group is listed when its mean is more than 3.5 standard errors from zero.</p>",
         d.folds,
         esc(EVIDENCE_SCALE)
     );

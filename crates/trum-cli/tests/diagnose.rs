@@ -59,7 +59,7 @@ fn synth_writes_a_valid_reproducible_file() {
     assert!(m.warnings.is_empty(), "{:?}", m.warnings);
     assert!(m.has(trum_core::measurements::Column::SpeedStdRpm));
     // stdout gives the same bytes
-    let o = trum(&["synth", "--motor", MOTOR, "-o", "-", &base[0], base[1], base[2], base[3], base[4], base[5]]);
+    let o = trum(&["synth", "--motor", MOTOR, "-o", "-", base[0], base[1], base[2], base[3], base[4], base[5]]);
     assert_eq!(o.stdout, a);
     // --omit drops columns; effects change the data; truth and candidate forms differ
     let om = synth(d, "om.csv", &[&base[..], &["--omit", "feedback_v,current_a"]].concat());

@@ -1,3 +1,4 @@
+#![allow(clippy::unwrap_used)] // examples: developer tools, a panic is the error report
 use trum_core::synth::*;
 use trum_core::*;
 fn main() {

@@ -1,3 +1,4 @@
+#![allow(clippy::unwrap_used)] // examples: developer tools, a panic is the error report
 use trum_core::*;
 fn main() {
     let args: Vec<String> = std::env::args().collect();

@@ -93,6 +93,8 @@ fn from_unit(f: &Free, u: f64) -> f64 {
 
 /// A target: name, paper value, model value, tolerance (the cost divides by it).
 type Target = (String, f64, f64, f64);
+/// The targets of a preset for a motor; `true` asks for coarser, faster scans.
+type Targets = fn(&Motor, bool) -> Vec<Target>;
 
 fn peak(xs: &[f64], ys: &[f64]) -> f64 {
     let mut i = 0;
@@ -291,7 +293,7 @@ fn main() {
         // the fit starts from the full projection of the contact stiffness on the mode
         base.effects.parse_assignment("preload_stiffening:stiffness_scale=1,modal_fraction=1").expect("effect");
     }
-    let (free, targets): (Vec<Free>, fn(&Motor, bool) -> Vec<Target>) = match name {
+    let (free, targets): (Vec<Free>, Targets) = match name {
         "trum60a" => (
             vec![
                 Free { key: "friction_layer.youngs_modulus_pa", lo: 1e8, hi: 3e9, log: true },

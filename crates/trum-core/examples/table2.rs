@@ -1,5 +1,6 @@
 //! Diagnosis of Sun et al. 2021 Table 2 (no-load speed and feedback voltage at four preloads)
 //! with the trum60-qut preset; prints what docs/DIAGNOSIS.md reports.
+#![allow(clippy::unwrap_used)] // examples: developer tools, a panic is the error report
 use trum_core::*;
 fn main() {
     let text = include_bytes!("../../../tests/data/good/measurements/sun2021_table2.csv");

@@ -203,13 +203,13 @@ pub struct Prior {
 }
 
 impl FitParam {
-    fn to_u(&self, p: f64) -> f64 {
+    fn p_to_u(&self, p: f64) -> f64 {
         let (lo, hi, x) =
             if self.log { (self.lo.ln(), self.hi.ln(), p.max(1e-300).ln()) } else { (self.lo, self.hi, p) };
         let t = ((x - lo) / (hi - lo)).clamp(1e-9, 1.0 - 1e-9);
         (t / (1.0 - t)).ln()
     }
-    fn from_u(&self, u: f64) -> f64 {
+    fn u_to_p(&self, u: f64) -> f64 {
         let t = 1.0 / (1.0 + (-u).exp());
         if self.log {
             (self.lo.ln() + t * (self.hi.ln() - self.lo.ln())).exp()
@@ -221,7 +221,7 @@ impl FitParam {
     /// with respect to `u`; `None` without a prior.
     fn prior_residual(&self, u: f64) -> Option<(f64, f64)> {
         let pr = self.prior?;
-        let p = self.from_u(u);
+        let p = self.u_to_p(u);
         let (x, dx_dp) = if self.log { (p.max(1e-300).ln(), 1.0 / p.max(1e-300)) } else { (p, 1.0) };
         Some(((x - pr.centre) / pr.sd, dx_dp * self.dp_du(u) / pr.sd))
     }
@@ -230,7 +230,7 @@ impl FitParam {
         let t = 1.0 / (1.0 + (-u).exp());
         let dt = t * (1.0 - t);
         if self.log {
-            self.from_u(u) * (self.hi.ln() - self.lo.ln()) * dt
+            self.u_to_p(u) * (self.hi.ln() - self.lo.ln()) * dt
         } else {
             (self.hi - self.lo) * dt
         }
@@ -500,7 +500,7 @@ fn lm_pass<'a>(problem: Problem<'a>, opts: &FitOptions) -> (Problem<'a>, levenbe
 fn motor_at(base: &Motor, params: &[FitParam], u: &DVector<f64>) -> Motor {
     let mut m = base.clone();
     for (fp, &ui) in params.iter().zip(u.iter()) {
-        fp.param.set(&mut m, fp.from_u(ui));
+        fp.param.set(&mut m, fp.u_to_p(ui));
     }
     m
 }
@@ -1075,6 +1075,8 @@ fn fit(
         )));
     }
     for fp in params {
+        // NaN bounds must take the error branch
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if !(fp.lo < fp.hi) || (fp.log && fp.lo <= 0.0) || !fp.lo.is_finite() || !fp.hi.is_finite() {
             return Err(TrumError::input(format!("invalid bounds [{}, {}] for {}", fp.lo, fp.hi, fp.param.name())));
         }
@@ -1093,7 +1095,7 @@ fn fit(
     let u_edge = ((1.0 - BOUND_T) / BOUND_T).ln();
     let u0 = DVector::from_iterator(
         params.len(),
-        params.iter().map(|fp| fp.to_u(fp.param.get(motor).clamp(fp.lo, fp.hi)).clamp(-u_edge, u_edge)),
+        params.iter().map(|fp| fp.p_to_u(fp.param.get(motor).clamp(fp.lo, fp.hi)).clamp(-u_edge, u_edge)),
     );
     let off: Vec<usize> = params
         .iter()
@@ -1188,7 +1190,7 @@ fn fit(
     // constant), so that models with the same priors compare by it
     let prior_chi2: f64 = prior_residuals(params, &problem.u).iter().map(|x| x * x).sum();
     let chi2: f64 = r.iter().map(|x| x * x).sum::<f64>() + prior_chi2;
-    if r.iter().any(|x| *x == 50.0) {
+    if r.contains(&50.0) {
         warnings.push("the model has no solution at some measured points (counted as 50-sigma misses)".into());
     }
     // Uncertainties: cov(p) = s²·(JᵀJ)⁻¹ with J in p-coordinates, computed on relative
@@ -1305,6 +1307,7 @@ fn fit(
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 pub(crate) mod tests {
     use super::*;
 
@@ -1669,7 +1672,7 @@ pub(crate) mod tests {
         let mut start = nominal.clone();
         start.effects.set(sag, &[1.0]);
         let t: f64 = 5e-4;
-        let u = DVector::from_vec(vec![params[0].to_u(params[0].param.get(&nominal)), (t / (1.0 - t)).ln()]);
+        let u = DVector::from_vec(vec![params[0].p_to_u(params[0].param.get(&nominal)), (t / (1.0 - t)).ln()]);
         let collapses = |restart: bool| {
             let mut problem = Problem::new(&start, &rows, &params, u.clone(), vec![1]);
             problem.off_at_zero = restart;
@@ -1715,7 +1718,7 @@ pub(crate) mod tests {
         // FitParam, J_p = J_u/(dp/du)), moving p onto its lower bound changes χ² by
         // 2·(J_pᵀr)·(lo − p) to first order.
         let fp = FitParam { param: ParamRef::Motor("x".into()), lo: 2.0, hi: 7.0, log: false, prior: None };
-        let p = fp.from_u(u0);
+        let p = fp.u_to_p(u0);
         let gp = j.column(0).dot(&r) / fp.dp_du(u0);
         let first_order = -2.0 * gp * (fp.lo - p);
         let edge = remaining_gain(&j, &r, &low) - gauss_newton_decrement(&j.columns(1, 1).into_owned(), &r);
@@ -1773,7 +1776,7 @@ pub(crate) mod tests {
             if let Some(e) = e {
                 params.extend(effect_params(e));
             }
-            let u = DVector::from_iterator(params.len(), params.iter().map(|fp| fp.to_u(fp.param.get(&m))));
+            let u = DVector::from_iterator(params.len(), params.iter().map(|fp| fp.p_to_u(fp.param.get(&m))));
             let at = |k: usize, h: f64| {
                 let mut v = u.clone();
                 v[k] += h;
@@ -1829,12 +1832,12 @@ pub(crate) mod tests {
     fn bound_transform_round_trips() {
         let fp = FitParam { param: ParamRef::Motor("x".into()), lo: 0.1, hi: 10.0, log: true, prior: None };
         for p in [0.11, 1.0, 9.0] {
-            assert!((fp.from_u(fp.to_u(p)) - p).abs() < 1e-9 * p);
+            assert!((fp.u_to_p(fp.p_to_u(p)) - p).abs() < 1e-9 * p);
         }
         let fp = FitParam { param: ParamRef::Motor("x".into()), lo: -1.0, hi: 2.0, log: false, prior: None };
         let u = 0.3;
         let h = 1e-6;
-        let fd = (fp.from_u(u + h) - fp.from_u(u - h)) / (2.0 * h);
+        let fd = (fp.u_to_p(u + h) - fp.u_to_p(u - h)) / (2.0 * h);
         assert!((fd - fp.dp_du(u)).abs() < 1e-8);
     }
 

@@ -80,6 +80,8 @@ impl CriterionConfig {
         if self.weights.iter().any(|w| !(w.is_finite() && *w >= 0.0)) || self.weights.iter().sum::<f64>() <= 0.0 {
             return Err(TrumError::input("weights must be finite, >= 0 and not all zero"));
         }
+        // a NaN start or stop must take the error branch
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if self.preload_n.n < 2
             || !(self.preload_n.start > 0.0)
             || !(self.preload_n.stop > self.preload_n.start)
@@ -181,6 +183,8 @@ pub fn region_overlap(region: (f64, f64), reference: (f64, f64)) -> (f64, f64) {
 pub fn loaded_stall_torque_nm(p: &Prepared, motor: &Motor, preload_n: f64, voltage_v: f64, frequency_hz: f64) -> f64 {
     let status = |t: f64| solve_prepared(p, motor, &OperatingPoint::new(preload_n, t, voltage_v, frequency_hz), None);
     let s0 = status(0.0);
+    // a NaN no-load stall torque must take the NaN return
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     if s0.status != Status::Ok || !(s0.stall_torque_nm > 0.0) {
         return f64::NAN;
     }

@@ -636,6 +636,7 @@ fn _accepts_integers(n: Num) -> f64 {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
     use super::*;
 

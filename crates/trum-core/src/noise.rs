@@ -117,6 +117,8 @@ pub fn estimate(rows: &[ObservedRow], groups: &[String]) -> BTreeMap<Observable,
         for l in ls {
             for w in l.windows(3) {
                 let (x0, x1, x2) = (x(w[0]), x(w[1]), x(w[2]));
+                // a NaN coordinate must skip the triple
+                #[allow(clippy::neg_cmp_op_on_partial_ord)]
                 if !(x2 > x0) {
                     continue;
                 }

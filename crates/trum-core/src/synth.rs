@@ -211,7 +211,7 @@ pub const PERTURBED: [(&str, f64); 11] = [
 
 /// The true motor: `motor` with its uncertain parameters perturbed.
 pub fn true_motor(motor: &Motor, cfg: &SynthConfig) -> Motor {
-    let mut rng = ChaCha8Rng::seed_from_u64(cfg.motor_seed.unwrap_or(cfg.seed) ^ 0x5eed_0f_7e57);
+    let mut rng = ChaCha8Rng::seed_from_u64(cfg.motor_seed.unwrap_or(cfg.seed) ^ 0x005e_ed0f_7e57);
     let mut m = motor.clone();
     for (key, factor) in PERTURBED {
         let rel = factor * cfg.perturbation;
@@ -385,6 +385,7 @@ pub fn synthesize(motor: &Motor, cfg: &SynthConfig) -> Result<Vec<SynthRow>, Tru
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
     use super::*;
 

@@ -92,6 +92,9 @@ fn grid(e: Effect) -> Vec<(f64, Vec<f64>)> {
     out
 }
 
+/// A scanned point: (base index, factor, values, χ²).
+type Scored = (usize, f64, Vec<f64>, f64);
+
 /// Valleys of the objective along the effect's strength, from each motor of `bases`, that
 /// the fit ending at `fitted` has not reached: lower than the fit on the scan's rows, or
 /// beyond eight times the typical strength (the fit's bounds) and lower than every
@@ -103,8 +106,7 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
     let chi2 = |m: &Motor| residuals(m, &sub).iter().map(|z| z * z).sum::<f64>();
     let fit_chi2 = chi2(fitted);
     let points = grid(e);
-    // (base index, factor, values, χ²)
-    let scored: Vec<(usize, f64, Vec<f64>, f64)> = bases
+    let scored: Vec<Scored> = bases
         .iter()
         .enumerate()
         .flat_map(|(b, base)| points.iter().map(move |(f, v)| (b, base, *f, v.clone())))
@@ -120,7 +122,7 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
     let mut found: Vec<Valley> = Vec::new();
     for (b, base) in bases.iter().enumerate() {
         // one series per shape set: the values with the same shape parameters
-        let mut series: Vec<Vec<&(usize, f64, Vec<f64>, f64)>> = Vec::new();
+        let mut series: Vec<Vec<&Scored>> = Vec::new();
         for p in scored.iter().filter(|p| p.0 == b) {
             let shape_of = |v: &[f64]| -> Vec<u64> {
                 e.info().params.iter().zip(v).filter(|(q, _)| q.shape).map(|(_, x)| x.to_bits()).collect()

@@ -122,6 +122,7 @@ pub(crate) fn overlap(a: &Signature, b: &Signature) -> f64 {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
     use super::*;
     use crate::calibrate::tests::classic_params;
