@@ -45,18 +45,9 @@ use trum_core::solve::{solve_prepared, Prepared};
 use trum_core::sweep::{solve_range, Axis, Grid};
 use trum_core::{solve, OperatingPoint, Status};
 
-/// The motors these regression points were found on: frozen copies of the paper presets'
-/// baseline (tests/data/motors/), so a recalibrated preset does not move them; other
-/// names are the presets themselves.
-fn preset(name: &str) -> Result<Motor, trum_core::ParamError> {
-    match name {
-        "trum60a" => Motor::from_toml_str(include_str!("data/motors/trum60a_baseline.toml"), "trum60a_baseline.toml"),
-        "trum60-qut" => {
-            Motor::from_toml_str(include_str!("data/motors/trum60-qut_baseline.toml"), "trum60-qut_baseline.toml")
-        }
-        other => trum_core::presets::preset(other),
-    }
-}
+#[path = "support/frozen.rs"]
+mod frozen;
+use frozen::preset;
 
 /// solve.rs `solve_drive`: a warm start (what `trum map` and `trum.map` use) from the
 /// previous grid point lands on the clamped branch although the point has a running

@@ -13,18 +13,9 @@ use trum_core::solve::amplitude_branches;
 use trum_core::sweep::{Axis, Grid};
 use trum_core::{solve, Motor, OperatingPoint, Status};
 
-/// The motors these regression points were found on: frozen copies of the paper presets'
-/// baseline (tests/data/motors/), so a recalibrated preset does not move them; other
-/// names are the presets themselves.
-fn preset(name: &str) -> Result<Motor, trum_core::ParamError> {
-    match name {
-        "trum60a" => Motor::from_toml_str(include_str!("data/motors/trum60a_baseline.toml"), "trum60a_baseline.toml"),
-        "trum60-qut" => {
-            Motor::from_toml_str(include_str!("data/motors/trum60-qut_baseline.toml"), "trum60-qut_baseline.toml")
-        }
-        other => trum_core::presets::preset(other),
-    }
-}
+#[path = "support/frozen.rs"]
+mod frozen;
+use frozen::preset;
 
 fn assert_largest_branch(m: &Motor, op: &OperatingPoint, want: Status) {
     let s = solve(m, op);
