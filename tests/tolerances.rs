@@ -54,3 +54,31 @@ fn a_zero_tolerance_holds_the_parameter_and_others_keep_their_priors() {
     assert!(!fewer.iter().any(|p| p.param.name() == "stator.resonance_frequency_hz"));
     assert!(fewer.iter().all(|p| p.prior.is_some()));
 }
+
+#[test]
+fn the_torque_offset_width_comes_from_the_table_and_zero_removes_it() {
+    use trum_core::calibrate::{baseline_params_with, Observable, ObservedRow};
+    let m = Motor::from_toml_str(MOTOR, "m.toml").expect("motor");
+    // a load sweep whose smallest reading is not a tared zero
+    let rows: Vec<ObservedRow> = (0..8)
+        .map(|i| ObservedRow {
+            op: trum_core::OperatingPoint::new(200.0, 0.002 + 0.04 * i as f64, 200.0, 43e3),
+            readings: vec![(Observable::SpeedRpm, 100.0, 1.0)],
+            ambient_c: 25.0,
+            speed_std_clipped: false,
+        })
+        .collect();
+    let offset = |t: &std::collections::BTreeMap<String, f64>| {
+        baseline_params_with(&m, &rows, t).into_iter().find(|p| p.param.name() == "bench.torque_offset_nm")
+    };
+    let default = offset(&Default::default()).expect("an offset on a load sweep");
+    // 1 % of the largest reading (0.282 N·m), bounded above by the smallest reading
+    assert!((default.prior.expect("prior").sd - 0.00282).abs() < 1e-9, "{default:?}");
+    assert!((default.hi - 0.002).abs() < 1e-12 && default.lo < -0.01, "{default:?}");
+    let text = format!("{MOTOR}\n[tolerances]\n\"bench.torque_offset_nm\" = 0.001\n");
+    let t = tolerances_from_toml_str(&text, "m.toml").expect("valid key");
+    assert_eq!(offset(&t).expect("offset").prior.expect("prior").sd, 0.001);
+    let held = tolerances_from_toml_str(&format!("{MOTOR}\n[tolerances]\n\"bench.torque_offset_nm\" = 0\n"), "m.toml")
+        .expect("valid key");
+    assert!(offset(&held).is_none());
+}

@@ -29,7 +29,7 @@ mod signature;
 use crate::calibrate::{
     baseline_params_with, calibrate, calibrate_adding, calibrate_nested, calibrate_refitting_bounds,
     calibrate_weighted, effect_params, prior_residuals, residuals, with_prior_rows, Calibration, FitOptions, FitParam,
-    FittedParam, Observable, ObservedRow, ParamRef, Start, IRLS_START_RTOL,
+    FittedParam, InstrumentParam, Observable, ObservedRow, ParamRef, Start, IRLS_START_RTOL,
 };
 use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
@@ -363,7 +363,7 @@ fn predict(motor: &Motor, rows: &[&ObservedRow]) -> Vec<Vec<f64>> {
     // in parallel: the baseline's held-out predictions are made while nothing else runs
     rows.par_iter()
         .map(|r| {
-            let s = solve_prepared(&p, motor, &r.op, None);
+            let s = solve_prepared(&p, motor, &motor.effects.instrument().operating_point(&r.op), None);
             r.readings
                 .iter()
                 .map(|&(o, _, sigma)| {
@@ -715,7 +715,7 @@ fn fit_params(
     let mut params = baseline_params_with(motor, rows, tolerances);
     // an instrument floor starts mid-range (at zero it would sit on its bound, where the
     // transformed gradient vanishes)
-    for fp in params.iter().filter(|fp| matches!(fp.param, ParamRef::Instrument(_))) {
+    for fp in params.iter().filter(|fp| matches!(fp.param, ParamRef::Instrument(InstrumentParam::SpeedStdFloorRpm))) {
         if m.effects.instrument().speed_std_floor_rpm == 0.0 {
             m.effects.instrument_mut().speed_std_floor_rpm = 0.5 * (fp.lo + fp.hi);
         }
@@ -984,7 +984,8 @@ pub fn diagnose(
         let at_rest = turning
             .iter()
             .filter(|r| {
-                matches!(solve_prepared(&pb, &base_cal.motor, &r.op, None).status, Status::Stall | Status::Clamped)
+                let op = base_cal.motor.effects.instrument().operating_point(&r.op);
+                matches!(solve_prepared(&pb, &base_cal.motor, &op, None).status, Status::Stall | Status::Clamped)
             })
             .count();
         if at_rest == turning.len() {

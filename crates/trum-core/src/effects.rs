@@ -305,9 +305,24 @@ pub struct Instrument {
     /// Noise floor of the speed-stability reading [rev/min]: the instrument reads
     /// √(true² + floor²) of a speed standard deviation.
     pub speed_std_floor_rpm: f64,
+    /// Zero offset of the torque transducer [N·m]: a row's torque column reads the load
+    /// the rotor carries plus this offset. A transducer's zero drifts with temperature and
+    /// mounting by a fraction of a percent of its full scale, which on a steep
+    /// speed-torque line is a speed error of the order of the readings' own noise.
+    pub torque_offset_nm: f64,
 }
 
 impl Instrument {
+    /// The operating point the motor ran at when a row's set points read `op`: the load
+    /// torque is the reading less the transducer's zero offset, never below zero (a
+    /// reading within the offset of zero is an unloaded rotor).
+    pub fn operating_point(&self, op: &crate::OperatingPoint) -> crate::OperatingPoint {
+        if self.torque_offset_nm == 0.0 {
+            return *op;
+        }
+        crate::OperatingPoint { torque_nm: (op.torque_nm - self.torque_offset_nm).max(0.0), ..*op }
+    }
+
     /// What the instrument shows of quantity `o` when the motor's value is `model`.
     pub fn reading(&self, o: crate::calibrate::Observable, model: f64) -> f64 {
         match o {

@@ -249,7 +249,8 @@ struct MotorFile {
 /// prior). Keys are dotted motor keys (`"geometry.neutral_plane_distance_m" = 0.02`) or
 /// sub-tables (`[tolerances.geometry]`), limited to the parameters calibration fits
 /// ([`crate::calibrate::TOLERANCES`], docs/DIAGNOSIS.md); the bench's speed-std floor is
-/// `bench.speed_std_floor_rpm` (0: the bench has none). Empty without a table; errors name
+/// `bench.speed_std_floor_rpm` (0: the bench has none), the torque transducer's zero offset
+/// `bench.torque_offset_nm` (the prior's standard deviation in N·m; 0: no offset). Empty without a table; errors name
 /// the file, line and key.
 pub fn tolerances_from_toml_str(
     text: &str,
@@ -266,7 +267,7 @@ pub fn tolerances_from_toml_str(
     let valid: Vec<String> = crate::calibrate::TOLERANCES
         .iter()
         .map(|t| t.key.to_string())
-        .chain(std::iter::once("bench.speed_std_floor_rpm".to_string()))
+        .chain(["bench.speed_std_floor_rpm", "bench.torque_offset_nm"].map(String::from))
         .collect();
     let mut flat: Vec<(String, &toml::Value)> = Vec::new();
     for (k, v) in &table {
