@@ -217,6 +217,7 @@ fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
 /// reports ([`scales`] with the noise levels it estimates from the data): for outside
 /// figures on the same scale, such as the blind benchmark's model without error.
 pub fn nrmse_scales(rows: &[ObservedRow], groups: &[String]) -> BTreeMap<Observable, f64> {
+    let groups = &bench::runs(rows, groups)[..];
     let rows = bench_model(rows, groups).0;
     scales(&noise_scaled(&rows, &crate::noise::estimate(&rows, groups)))
 }
@@ -811,9 +812,19 @@ pub fn diagnose(
     opts: &DiagnoseOptions,
 ) -> Result<Diagnosis, TrumError> {
     let n_read: usize = rows.iter().map(|r| r.readings.len()).sum();
+    // runs inferred from the set points where the data name none
+    let named = groups.iter().any(|g| !g.is_empty());
+    let groups = &bench::runs(rows, groups)[..];
     // The bench model first: set points read back with noise are taken at their run's
     // mean, quantised readings carry their rounding error (`bench`).
-    let (bench_rows, bench_notes) = bench_model(rows, groups);
+    let (bench_rows, mut bench_notes) = bench_model(rows, groups);
+    if !named && !rows.is_empty() {
+        let n = groups.iter().collect::<std::collections::BTreeSet<_>>().len();
+        bench_notes.insert(
+            0,
+            format!("the data name no runs (run_id): {n} run(s) inferred from the preload and voltage levels"),
+        );
+    }
     let rows = &bench_rows[..];
     // Noise levels from the data, so that χ² and the evidence are on the scale of the
     // actual noise; clamped to [1/4, 4] × the stated levels.

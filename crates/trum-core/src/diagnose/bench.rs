@@ -7,8 +7,11 @@
 //!   the motor ran at the set point. Within a run, a column that scatters by less than
 //!   [`SET_POINT_CV`] around its mean without a trend in row order is such a read-back,
 //!   and each row gets the run's mean (the set point's best estimate: a nuisance
-//!   parameter per run and column). A column swept within the run (monotone in row order)
-//!   is left as recorded.
+//!   parameter per run and column). Left as recorded: a column swept within the run
+//!   (monotone in row order), one whose values repeat exactly (set points written as set,
+//!   at several levels), and one the readings follow (a real variation of the operating
+//!   point, whatever the rows' order: files without runs, or with rows in random order,
+//!   show no trend).
 //! - **Quantised readings.** A column whose every reading is a whole multiple of a step
 //!   carries the rounding's uniform error, of variance step²/12, beside its noise.
 //! - **Instrument floors** are nuisance parameters of the fit itself
@@ -60,6 +63,89 @@ fn is_read_back(v: &[f64]) -> bool {
     turns as f64 >= 0.25 * (steps.len() - 1) as f64
 }
 
+/// True when the values `v` are written as set rather than read back: fewer than three
+/// quarters of them are distinct (a read-back's noise makes every value its own; exact
+/// repeats are levels).
+fn repeats_levels(v: &[f64]) -> bool {
+    let mut sorted = v.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted.dedup();
+    (sorted.len() as f64) < 0.75 * v.len() as f64
+}
+
+/// Student's t of the correlation above which a run's readings are taken to follow a
+/// column: |t| > 4 happens by chance about once in a thousand runs of a dozen rows, while
+/// a sweep that moves the motor's state gives tens.
+const FOLLOW_T: f64 = 4.0;
+
+/// True when some reading of the run's rows `idx` follows the column `col`: the
+/// correlation of the two over the rows that have the reading has |t| > [`FOLLOW_T`]. A
+/// read-back's noise is not what the motor ran at, so the readings cannot follow it.
+fn readings_follow(rows: &[ObservedRow], idx: &[usize], col: &str) -> bool {
+    let mut rows_c: Vec<ObservedRow> = idx.iter().map(|&i| rows[i].clone()).collect();
+    let x: Vec<f64> = rows_c.iter_mut().map(|r| *column_mut(r, col)).collect();
+    Observable::ALL.iter().any(|&o| {
+        let pairs: Vec<(f64, f64)> = x
+            .iter()
+            .zip(&rows_c)
+            .filter_map(|(&xi, r)| r.readings.iter().find(|q| q.0 == o).map(|q| (xi, q.1)))
+            .filter(|(a, b)| a.is_finite() && b.is_finite())
+            .collect();
+        let n = pairs.len() as f64;
+        if n < 5.0 {
+            return false;
+        }
+        let (mx, my) = (pairs.iter().map(|p| p.0).sum::<f64>() / n, pairs.iter().map(|p| p.1).sum::<f64>() / n);
+        let sxy: f64 = pairs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+        let sxx: f64 = pairs.iter().map(|p| (p.0 - mx).powi(2)).sum();
+        let syy: f64 = pairs.iter().map(|p| (p.1 - my).powi(2)).sum();
+        if sxx <= 0.0 || syy <= 0.0 {
+            return false;
+        }
+        let r = (sxy / (sxx * syy).sqrt()).clamp(-1.0, 1.0);
+        r.abs() * ((n - 2.0) / (1.0 - r * r).max(1e-300)).sqrt() > FOLLOW_T
+    })
+}
+
+/// The runs of `rows`: `groups` as given when any row names its run, else runs inferred
+/// from the set points, whatever the rows' order (a file without `run_id`, perhaps with its
+/// rows in random order, as a designed experiment runs them). An inferred run is the rows
+/// that share a level of the preload and of the drive voltage (levels: values closer than
+/// [`SET_POINT_CV`] of their size chain into one) and whether they are a time series
+/// (`elapsed_s` > 0). Sweeps of the load or frequency then fall inside a run, where the
+/// set-point test leaves them alone, and a read-back preload or voltage scatters around its
+/// level inside one.
+pub fn runs(rows: &[ObservedRow], groups: &[String]) -> Vec<String> {
+    if groups.iter().any(|g| !g.is_empty()) {
+        return groups.to_vec();
+    }
+    let preload = levels(&rows.iter().map(|r| r.op.preload_n).collect::<Vec<_>>());
+    let voltage = levels(&rows.iter().map(|r| r.op.voltage_v).collect::<Vec<_>>());
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| format!("inferred:{}:{}:{}", preload[i], voltage[i], u8::from(r.op.elapsed_s > 0.0)))
+        .collect()
+}
+
+/// The level index of each value: sorted values chain into one level while neighbours are
+/// within [`SET_POINT_CV`] of their size.
+fn levels(v: &[f64]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..v.len()).collect();
+    order.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
+    let mut out = vec![0; v.len()];
+    let mut level = 0;
+    for w in order.windows(2) {
+        let (a, b) = (v[w[0]], v[w[1]]);
+        // (a NaN starts a level of its own)
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if !(b - a <= SET_POINT_CV * a.abs().max(b.abs())) {
+            level += 1;
+        }
+        out[w[1]] = level;
+    }
+    out
+}
+
 /// Rows with each run's read-back set points replaced by the run's mean, and a note
 /// naming what was replaced (`None` when nothing was).
 pub fn snap_set_points(rows: &[ObservedRow], groups: &[String]) -> (Vec<ObservedRow>, Option<String>) {
@@ -72,7 +158,7 @@ pub fn snap_set_points(rows: &[ObservedRow], groups: &[String]) -> (Vec<Observed
     for idx in runs.values().filter(|idx| idx.len() >= MIN_RUN_ROWS) {
         for col in SET_POINT_COLUMNS {
             let v: Vec<f64> = idx.iter().map(|&i| *column_mut(&mut out[i], col)).collect();
-            if is_read_back(&v) {
+            if is_read_back(&v) && !repeats_levels(&v) && !readings_follow(rows, idx, col) {
                 let mean = v.iter().sum::<f64>() / v.len() as f64;
                 for &i in idx {
                     *column_mut(&mut out[i], col) = mean;
@@ -176,6 +262,73 @@ mod tests {
         // rows of different runs are not averaged together; exact set points are left alone
         let exact: Vec<ObservedRow> = (0..8).map(|_| row(200.0, 43e3)).collect();
         assert!(snap_set_points(&exact, &groups).1.is_none());
+    }
+
+    /// Rows in random order without runs: a frequency swept 41.5-45 kHz among rows held at
+    /// 43 kHz scatters by under 2 % with no trend in row order, but its values repeat and
+    /// the speed follows them; a voltage read back ±0.5 % around 200 V is still snapped.
+    #[test]
+    fn a_sweep_in_shuffled_rows_without_runs_is_kept() {
+        let mut rows: Vec<ObservedRow> = Vec::new();
+        for i in 0..15 {
+            let f = 41_500.0 + 250.0 * i as f64;
+            let mut r = row(200.0 + 0.8 * (1.7 * i as f64).sin(), f);
+            r.readings = vec![(Observable::SpeedRpm, 200.0 - 0.05 * (f - 41_500.0), 1.0)];
+            rows.push(r);
+        }
+        for i in 0..30 {
+            let mut r = row(200.0 + 0.8 * (2.3 * i as f64 + 0.4).sin(), 43_000.0);
+            r.readings = vec![(Observable::SpeedRpm, 120.0 + (i % 3) as f64, 1.0)];
+            rows.push(r);
+        }
+        // a fixed shuffle: no trend in row order
+        let order: Vec<usize> = (0..rows.len()).map(|i| (i * 17) % rows.len()).collect();
+        let shuffled: Vec<ObservedRow> = order.iter().map(|&i| rows[i].clone()).collect();
+        let f: Vec<f64> = shuffled.iter().map(|r| r.op.frequency_hz).collect();
+        assert!(is_read_back(&f), "the order test alone would snap the sweep");
+        let groups = vec![String::new(); shuffled.len()];
+        let (snapped, note) = snap_set_points(&shuffled, &groups);
+        assert!(snapped.iter().zip(&shuffled).all(|(a, b)| a.op.frequency_hz == b.op.frequency_hz), "sweep moved");
+        assert!(note.expect("note").contains("voltage_v in 1 run"));
+        // without the repeats, the speed following the frequency keeps it too
+        let distinct: Vec<ObservedRow> = shuffled
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let mut r = r.clone();
+                r.op.frequency_hz += 1e-3 * i as f64;
+                r
+            })
+            .collect();
+        assert!(!repeats_levels(&distinct.iter().map(|r| r.op.frequency_hz).collect::<Vec<_>>()));
+        let (snapped, _) = snap_set_points(&distinct, &groups);
+        assert!(snapped.iter().zip(&distinct).all(|(a, b)| a.op.frequency_hz == b.op.frequency_hz), "sweep moved");
+    }
+
+    /// Without run names, runs are the rows at one preload and voltage level, in any order.
+    #[test]
+    fn runs_are_inferred_from_set_point_levels_only_without_names() {
+        let mut rows = Vec::new();
+        for (k, preload) in [100.0, 150.0, 200.0].iter().enumerate() {
+            for i in 0..5 {
+                let mut r = row(200.0 * (1.0 + 0.004 * ((k * 5 + i) as f64).sin()), 43e3);
+                r.op.preload_n = preload * (1.0 + 0.004 * ((3 * i + k) as f64).cos());
+                r.op.torque_nm = 0.05 * i as f64;
+                rows.push(r);
+            }
+        }
+        rows.reverse();
+        let inferred = runs(&rows, &vec![String::new(); rows.len()]);
+        let distinct: std::collections::BTreeSet<&String> = inferred.iter().collect();
+        assert_eq!(distinct.len(), 3, "{inferred:?}");
+        // each run holds the five rows of one preload
+        assert!(inferred.chunks(5).all(|c| c.iter().all(|g| g == &c[0])), "{inferred:?}");
+        let named = vec!["a".to_string(); rows.len()];
+        assert_eq!(runs(&rows, &named), named);
+        // the read-back preload is then snapped within each run
+        let (snapped, note) = snap_set_points(&rows, &inferred);
+        assert!(note.expect("note").contains("preload_n in 3 run(s)"));
+        assert!(snapped.iter().all(|r| [100.0, 150.0, 200.0].iter().any(|p| (r.op.preload_n - p).abs() < 0.5)));
     }
 
     #[test]
