@@ -14,8 +14,8 @@
 //! the per-case tables docs/data/blind_{dev,heldout}.csv. Options (these print only):
 //! `--half dev|heldout` one half; `--seed-offset K` every seed moved by K (another draw);
 //! `--slice` the test suite's slices; `--plain` the earlier single-form design without
-//! artefacts; `--only NAME` the cases whose injected set contains NAME; `--workers N`;
-//! `--no-write`. Each case's CSV and JSON stay in target/blind/.
+//! artefacts; `--only NAME` the cases whose injected set contains NAME; `--bare` every
+//! case's file without `run_id` and with its rows shuffled; `--workers N`; `--no-write`. Each case's CSV and JSON stay in target/blind/.
 
 #[path = "../tests/support/blind.rs"]
 mod blind;
@@ -126,7 +126,11 @@ fn main() {
         None if flag("--plain") => vec![Half::Plain],
         None => vec![Half::Dev, Half::HeldOut],
     };
+    if flag("--bare") {
+        blind::BARE.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
     let write = !flag("--no-write")
+        && !flag("--bare")
         && !flag("--slice")
         && !flag("--plain")
         && seed_offset == 0

@@ -295,6 +295,33 @@ fn trum(args: &[String]) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
+/// When set, every case's file loses its `run_id` column and has its rows in a
+/// pseudo-random order before the diagnosis reads it (`cargo bench --bench blind --
+/// --bare`): data laid out as a designed experiment without run names would be.
+pub static BARE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Rewrites the synthesised CSV at `path` without its `run_id` column and with its rows
+/// permuted by a generator seeded with `seed`.
+fn strip_runs_and_shuffle(path: &std::path::Path, seed: u64) {
+    let text = std::fs::read_to_string(path).expect("case CSV");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let keep: Vec<usize> = (0..header.len()).filter(|&i| header[i] != "run_id").collect();
+    let pick = |l: &str| {
+        let cells: Vec<&str> = l.split(',').collect();
+        keep.iter().map(|&i| cells.get(i).copied().unwrap_or("")).collect::<Vec<_>>().join(",")
+    };
+    let mut rows: Vec<String> = lines.filter(|l| !l.is_empty()).map(pick).collect();
+    // Fisher-Yates with a 64-bit LCG (Knuth's MMIX constants): reproducible per case
+    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    for i in (1..rows.len()).rev() {
+        state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        rows.swap(i, ((state >> 33) % (i as u64 + 1)) as usize);
+    }
+    let head: Vec<&str> = keep.iter().map(|&i| header[i]).collect();
+    std::fs::write(path, format!("{}\n{}\n", head.join(","), rows.join("\n"))).expect("rewrite case CSV");
+}
+
 /// Synthesises the case's data and diagnoses it blind.
 pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
     let tag = format!(
@@ -321,6 +348,9 @@ pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
         args.push(v);
     }
     trum(&args);
+    if BARE.load(std::sync::atomic::Ordering::Relaxed) {
+        strip_runs_and_shuffle(&data, case.seed);
+    }
     let t0 = std::time::Instant::now();
     trum(&[
         "diagnose".into(),
