@@ -131,7 +131,7 @@ impl Case {
     /// `injected` in their truth forms, σ as in [`Case::signal_chi2`]. Starts at the true
     /// baseline parameters: the best any calibration could do.
     fn leftover_chi2(&self, injected: &[&str], fitted: &[&str]) -> f64 {
-        use trum_core::calibrate::{baseline_params, calibrate, effect_params, FitOptions, ObservedRow};
+        use trum_core::calibrate::{baseline_params, effect_params, Calibration, FitOptions, ObservedRow};
         use trum_core::synth::{reading_noise, synthesize, true_motor, Artefacts};
         // the effect's signal in the motor's readings, without the bench's artefacts
         let cfg = trum_core::synth::SynthConfig { artefacts: Artefacts::default(), ..self.synth_config(0.0) };
@@ -157,7 +157,7 @@ impl Case {
         }
         // a generous budget: this is the reference the verdicts are judged against
         let opts = FitOptions { huber_k: f64::INFINITY, irls_passes: 0, max_evaluations: 4000, fold_rtol: 0.0 };
-        calibrate(&start, &rows, &params, &opts).map(|c| c.chi2).unwrap_or(f64::NAN)
+        Calibration::builder(&start, &rows).params(&params).options(&opts).run().map(|c| c.chi2).unwrap_or(f64::NAN)
     }
 
     /// Held-out NRMSE of the true motor itself (the injected effects in their truth forms,

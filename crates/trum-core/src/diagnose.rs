@@ -27,9 +27,8 @@ mod scan;
 mod signature;
 
 use crate::calibrate::{
-    baseline_params_with, calibrate, calibrate_adding, calibrate_nested, calibrate_refitting_bounds,
-    calibrate_weighted, effect_params, prior_residuals, residuals, with_prior_rows, Calibration, FitOptions, FitParam,
-    FittedParam, Observable, ObservedRow, ParamRef, Start, IRLS_START_RTOL,
+    baseline_params_with, effect_params, prior_residuals, residuals, with_prior_rows, Calibration, FitOptions,
+    FitParam, FittedParam, Observable, ObservedRow, ParamRef, Start, IRLS_START_RTOL,
 };
 use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
@@ -465,7 +464,13 @@ fn approx_cv(cal: &Calibration, rows: &[ObservedRow], folds: &[usize], k: usize,
         let moved = (&best.0 - &lin.u).amax();
         let fitted = if moved > 0.3 {
             let stepped = lin.motor_at(&best.0);
-            calibrate_weighted(&stepped, &train_rows, &lin.params, fit, w.clone()).map(|c| c.motor).unwrap_or(stepped)
+            Calibration::builder(&stepped, &train_rows)
+                .params(&lin.params)
+                .options(fit)
+                .weights(w.clone())
+                .run()
+                .map(|c| c.motor)
+                .unwrap_or(stepped)
         } else {
             lin.motor_at(&best.0)
         };
@@ -754,12 +759,12 @@ fn cross_validate(
             continue;
         }
         let (s0, params) = fit_params(motor, start, &train, effects, reduced, &opts.tolerances);
-        let mut fitted = calibrate(&s0, &train, &params, &opts.fit).ok();
+        let mut fitted = Calibration::builder(&s0, &train).params(&params).options(&opts.fit).run().ok();
         if !effects.is_empty() {
             // Nested models: the effect at zero strength is the baseline, so a fit that ends
             // worse than the baseline's is a local minimum; use the baseline fit instead.
             let (b0, bp) = fit_params(motor, start, &train, &[], reduced, &opts.tolerances);
-            let base = calibrate(&b0, &train, &bp, &opts.fit).ok();
+            let base = Calibration::builder(&b0, &train).params(&bp).options(&opts.fit).run().ok();
             if let Some(b) = base {
                 if fitted.as_ref().is_none_or(|f| f.chi2 > b.chi2) {
                     fitted = Some(b);
@@ -880,10 +885,10 @@ pub fn diagnose(
     // full-data baseline fit (the start of every other fit; "where", BIC, reported parameters)
     let (start0, bparams) = fit_params(motor, motor, rows, &[], reduced, &opts.tolerances);
     // A baseline that ends with a parameter on a bound is refitted from its own end
-    // (`calibrate_refitting_bounds`). (1000-row benchmark, seeds 31-38: every single fit,
+    // (`Calibrate::refit_bounds`). (1000-row benchmark, seeds 31-38: every single fit,
     // started from the baseline left on the damping bound, first refitted the baseline
     // whatever its effect.)
-    let base_cal = calibrate_refitting_bounds(&start0, rows, &bparams, &opts.fit)?;
+    let base_cal = Calibration::builder(&start0, rows).params(&bparams).options(&opts.fit).refit_bounds(true).run()?;
     let start = base_cal.motor.clone();
     let base_cv = if opts.exact_cv {
         cross_validate(motor, &start, rows, &folds, k, &[], opts, reduced)
@@ -1051,9 +1056,14 @@ pub fn diagnose(
         // 1e-3 of a bound moved to 1e-3 from it, `calibrate::fit`)
         let first = |s: &Motor| {
             if nested.is_some() {
-                calibrate_nested(s, rows, &params, &opts.fit, added, Start::Extending(IRLS_START_RTOL))
+                Calibration::builder(s, rows)
+                    .params(&params)
+                    .options(&opts.fit)
+                    .adding(added)
+                    .start(Start::Extending(IRLS_START_RTOL))
+                    .run()
             } else {
-                calibrate_adding(s, rows, &params, &opts.fit, added)
+                Calibration::builder(s, rows).params(&params).options(&opts.fit).adding(added).run()
             }
         };
         let mut cal = first(&s0);
@@ -1068,12 +1078,16 @@ pub fn diagnose(
             // the shape held (not fitted: a free shape column on its bound still changed the
             // path enough to collapse), then freed from that fit's optimum
             let held: Vec<FitParam> = params.iter().filter(|fp| !is_shape_of(fp, added)).cloned().collect();
-            let alt = match calibrate_adding(&typical_shape, rows, &held, &opts.fit, added) {
-                Ok(c) if !c.abandoned => {
-                    calibrate_nested(&c.motor, rows, &params, &opts.fit, added, Start::Extending(IRLS_START_RTOL))
-                }
-                other => other,
-            };
+            let alt =
+                match Calibration::builder(&typical_shape, rows).params(&held).options(&opts.fit).adding(added).run() {
+                    Ok(c) if !c.abandoned => Calibration::builder(&c.motor, rows)
+                        .params(&params)
+                        .options(&opts.fit)
+                        .adding(added)
+                        .start(Start::Extending(IRLS_START_RTOL))
+                        .run(),
+                    other => other,
+                };
             let fitted = |c: &Result<Calibration, _>| c.as_ref().ok().filter(|c| !c.abandoned).map(|c| c.chi2);
             if fitted(&alt).is_some_and(|a| fitted(&cal).is_none_or(|c| a < c)) {
                 cal = alt;
@@ -1096,7 +1110,13 @@ pub fn diagnose(
             for &e in effects {
                 s1.effects.set(e, &e.info().with_primary(e.info().params[0].typical));
             }
-            if let Ok(c1) = calibrate_nested(&s1, rows, &params, &opts.fit, added, Start::Restart) {
+            if let Ok(c1) = Calibration::builder(&s1, rows)
+                .params(&params)
+                .options(&opts.fit)
+                .adding(added)
+                .start(Start::Restart)
+                .run()
+            {
                 if !c1.abandoned && !cal.as_ref().is_ok_and(|c| !c.abandoned && c1.chi2 >= c.chi2) {
                     cal = Ok(c1);
                 }
@@ -1133,7 +1153,13 @@ pub fn diagnose(
                 }
                 let probe = starts.into_iter().map(|m| (chi2_of(&m), m)).min_by(|a, b| a.0.total_cmp(&b.0));
                 if let Some((_, m)) = probe.filter(|p| p.0 < PROBE_LEFT * nominal) {
-                    if let Ok(c2) = calibrate_nested(&m, rows, &params, &opts.fit, added, Start::Restart) {
+                    if let Ok(c2) = Calibration::builder(&m, rows)
+                        .params(&params)
+                        .options(&opts.fit)
+                        .adding(added)
+                        .start(Start::Restart)
+                        .run()
+                    {
                         if !c2.abandoned && c2.chi2 < fit_chi2 {
                             cal = Ok(c2);
                         }
@@ -1160,7 +1186,13 @@ pub fn diagnose(
                 scan::widen(&mut wide, effects[0], &v.values);
                 let mut s2 = v.base.clone();
                 s2.effects.set(effects[0], &v.values);
-                if let Ok(c2) = calibrate_nested(&s2, rows, &wide, &opts.fit, added, Start::Restart) {
+                if let Ok(c2) = Calibration::builder(&s2, rows)
+                    .params(&wide)
+                    .options(&opts.fit)
+                    .adding(added)
+                    .start(Start::Restart)
+                    .run()
+                {
                     let current = match &cal {
                         Ok(c) if !c.abandoned => c.chi2,
                         _ => f64::INFINITY,
@@ -1808,7 +1840,7 @@ mod tests {
         let (nominal, rows, _) = sag_data();
         let fit = FitOptions::default();
         let (s0, params) = fit_params(&nominal, &nominal, &rows, &[], false, &BTreeMap::new());
-        let cal = calibrate(&s0, &rows, &params, &fit).expect("baseline");
+        let cal = Calibration::builder(&s0, &rows).params(&params).options(&fit).run().expect("baseline");
         // folds by preload, so each held-out block moves the parameters
         let mut loads: Vec<f64> = rows.iter().map(|r| r.op.preload_n).collect();
         loads.sort_by(f64::total_cmp);
@@ -1943,13 +1975,18 @@ mod tests {
         let rows = crate::calibrate::tests::rows_on_grid(&truth, &loads, &[0.0, 0.15, 0.3, 0.45]);
         let fit = FitOptions::default();
         let (s0, params) = fit_params(&nominal, &nominal, &rows, &[], false, &classic_tolerances());
-        let base = calibrate(&s0, &rows, &params, &fit).expect("baseline");
+        let base = Calibration::builder(&s0, &rows).params(&params).options(&fit).run().expect("baseline");
         let sig = signature::signature(&base, &rows, Effect::RadialFriction).expect("signature");
         let sc = scales(&rows);
         let (d_chi2, d_e2) = first_order_gains(&base, &rows, &sig, &sc);
         let (s1, params) =
             fit_params(&nominal, &base.motor, &rows, &[Effect::RadialFriction], false, &classic_tolerances());
-        let with = calibrate_adding(&s1, &rows, &params, &fit, &[Effect::RadialFriction]).expect("refit");
+        let with = Calibration::builder(&s1, &rows)
+            .params(&params)
+            .options(&fit)
+            .adding(&[Effect::RadialFriction])
+            .run()
+            .expect("refit");
         assert!(!with.abandoned);
         // Σ z² and Σ e² of a motor's residuals
         let sums = |m: &Motor| {
@@ -2146,7 +2183,7 @@ mod tests {
     /// onto its upper bound, where the logistic transform holds it (a radial-friction fit
     /// started there stays in that valley, held-out χ² 108 per reading, without the second
     /// start from the nominal motor). Refitted from its own end, the baseline leaves
-    /// the bound at a fraction of the χ²; `calibrate_refitting_bounds` and so the diagnosis
+    /// the bound at a fraction of the χ²; `Calibrate::refit_bounds` and so the diagnosis
     /// do that, and the diagnosis finds radial friction at its truth.
     #[test]
     fn a_baseline_left_on_a_bound_is_refitted_from_its_end() {
@@ -2166,14 +2203,19 @@ mod tests {
         let (s0, bp) = fit_params(&nominal, &nominal, &scaled, &[], false, &classic_tolerances());
         let on_damping_bound =
             |c: &Calibration| c.params.iter().any(|p| p.name.ends_with("modal_damping_ns_per_m") && p.at_bound);
-        let first = calibrate(&s0, &scaled, &bp, &opts.fit).expect("baseline");
+        let first = Calibration::builder(&s0, &scaled).params(&bp).options(&opts.fit).run().expect("baseline");
         assert!(on_damping_bound(&first), "the baseline no longer ends on the damping bound: the test needs new data");
-        let again = calibrate(&first.motor, &scaled, &bp, &opts.fit).expect("refit");
+        let again = Calibration::builder(&first.motor, &scaled).params(&bp).options(&opts.fit).run().expect("refit");
         assert!(!on_damping_bound(&again));
         // (χ² 1.74e5 → 6.3e4 when written)
         assert!(again.chi2 < 0.5 * first.chi2, "χ² {} → {}", first.chi2, again.chi2);
         // what `trum calibrate` and the diagnosis call does both
-        let refitted = calibrate_refitting_bounds(&s0, &scaled, &bp, &opts.fit).expect("refitting");
+        let refitted = Calibration::builder(&s0, &scaled)
+            .params(&bp)
+            .options(&opts.fit)
+            .refit_bounds(true)
+            .run()
+            .expect("refitting");
         assert_eq!(refitted.chi2, again.chi2);
         assert_eq!(refitted.motor, again.motor);
         let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnose");
@@ -2336,12 +2378,18 @@ mod tests {
         // only an added effect's strength counts (for a pair, the lead's is not added)
         assert!(!added_near_zero(&params, &fitted(0.0), &[Effect::RadialFriction]));
         let opts = FitOptions { huber_k: 3.0, irls_passes: 1, max_evaluations: 300, ..FitOptions::default() };
-        let without = calibrate_adding(&start, &rows, &params, &opts, &[tc]).expect("fit");
+        let without =
+            Calibration::builder(&start, &rows).params(&params).options(&opts).adding(&[tc]).run().expect("fit");
         // (not abandoned when written: 0.3 % of the range, on its bound by the 0.5 % rule)
         assert!(without.abandoned || added_near_zero(&params, &without.params, &[tc]), "{:?}", without.params);
         let mut truth = nominal.clone();
         truth.effects.set(tc, &[tc.info().params[0].typical]);
-        let with = calibrate_adding(&start, &grid(&truth), &params, &opts, &[tc]).expect("fit");
+        let with = Calibration::builder(&start, &grid(&truth))
+            .params(&params)
+            .options(&opts)
+            .adding(&[tc])
+            .run()
+            .expect("fit");
         assert!(!with.abandoned && !added_near_zero(&params, &with.params, &[tc]), "{:?}", with.params);
     }
 }
