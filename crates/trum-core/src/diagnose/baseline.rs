@@ -173,3 +173,35 @@ pub(super) fn noise_nrmse_best(
         acc.iter().map(|(o, &(noise, res))| if best.contains_key(o) { noise } else { noise.min(res) }).sum();
     (total / n.max(1) as f64).sqrt()
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
+mod tests {
+    use super::super::tests::{data, quick, sag_data};
+    use super::*;
+
+    /// Data of the nominal motor itself: the calibrated baseline predicts held-out regions
+    /// at the noise level, its NRMSE near what noise alone gives. Data with a voltage sag
+    /// the baseline cannot follow: a held-out gap well beyond the noise. The BIC is
+    /// χ² + k·ln n of the full-data fit.
+    #[test]
+    fn the_baseline_misses_held_out_data_only_where_an_effect_is_missing() {
+        let nominal = crate::calibrate::tests::reference_motor();
+        let (rows, groups) = data(&nominal, 1.0, 5);
+        let ctx = Context::new(&nominal, &rows, &groups, &quick(false)).unwrap();
+        let base = fit(&ctx).unwrap();
+        assert!(base.z2 < 2.0, "held-out χ² per reading {}", base.z2);
+        assert!(base.nrmse < 1.5 * base.noise_best, "NRMSE {} against noise {}", base.nrmse, base.noise_best);
+        assert!(base.cv.preds.iter().flatten().all(|p| p.is_finite()));
+        assert_eq!(base.e2.len(), ctx.n_read);
+        let k = base.cal.params.len();
+        assert!((base.bic - (base.cal.chi2 + k as f64 * (ctx.n_read as f64).ln())).abs() < 1e-9 * base.bic);
+        assert_eq!(base.start, base.cal.motor);
+
+        let (nominal, rows, groups) = sag_data();
+        let ctx = Context::new(&nominal, &rows, &groups, &quick(false)).unwrap();
+        let sag = fit(&ctx).unwrap();
+        assert!(sag.z2 > 4.0, "held-out χ² per reading {}", sag.z2);
+        assert!(sag.nrmse > 2.0 * sag.noise_best, "NRMSE {} against noise {}", sag.nrmse, sag.noise_best);
+    }
+}

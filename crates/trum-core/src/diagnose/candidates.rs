@@ -570,3 +570,37 @@ pub(super) fn bootstrap_shrink(before: &[f64], after: &[f64], n: usize, seed: u6
     v.sort_by(f64::total_cmp);
     (v[(0.05 * (n - 1) as f64) as usize], v[(0.95 * (n - 1) as f64) as usize])
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
+mod tests {
+    use super::super::tests::{quick, sag_data};
+    use super::super::DiagnoseOptions;
+    use super::*;
+
+    /// Preload-torque data with a voltage sag: without a time series `thermal_drift` moves
+    /// no prediction, so it is untestable and ranked with the baseline's fit and its
+    /// parameter penalty (negative evidence, no shrink); `voltage_sag` has a signature
+    /// that matches the baseline's residual, and its fit is supported and shrinks the gap.
+    #[test]
+    fn candidates_are_probed_then_scored_against_the_baseline() {
+        let (nominal, rows, groups) = sag_data();
+        let opts = DiagnoseOptions { candidates: vec![Effect::ThermalDrift, Effect::VoltageSag], ..quick(false) };
+        let ctx = Context::new(&nominal, &rows, &groups, &opts).unwrap();
+        let base = baseline::fit(&ctx).unwrap();
+        let probes = probe(&ctx, &base);
+        assert_eq!(probes.untestable, vec![Effect::ThermalDrift]);
+        assert_eq!(probes.base_sigs.keys().copied().collect::<Vec<_>>(), vec![Effect::VoltageSag]);
+        assert!(probes.base_sigs[&Effect::VoltageSag].matched > 0.3);
+
+        let scorer = Scorer::new(&ctx, &base, &probes);
+        let mut fits = Fits::default();
+        let ranking = score_singles(&scorer, &mut fits);
+        assert_eq!(ranking.iter().map(|r| r.effect.as_str()).collect::<Vec<_>>(), ["voltage_sag", "thermal_drift"]);
+        let (sag, drift) = (&ranking[0], &ranking[1]);
+        assert!(sag.evidence > 5.0 && sag.shrink > 0.3 && sag.shrink_interval.0 > 0.0, "{sag:?}");
+        assert!(fits.fits.contains_key("voltage_sag") && !fits.fits.contains_key("thermal_drift"));
+        assert!(drift.evidence < 0.0 && drift.shrink == 0.0 && drift.params.is_empty(), "{drift:?}");
+        assert_eq!(fits.cv_preds["thermal_drift"], base.cv.preds);
+    }
+}

@@ -281,3 +281,50 @@ pub(super) fn in_sample_note(base_in_sample: usize, ranking: &[RankEntry], k: us
         stuck.join(", ")
     ))
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
+mod tests {
+    use super::*;
+    use crate::solve::OperatingPoint;
+
+    fn row(preload_n: f64) -> ObservedRow {
+        ObservedRow {
+            op: OperatingPoint::new(preload_n, 0.1, 200.0, 43_000.0),
+            readings: vec![(Observable::SpeedRpm, 100.0, 1.0)],
+            ambient_c: 20.0,
+            speed_std_clipped: false,
+        }
+    }
+
+    /// Regions (25 N preload bins here) are dealt round-robin in their sorted order: every
+    /// row of a region in one fold, the fold count clamped to the number of regions.
+    #[test]
+    fn regions_are_dealt_round_robin_into_folds() {
+        let rows: Vec<ObservedRow> =
+            [100.0, 150.0, 200.0, 250.0, 300.0].iter().flat_map(|&p| [row(p), row(p + 5.0)]).collect();
+        let (of_row, k) = assign(&rows, &[], 3).unwrap();
+        assert_eq!(k, 3);
+        // region keys sort as text: bins 10 (250 N), 12 (300 N), 4 (100 N), 6 (150 N), 8 (200 N)
+        assert_eq!(of_row, vec![2, 2, 0, 0, 1, 1, 0, 0, 1, 1]);
+        assert_eq!(assign(&rows, &[], 10).unwrap().1, 5);
+        assert_eq!(assign(&rows, &[], 1).unwrap().1, 2);
+        // two runs at one operating point are two regions; one region is no held-out test
+        let runs = vec!["a".to_string(), "b".to_string()];
+        assert_eq!(assign(&[row(100.0), row(100.0)], &runs, 4).unwrap(), (vec![0, 1], 2));
+        assert!(assign(&[row(100.0), row(101.0)], &[], 4).is_err());
+    }
+
+    /// The errors' NRMSE is over the quantity scales, the mean z² over σ with each reading
+    /// clipped at OUTLIER_Z2, and a missing prediction counts as zero.
+    #[test]
+    fn held_out_errors_scale_clip_and_count_missing_predictions() {
+        let rows = vec![row(100.0), row(200.0)];
+        let sc: BTreeMap<Observable, f64> = [(Observable::SpeedRpm, 10.0)].into();
+        let (nrmse, z2, e2, raw) = errors(&rows, &[vec![103.0], vec![f64::NAN]], &sc);
+        assert!((e2[0] - 0.09).abs() < 1e-12 && e2[1] == 100.0, "{e2:?}");
+        assert_eq!(raw, vec![9.0, 10_000.0]);
+        assert!((nrmse - (100.09f64 / 2.0).sqrt()).abs() < 1e-12);
+        assert!((z2 - (9.0 + OUTLIER_Z2) / 2.0).abs() < 1e-12);
+    }
+}

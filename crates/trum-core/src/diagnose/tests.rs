@@ -10,13 +10,13 @@ use crate::calibrate::tests::classic_tolerances;
 use crate::calibrate::{residuals, Calibration, FittedParam, ParamRef};
 use crate::synth::{synthesize, Campaign, SynthConfig};
 
-fn data(m: &Motor, noise: f64, seed: u64) -> (Vec<ObservedRow>, Vec<String>) {
+pub(super) fn data(m: &Motor, noise: f64, seed: u64) -> (Vec<ObservedRow>, Vec<String>) {
     let cfg = SynthConfig { campaign: Campaign::PreloadTorque, noise, seed, ..SynthConfig::default() };
     let rows = synthesize(m, &cfg).expect("synth");
     (rows.iter().map(|r| r.observed()).collect(), rows.iter().map(|r| r.run_id.clone()).collect())
 }
 
-fn quick(exact_cv: bool) -> DiagnoseOptions {
+pub(super) fn quick(exact_cv: bool) -> DiagnoseOptions {
     DiagnoseOptions {
         candidates: vec![Effect::VoltageSag, Effect::PreloadStiffening],
         try_pairs: false,
@@ -27,7 +27,7 @@ fn quick(exact_cv: bool) -> DiagnoseOptions {
 }
 
 /// The nominal trum60a and seeded preload-torque data of it with voltage sag (300 Ω).
-fn sag_data() -> (Motor, Vec<ObservedRow>, Vec<String>) {
+pub(super) fn sag_data() -> (Motor, Vec<ObservedRow>, Vec<String>) {
     let mut m = crate::calibrate::tests::reference_motor();
     m.effects.set_strength(Effect::VoltageSag, 300.0);
     let (rows, groups) = data(&m, 1.0, 11);
@@ -457,7 +457,7 @@ fn the_positive_bias_of_speed_std_readings_is_not_eccentricity() {
 }
 
 /// A supported ranking entry with the given held-out χ² per reading and NRMSE.
-fn ranked(effect: &str, chi2: f64, nrmse: f64) -> RankEntry {
+pub(super) fn ranked(effect: &str, chi2: f64, nrmse: f64) -> RankEntry {
     RankEntry {
         effect: effect.into(),
         evidence: 100.0,

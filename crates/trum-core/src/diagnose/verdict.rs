@@ -212,3 +212,65 @@ pub(super) fn decide(
     }
     Verdict { verdict, complete, confounded, partial, notes }
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
+mod tests {
+    use super::super::tests::{data, quick, ranked};
+    use super::*;
+
+    /// An entry with `shrink` of the held-out NRMSE 0.4 gone (to `nrmse`), χ² `chi2` per
+    /// reading left, evidence `evidence`.
+    fn entry(effect: &str, evidence: f64, shrink: f64, chi2: f64) -> RankEntry {
+        RankEntry { evidence, shrink, ..ranked(effect, chi2, 0.4 * (1.0 - shrink)) }
+    }
+
+    /// With a baseline NRMSE of 0.4 and noise 0.05: the tests of an entry, and the verdict
+    /// they give (a closing single; a material but incomplete one; a sliver, which leaves
+    /// the gap unexplained with a partial effect; a second single as good, confounded).
+    #[test]
+    fn the_verdict_follows_the_gap_tests() {
+        let motor = crate::calibrate::tests::reference_motor();
+        let (rows, groups) = data(&motor, 1.0, 3);
+        let ctx = Context::new(&motor, &rows, &groups, &quick(false)).unwrap();
+        let tests = GapTests { base_nrmse: 0.4, gap_noise: 0.05 };
+        let none = BTreeMap::new();
+        let decide_on = |ranking: &mut [RankEntry], closes: bool| {
+            let best = ranking.iter().find(|r| GapTests::supported(r)).cloned();
+            decide(&ctx, &tests, ranking, &BTreeMap::new(), best, closes, None, &none)
+        };
+
+        let closing = entry("voltage_sag", 100.0, 0.8, 1.5);
+        assert!(GapTests::supported(&closing) && tests.material(&closing) && tests.closes(&closing));
+        let v = decide_on(&mut [closing.clone()], true);
+        assert_eq!((v.verdict.as_str(), v.complete, v.partial.clone()), ("voltage_sag", true, None));
+        assert!(v.confounded.is_empty() && v.notes.is_empty());
+
+        // as good within 15 % of held-out error and 5 of evidence: confounded
+        let alike = RankEntry { heldout_nrmse_after: 1.1 * closing.heldout_nrmse_after, ..closing.clone() };
+        let alike = RankEntry { effect: "preload_stiffening".into(), evidence: 97.0, ..alike };
+        let v = decide_on(&mut [closing.clone(), alike], true);
+        assert_eq!(v.confounded, vec!["preload_stiffening".to_string()]);
+
+        // a quarter of the NRMSE gone, χ² 5 left: material, not closing
+        let part = entry("radial_friction", 100.0, 0.25, 5.0);
+        assert!(tests.material(&part) && !tests.closes(&part));
+        let v = decide_on(&mut [part], false);
+        assert_eq!((v.verdict.as_str(), v.complete, v.notes.len()), ("radial_friction", false, 1));
+
+        // 5 % gone: supported, not material; unexplained, the effect partial
+        let sliver = entry("eccentricity", 100.0, 0.05, 8.0);
+        assert!(GapTests::supported(&sliver) && !tests.material(&sliver));
+        let v = decide_on(&mut [sliver], false);
+        assert_eq!(
+            (v.verdict.as_str(), v.complete, v.partial.as_deref()),
+            ("unexplained", false, Some("eccentricity"))
+        );
+
+        // no supported entry (evidence below 5): unexplained without a partial effect
+        let weak = entry("eccentricity", 4.0, 0.8, 1.5);
+        assert!(!GapTests::supported(&weak));
+        let v = decide_on(&mut [weak], false);
+        assert_eq!((v.verdict.as_str(), v.partial), ("unexplained", None));
+    }
+}

@@ -115,3 +115,45 @@ fn fmt_num(x: f64) -> String {
     let s = s.trim_end_matches('0').trim_end_matches('.');
     s.to_string()
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
+mod tests {
+    use super::*;
+    use crate::solve::OperatingPoint;
+
+    /// Thirty speed readings (σ = 1) along the preload; the model misses by `shift` at and
+    /// above 300 N.
+    fn rows_and_preds(shift: f64) -> (Vec<ObservedRow>, Vec<Vec<f64>>) {
+        (0..30)
+            .map(|i| {
+                let p = 100.0 + 10.0 * i as f64;
+                let row = ObservedRow {
+                    op: OperatingPoint::new(p, 0.1, 200.0, 43_000.0),
+                    readings: vec![(Observable::SpeedRpm, 100.0, 1.0)],
+                    ambient_c: 20.0,
+                    speed_std_clipped: false,
+                };
+                (row, vec![if p >= 300.0 { 100.0 - shift } else { 100.0 }])
+            })
+            .unzip()
+    }
+
+    /// A shift in the upper preload tercile is reported there, with its mean residual
+    /// (measured − model) and z = mean/σ·√n; a model without misses has no region.
+    #[test]
+    fn a_miss_in_one_tercile_is_located_there() {
+        let (rows, preds) = rows_and_preds(3.0);
+        let found = locate_gap(&rows, &preds);
+        assert_eq!(found.len(), 1, "{found:?}");
+        let g = &found[0];
+        assert_eq!((g.quantity.as_str(), g.region.as_str(), g.n), ("speed_rpm", "preload_n >= 300", 10));
+        assert!((g.mean_residual - 3.0).abs() < 1e-12);
+        assert!((g.z - 3.0 * 10f64.sqrt()).abs() < 1e-9);
+        // below 3.5 standard errors: not reported
+        let (rows, preds) = rows_and_preds(1.0);
+        assert!(locate_gap(&rows, &preds).is_empty());
+        let (rows, preds) = rows_and_preds(0.0);
+        assert!(locate_gap(&rows, &preds).is_empty());
+    }
+}
