@@ -8,121 +8,15 @@
 
 use crate::effects::{Effect, Instrument};
 use crate::error::TrumError;
+pub use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
 use crate::sensitivity::{solve_kept, Solved};
 #[cfg(test)]
 use crate::solve::Status;
-use crate::solve::{solve_prepared, OperatingPoint, Prepared, Solution};
+use crate::solve::{solve_prepared, Prepared, Solution};
+pub use crate::tolerances::{Needs, Tolerance, TOLERANCES};
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
-
-/// A measured quantity the model predicts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Observable {
-    /// Mean rotor speed [rev/min].
-    SpeedRpm,
-    /// Electrical input power, both phases [W].
-    InputPowerW,
-    /// Drive current amplitude per phase [A].
-    CurrentA,
-    /// Efficiency [-].
-    Efficiency,
-    /// Feedback electrode voltage amplitude [V].
-    FeedbackV,
-    /// Stator temperature [°C].
-    TemperatureC,
-    /// Speed standard deviation over a revolution [rev/min].
-    SpeedStdRpm,
-}
-
-impl Observable {
-    /// All observables, in column order.
-    pub const ALL: [Observable; 7] = [
-        Observable::SpeedRpm,
-        Observable::InputPowerW,
-        Observable::CurrentA,
-        Observable::Efficiency,
-        Observable::FeedbackV,
-        Observable::TemperatureC,
-        Observable::SpeedStdRpm,
-    ];
-
-    /// The measurement-file column name.
-    pub fn column(self) -> &'static str {
-        match self {
-            Observable::SpeedRpm => "speed_rpm",
-            Observable::InputPowerW => "input_power_w",
-            Observable::CurrentA => "current_a",
-            Observable::Efficiency => "efficiency",
-            Observable::FeedbackV => "feedback_v",
-            Observable::TemperatureC => "temperature_c",
-            Observable::SpeedStdRpm => "speed_std_rpm",
-        }
-    }
-
-    /// The model's prediction from a solution (`ambient_c` for temperatures).
-    pub fn predict(self, s: &Solution, ambient_c: f64) -> f64 {
-        match self {
-            Observable::SpeedRpm => s.speed_rpm,
-            Observable::InputPowerW => s.input_power_w,
-            Observable::CurrentA => s.current_a,
-            Observable::Efficiency => s.efficiency,
-            Observable::FeedbackV => s.feedback_v,
-            Observable::TemperatureC => ambient_c + s.temperature_rise_at_elapsed_k,
-            Observable::SpeedStdRpm => s.speed_std_rpm,
-        }
-    }
-
-    /// The expected reading of this quantity in row `row` when the model gives `model` and
-    /// the reading's noise has standard deviation `sigma`. Where the bench clips the speed
-    /// standard deviation at zero (`ObservedRow::speed_std_clipped`), its readings of a
-    /// smoothly running motor (true value near 0) are the non-negative part of the noise,
-    /// whose mean, σ/√(2π) at a true value of zero, a model predicting 0 misses in every
-    /// reading alike (eccentricity, which adds a speed ripple, then fits that bias: 1000-row
-    /// null data, evidence 9.6). The expected reading of max(0, m + ε), ε ~ N(0, σ²), is
-    /// m·Φ(m/σ) + σ·φ(m/σ), which is m to within 1e-9·σ once m > 6σ. Otherwise, and for
-    /// every other quantity: `model`.
-    pub fn expected_reading(self, row: &ObservedRow, model: f64, sigma: f64) -> f64 {
-        match self {
-            Observable::SpeedStdRpm if row.speed_std_clipped && sigma > 0.0 && model < 8.0 * sigma => {
-                let x = model / sigma;
-                model * crate::noise::normal_cdf(x) + sigma * crate::noise::normal_pdf(x)
-            }
-            _ => model,
-        }
-    }
-
-    /// Default noise level of one reading when the data do not say (documented in
-    /// docs/DIAGNOSIS.md): an absolute floor plus a relative part.
-    pub fn default_sigma(self, value: f64) -> f64 {
-        let v = value.abs();
-        match self {
-            Observable::SpeedRpm => 0.5 + 0.01 * v,
-            Observable::InputPowerW => 0.05 + 0.02 * v,
-            Observable::CurrentA => 0.002 + 0.015 * v,
-            Observable::Efficiency => 0.005 + 0.03 * v,
-            Observable::FeedbackV => 0.2 + 0.01 * v,
-            Observable::TemperatureC => 0.2,
-            Observable::SpeedStdRpm => 0.05 + 0.1 * v,
-        }
-    }
-}
-
-/// One measured row: the operating point and the readings taken there.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ObservedRow {
-    /// Operating point (elapsed time included for time series).
-    pub op: OperatingPoint,
-    /// Readings: (what, value, noise level σ).
-    pub readings: Vec<(Observable, f64, f64)>,
-    /// Ambient temperature for temperature readings [°C].
-    pub ambient_c: f64,
-    /// The bench reports this row's speed standard deviation clipped at zero, and its σ is
-    /// the readings' own noise level: the reading is compared with the expected reading of
-    /// clipped noise ([`Observable::expected_reading`]). Set by the diagnosis where the
-    /// data show both (docs/DIAGNOSIS.md, "Calibration").
-    pub speed_std_clipped: bool,
-}
 
 /// Which parameter a fit moves.
 #[derive(Clone, Debug, PartialEq)]
@@ -237,63 +131,22 @@ impl FitParam {
     }
 }
 
-/// How well a baseline parameter is known before the data are seen: the standard
-/// deviation of its logarithm (a relative tolerance) and the bounds of its fit, as
-/// factors on the nominal value.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Tolerance {
-    /// Dotted motor key.
-    pub key: &'static str,
-    /// Prior standard deviation of ln(value / nominal) [-].
-    pub rel_sd: f64,
-    /// Lower bound of the fit as a factor on the nominal value.
-    pub lo: f64,
-    /// Upper bound of the fit as a factor on the nominal value.
-    pub hi: f64,
-    /// The readings that must be present for the data to see it.
-    pub needs: Needs,
+// Next to the residuals that use it, not in `crate::observable`: the observation types
+// stay independent of the solver, whose effects' instrument model reads them.
+impl Observable {
+    /// The model's prediction from a solution (`ambient_c` for temperatures).
+    pub fn predict(self, s: &Solution, ambient_c: f64) -> f64 {
+        match self {
+            Observable::SpeedRpm => s.speed_rpm,
+            Observable::InputPowerW => s.input_power_w,
+            Observable::CurrentA => s.current_a,
+            Observable::Efficiency => s.efficiency,
+            Observable::FeedbackV => s.feedback_v,
+            Observable::TemperatureC => ambient_c + s.temperature_rise_at_elapsed_k,
+            Observable::SpeedStdRpm => s.speed_std_rpm,
+        }
+    }
 }
-
-/// Which readings a baseline parameter needs before it is fitted.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Needs {
-    /// Any data (it moves the speed).
-    Always,
-    /// Feedback-electrode voltages.
-    Feedback,
-    /// Electrical readings (input power or current).
-    Electrical,
-    /// A temperature time series.
-    ThermalSeries,
-}
-
-/// Default tolerances of the baseline parameters, by class (docs/DIAGNOSIS.md,
-/// "Calibration"). Material and contact constants are known to a factor of a few (broad
-/// priors, bounds at about ±2σ); machined geometry to a few percent; the modal mass and
-/// the electrical constants in between. A real motor differs from its nominal file in all
-/// of them at once, so all are fitted: a parameter the data cannot determine stays at its
-/// prior instead of leaving a structured residual for an effect to fill.
-pub const TOLERANCES: &[Tolerance] = &[
-    Tolerance { key: "friction_layer.friction_coefficient", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::Always },
-    Tolerance { key: "friction_layer.youngs_modulus_pa", rel_sd: 1.15, lo: 0.1, hi: 10.0, needs: Needs::Always },
-    Tolerance { key: "stator.modal_damping_ns_per_m", rel_sd: 0.8, lo: 0.2, hi: 5.0, needs: Needs::Always },
-    Tolerance { key: "stator.force_factor_n_per_v", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::Always },
-    Tolerance { key: "stator.resonance_frequency_hz", rel_sd: 0.015, lo: 0.97, hi: 1.03, needs: Needs::Always },
-    Tolerance { key: "geometry.neutral_plane_distance_m", rel_sd: 0.05, lo: 0.8, hi: 1.25, needs: Needs::Always },
-    Tolerance { key: "geometry.mean_radius_m", rel_sd: 0.02, lo: 0.93, hi: 1.07, needs: Needs::Always },
-    Tolerance { key: "stator.modal_mass_kg", rel_sd: 0.1, lo: 0.7, hi: 1.4, needs: Needs::Always },
-    Tolerance { key: "electrical.feedback_gain_v_per_m", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::Feedback },
-    Tolerance { key: "electrical.clamped_capacitance_f", rel_sd: 0.35, lo: 0.5, hi: 2.0, needs: Needs::Electrical },
-    Tolerance { key: "electrical.dielectric_loss_tangent", rel_sd: 0.4, lo: 0.3, hi: 3.0, needs: Needs::Electrical },
-    Tolerance { key: "thermal.heat_capacity_j_per_k", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::ThermalSeries },
-    Tolerance {
-        key: "thermal.heat_transfer_coefficient_w_per_m2k",
-        rel_sd: 0.6,
-        lo: 0.3,
-        hi: 3.0,
-        needs: Needs::ThermalSeries,
-    },
-];
 
 /// The uncertain baseline parameters of a motor, their bounds and priors
 /// ([`TOLERANCES`]): every parameter the data can see. See [`baseline_params_with`].
@@ -1369,6 +1222,7 @@ fn fit(
 #[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 pub(crate) mod tests {
     use super::*;
+    use crate::solve::OperatingPoint;
 
     /// Noise-free readings (speed, input power, feedback voltage at their default σ) of `m`
     /// at each operating point of `ops`.

@@ -5,8 +5,9 @@
 use super::candidates::fit_params;
 use super::context::{applied_factor, Context};
 use super::folds::{approx_cv, cross_validate, errors, predict, CvResult};
-use crate::calibrate::{Calibration, Observable, ObservedRow};
+use crate::calibrate::Calibration;
 use crate::error::TrumError;
+use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
 use std::collections::BTreeMap;
 
@@ -50,9 +51,9 @@ pub(super) fn fit(ctx: &Context) -> Result<Baseline, TrumError> {
     let base_cal = Calibration::builder(&start0, rows).params(&bparams).options(&opts.fit).refit_bounds(true).run()?;
     let start = base_cal.motor.clone();
     let base_cv = if opts.exact_cv {
-        cross_validate(motor, &start, rows, &folds, k, &[], opts, reduced)
+        cross_validate(motor, &start, rows, folds, k, &[], opts, reduced)
     } else {
-        approx_cv(&base_cal, rows, &folds, k, &opts.fit)
+        approx_cv(&base_cal, rows, folds, k, &opts.fit)
     };
     let (base_nrmse, base_z2, base_e2, _) = errors(rows, &base_cv.preds, sc);
     // The noise NRMSE reported (the spec's `noise_nrmse`) is the best estimate of what noise
@@ -120,7 +121,7 @@ pub(super) fn noise_estimate(
 /// that the bench clips at zero (a speed standard deviation): about its mean when the
 /// reading is compared with the expected clipped reading (`centred`), else about m.
 pub(super) fn clipped_second_moment(x: f64, centred: bool) -> f64 {
-    let (cdf, upper, pdf) = (crate::noise::normal_cdf(x), crate::noise::normal_cdf(-x), crate::noise::normal_pdf(x));
+    let (cdf, upper, pdf) = (crate::normal::normal_cdf(x), crate::normal::normal_cdf(-x), crate::normal::normal_pdf(x));
     // E[(Y/σ − x)²] = Φ(x) − xφ(x) + x²(1 − Φ(x)); the mean of Y/σ − x is φ(x) − x(1 − Φ(x))
     let about_m = cdf - x * pdf + x * x * upper;
     let bias = pdf - x * upper;

@@ -6,12 +6,12 @@ use super::baseline::{self, Baseline};
 use super::context::Context;
 use super::folds::{approx_cv, cross_validate, errors};
 use super::{scan, signature, RankEntry};
-use crate::calibrate::Observable;
 use crate::calibrate::{
     baseline_params_with, effect_params, residuals, Calibration, FitParam, FittedParam, ObservedRow, ParamRef, Start,
     IRLS_START_RTOL,
 };
 use crate::effects::Effect;
+use crate::observable::Observable;
 use crate::params::Motor;
 use crate::solve::{solve_prepared, Prepared, Status};
 use rayon::prelude::*;
@@ -38,7 +38,7 @@ pub(super) fn probe(ctx: &Context, base: &Baseline) -> Probes {
     let (motor, rows, opts) = (ctx.motor, &ctx.rows[..], &ctx.opts);
     let (base_cal, start) = (&base.cal, &base.start);
     let probed: Vec<(Effect, Option<signature::Signature>)> =
-        opts.candidates.par_iter().map(|&e| (e, signature::signature(&base_cal, rows, e))).collect();
+        opts.candidates.par_iter().map(|&e| (e, signature::signature(base_cal, rows, e))).collect();
     // (an effect the motor already carries has no probe: switched off instead)
     // (each computed once, when a probe first needs it)
     let (base_res, nominal_res) = (std::cell::OnceCell::new(), std::cell::OnceCell::new());
@@ -57,7 +57,7 @@ pub(super) fn probe(ctx: &Context, base: &Baseline) -> Probes {
             None if start.effects.is_on(*e) => {
                 let mut off = start.clone();
                 off.effects.clear(*e);
-                &residuals(&off, rows) == base_res.get_or_init(|| residuals(&start, rows))
+                &residuals(&off, rows) == base_res.get_or_init(|| residuals(start, rows))
             }
             None => false,
         })
@@ -356,9 +356,9 @@ impl<'a> Scorer<'a> {
             // lead's fit) is that model.
             Ok(c) if !c.abandoned && (c.chi2 <= base_cal.chi2 || opts.exact_cv) => {
                 let cv = if opts.exact_cv {
-                    cross_validate(motor, &start, rows, &folds, k, effects, opts, reduced)
+                    cross_validate(motor, start, rows, folds, k, effects, opts, reduced)
                 } else {
-                    approx_cv(&c, rows, &folds, k, &opts.fit)
+                    approx_cv(&c, rows, folds, k, &opts.fit)
                 };
                 in_sample = cv.in_sample;
                 (0.5 * (base_bic - bic(c.chi2.min(base_cal.chi2), kpar)), c.params.clone(), cv.preds, Some(c))
@@ -379,9 +379,9 @@ impl<'a> Scorer<'a> {
             }
             Err(_) => (f64::NEG_INFINITY, Vec::new(), base_cv.preds.clone(), None),
         };
-        let (after, chi2_after, e2, _) = errors(rows, &preds, &sc);
+        let (after, chi2_after, e2, _) = errors(rows, &preds, sc);
         let shrink = 1.0 - after / base_nrmse.max(1e-300);
-        let interval = bootstrap_shrink(&base_e2, &e2, opts.bootstrap, opts.seed);
+        let interval = bootstrap_shrink(base_e2, &e2, opts.bootstrap, opts.seed);
         let entry = RankEntry {
             effect: name,
             evidence,

@@ -3,9 +3,10 @@
 //! of the NRMSE and the notes so far.
 
 use super::{bench, folds, DiagnoseOptions};
-use crate::calibrate::{baseline_params_with, Observable, ObservedRow};
+use crate::calibrate::baseline_params_with;
 use crate::error::TrumError;
 use crate::noise::NoiseScale;
+use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
 use std::collections::BTreeMap;
 

@@ -5,9 +5,10 @@
 
 use super::candidates::fit_params;
 use super::{DiagnoseOptions, RankEntry};
-use crate::calibrate::{prior_residuals, residuals, with_prior_rows, Calibration, FitOptions, Observable, ObservedRow};
+use crate::calibrate::{prior_residuals, residuals, with_prior_rows, Calibration, FitOptions};
 use crate::effects::Effect;
 use crate::error::TrumError;
+use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
 use crate::solve::{solve_prepared, Prepared};
 use nalgebra::{DMatrix, DVector};

@@ -40,9 +40,10 @@ mod tests;
 mod verdict;
 mod where_;
 
-use crate::calibrate::{FitOptions, Observable, ObservedRow};
+use crate::calibrate::FitOptions;
 use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
+use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
 use crate::solve::Status;
 use candidates::{Fits, Scorer};

@@ -4,8 +4,9 @@
 
 use super::candidates::{sort_ranking, Fits, Nested, Scored, Scorer};
 use super::{signature, RankEntry};
-use crate::calibrate::{Calibration, Observable, ObservedRow};
+use crate::calibrate::Calibration;
 use crate::effects::Effect;
+use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -90,7 +91,7 @@ pub(super) fn fit_pairs(
         let second: Vec<(Effect, (bool, String))> = names
             .par_iter()
             .filter(|&&e| e != lead)
-            .map(|&e| (e, worth_pair_fit(lead_fit, rows, e, needed(e), need, &sc)))
+            .map(|&e| (e, worth_pair_fit(lead_fit, rows, e, needed(e), need, sc)))
             .collect();
         for (e, (worth, _)) in &second {
             if *worth {
@@ -125,7 +126,7 @@ pub(super) fn fit_pairs(
         let evidence = |e: Effect| ranking.iter().find(|r| r.effect == e.name()).map(|r| r.evidence);
         let reaches = |a: Effect, b: Effect| -> Option<bool> {
             let best = best_single.as_ref()?.evidence;
-            pair_may_beat(fits.fits.get(a.name())?, evidence(a)?, best, rows, b, &sc)
+            pair_may_beat(fits.fits.get(a.name())?, evidence(a)?, best, rows, b, sc)
         };
         let mut hopeless = Vec::new();
         for i in 0..names.len().min(3) {

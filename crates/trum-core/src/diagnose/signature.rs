@@ -14,8 +14,9 @@
 //! negative strength would remove is no evidence for the effect.
 
 use super::pseudo_inverse;
-use crate::calibrate::{residuals, Calibration, ObservedRow};
+use crate::calibrate::{residuals, Calibration};
 use crate::effects::Effect;
+use crate::observable::ObservedRow;
 use nalgebra::{DMatrix, DVector};
 
 /// Probe strength of the primary parameter, as a fraction of its typical value.

@@ -130,7 +130,7 @@ pub(super) fn decide(
             return false;
         }
         let (gain_nrmse, gain_chi2) = pair_gains(single, bp, n_read, noise_weights);
-        let held = |name: &str| cv_preds.iter().find(|(n, _)| same_set(n, name)).map(|(_, p)| errors(rows, p, &sc));
+        let held = |name: &str| cv_preds.iter().find(|(n, _)| same_set(n, name)).map(|(_, p)| errors(rows, p, sc));
         let (Some(hs), Some(hp)) = (held(&single.effect), held(&bp.effect)) else { return false };
         let real = |before: &[f64], after: &[f64]| bootstrap_shrink(before, after, opts.bootstrap, opts.seed).0 > 0.0;
         (gain_nrmse >= PAIR_GAIN && real(&hs.2, &hp.2)) || (gain_chi2 >= PAIR_GAIN && real(&hs.3, &hp.3))

@@ -7,7 +7,7 @@ use super::baseline::Baseline;
 use super::context::Context;
 use super::folds::{errors, predict};
 use super::GapRegion;
-use crate::calibrate::{Observable, ObservedRow};
+use crate::observable::{Observable, ObservedRow};
 
 /// The regions where the baseline misses, strongest first, and a note when they are
 /// located on the held-out residuals. A fit that passes through every point (few readings,
