@@ -25,7 +25,7 @@ pub enum Status {
 
 impl Status {
     /// The word written in status columns.
-    pub fn as_str(self) -> &'static str {
+    pub const fn as_str(self) -> &'static str {
         match self {
             Status::Ok => "ok",
             Status::Stall => "stall",
