@@ -410,16 +410,10 @@ fn oracle_shrink(case: &Case, data: &std::path::Path, v: &serde_json::Value, _be
     1.0 - case.oracle_nrmse(&bench.rows, &scale) / before
 }
 
-/// Every effect named in shared/spec/diagnose.md.
-pub const EFFECTS: [&str; 7] = [
-    "radial_friction",
-    "preload_stiffening",
-    "hertz_softening",
-    "thermal_drift",
-    "voltage_sag",
-    "eccentricity",
-    "tangential_compliance",
-];
+/// Every effect of the registry (`trum_core::effects::ALL`), in its order.
+pub fn effect_names() -> Vec<&'static str> {
+    trum_core::effects::ALL.iter().map(|e| e.name()).collect()
+}
 
 /// The full benchmark: every effect × three strengths (0.3, 1 and 3 × typical) × two
 /// noise levels (0.5 and 1 × the nominal bench noise) × two campaigns (preload-torque and
@@ -431,7 +425,7 @@ pub fn full_cases_at(seed_offset: u64) -> Vec<Case> {
     let mut seed = 200 + seed_offset;
     for campaign in ["preload-torque", "combined"] {
         for noise in [0.5, 1.0] {
-            for e in EFFECTS {
+            for e in effect_names() {
                 seed += 1;
                 out.push(Case { effects: vec![e], factor: STRONG_FACTOR, campaign, noise, seed, half: Half::Plain });
             }
@@ -453,7 +447,7 @@ pub fn half_cases(half: Half, seed_offset: u64) -> Vec<Case> {
     };
     let mut out = Vec::new();
     for campaign in ["preload-torque", "combined"] {
-        for e in EFFECTS {
+        for e in effect_names() {
             for factor in [1.0, STRONG_FACTOR] {
                 out.push(Case { effects: vec![e], factor, campaign, noise: 1.0, seed: next(), half });
             }
@@ -532,7 +526,7 @@ pub fn cases_at(factors: &[f64], seed_offset: u64) -> Vec<Case> {
     };
     for campaign in ["preload-torque", "combined"] {
         for noise in [0.5, 1.0] {
-            for e in EFFECTS {
+            for e in effect_names() {
                 for &factor in factors {
                     out.push(Case { effects: vec![e], factor, campaign, noise, seed: next(), half: Half::Plain });
                 }
