@@ -20,9 +20,8 @@
 //! 4. Where: baseline residuals grouped by quantity and region; a group is reported when
 //!    its mean normalised residual is more than 3.5 standard errors from zero (z-test;
 //!    3.5 keeps the family-wise false-alarm rate near 1 % over ~50 groups).
-
 //!
-//! The stages, each in a module of its own over one [`context::Context`]: the prepared
+//! The stages, each in a module of its own over one context (`context::Context`): the prepared
 //! rows and their `folds`, the calibrated `baseline`, the `candidates` scored (and their
 //! `pairs`), the `verdict`, and where the gap lies (`where_`).
 
