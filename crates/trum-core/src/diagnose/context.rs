@@ -74,17 +74,17 @@ impl<'a> Context<'a> {
         if !noise_scale.is_empty() {
             let list: Vec<String> = noise_scale.iter().map(|(q, f, n)| format!("{q} ×{f:.2} ({n})")).collect();
             notes.push(format!(
-            "noise levels estimated from the data (residuals from lines through neighbouring readings within runs; \
-             factor on the default levels, residuals used): {}",
-            list.join(", ")
-        ));
+                "noise levels estimated from the data (residuals from lines through neighbouring readings \
+                 within runs; factor on the default levels, residuals used): {}",
+                list.join(", ")
+            ));
         }
         let n_base = baseline_params_with(motor, rows, &opts.tolerances).len();
         let reduced = n_read < 4 * (n_base + 2);
         if reduced {
             notes.push(format!(
                 "only {n_read} readings: the baseline's parameters rest largely on their priors, the held-out \
-             figures come from exact refits, and no effect can be confirmed with confidence"
+                 figures come from exact refits, and no effect can be confirmed with confidence"
             ));
         }
         // With few readings the fit is far from linear over a fold's influence: refit exactly
