@@ -78,7 +78,7 @@ fn known_bug_warm_start_reports_clamped_where_the_motor_runs() {
 #[test]
 fn known_bug_maps_and_points_disagree() {
     let mut bad = Vec::new();
-    for name in ["trum60a", "trum60-qut", "generic60"] {
+    for name in trum_core::presets::PRESETS.iter().map(|p| p.name) {
         let m = preset(name).expect("preset");
         let p = Prepared::new(&m);
         for (hz, v) in [(41_300.0, 88.0), (40_750.0, 200.0), (43_000.0, 200.0), (42_000.0, 150.0)] {

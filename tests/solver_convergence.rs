@@ -75,7 +75,7 @@ fn dense_map_points_near_stall_and_clamping() {
 #[test]
 fn dense_preset_maps_have_no_unconverged_point() {
     let mut bad = Vec::new();
-    for name in ["trum60a", "trum60-qut", "generic60"] {
+    for name in trum_core::presets::PRESETS.iter().map(|p| p.name) {
         let m = preset(name).unwrap();
         for (v, hz) in [(88.0, 41_300.0), (200.0, 40_750.0), (200.0, 43_000.0), (150.0, 42_000.0), (300.0, 44_000.0)] {
             let g = Grid {

@@ -131,7 +131,7 @@ impl Case {
     /// `injected` in their truth forms, σ as in [`Case::signal_chi2`]. Starts at the true
     /// baseline parameters: the best any calibration could do.
     fn leftover_chi2(&self, injected: &[&str], fitted: &[&str]) -> f64 {
-        use trum_core::calibrate::{baseline_params, calibrate, effect_params, FitOptions, ObservedRow};
+        use trum_core::calibrate::{baseline_params, effect_params, Calibration, FitOptions, ObservedRow};
         use trum_core::synth::{reading_noise, synthesize, true_motor, Artefacts};
         // the effect's signal in the motor's readings, without the bench's artefacts
         let cfg = trum_core::synth::SynthConfig { artefacts: Artefacts::default(), ..self.synth_config(0.0) };
@@ -157,7 +157,7 @@ impl Case {
         }
         // a generous budget: this is the reference the verdicts are judged against
         let opts = FitOptions { huber_k: f64::INFINITY, irls_passes: 0, max_evaluations: 4000, fold_rtol: 0.0 };
-        calibrate(&start, &rows, &params, &opts).map(|c| c.chi2).unwrap_or(f64::NAN)
+        Calibration::builder(&start, &rows).params(&params).options(&opts).run().map(|c| c.chi2).unwrap_or(f64::NAN)
     }
 
     /// Held-out NRMSE of the true motor itself (the injected effects in their truth forms,
@@ -440,16 +440,10 @@ fn oracle_shrink(case: &Case, data: &std::path::Path, v: &serde_json::Value, _be
     1.0 - case.oracle_nrmse(&bench.rows, &scale) / before
 }
 
-/// Every effect named in shared/spec/diagnose.md.
-pub const EFFECTS: [&str; 7] = [
-    "radial_friction",
-    "preload_stiffening",
-    "hertz_softening",
-    "thermal_drift",
-    "voltage_sag",
-    "eccentricity",
-    "tangential_compliance",
-];
+/// Every effect of the registry (`trum_core::effects::ALL`), in its order.
+pub fn effect_names() -> Vec<&'static str> {
+    trum_core::effects::ALL.iter().map(|e| e.name()).collect()
+}
 
 /// The full benchmark: every effect × three strengths (0.3, 1 and 3 × typical) × two
 /// noise levels (0.5 and 1 × the nominal bench noise) × two campaigns (preload-torque and
@@ -461,7 +455,7 @@ pub fn full_cases_at(seed_offset: u64) -> Vec<Case> {
     let mut seed = 200 + seed_offset;
     for campaign in ["preload-torque", "combined"] {
         for noise in [0.5, 1.0] {
-            for e in EFFECTS {
+            for e in effect_names() {
                 seed += 1;
                 out.push(Case { effects: vec![e], factor: STRONG_FACTOR, campaign, noise, seed, half: Half::Plain });
             }
@@ -483,7 +477,7 @@ pub fn half_cases(half: Half, seed_offset: u64) -> Vec<Case> {
     };
     let mut out = Vec::new();
     for campaign in ["preload-torque", "combined"] {
-        for e in EFFECTS {
+        for e in effect_names() {
             for factor in [1.0, STRONG_FACTOR] {
                 out.push(Case { effects: vec![e], factor, campaign, noise: 1.0, seed: next(), half });
             }
@@ -562,7 +556,7 @@ pub fn cases_at(factors: &[f64], seed_offset: u64) -> Vec<Case> {
     };
     for campaign in ["preload-torque", "combined"] {
         for noise in [0.5, 1.0] {
-            for e in EFFECTS {
+            for e in effect_names() {
                 for &factor in factors {
                     out.push(Case { effects: vec![e], factor, campaign, noise, seed: next(), half: Half::Plain });
                 }

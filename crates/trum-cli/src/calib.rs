@@ -9,9 +9,7 @@ use clap::Args;
 use serde_json::json;
 use std::io::Write;
 use std::path::PathBuf;
-use trum_core::calibrate::{
-    baseline_params_with, calibrate_refitting_bounds, residuals, Calibration, FitOptions, ObservedRow,
-};
+use trum_core::calibrate::{residuals, Calibration, FitOptions, ObservedRow};
 
 #[derive(Args, Debug)]
 pub struct CalibrateArgs {
@@ -36,8 +34,11 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     let (motor, _) = a.motor.load()?;
     let (_, bench) = read_data(&a.data, &motor, err)?;
     let tolerances = crate::motor::load_tolerances(&a.motor.motor)?;
-    let params = baseline_params_with(&motor, &bench.rows, &tolerances);
-    let mut cal = calibrate_refitting_bounds(&motor, &bench.rows, &params, &FitOptions::default())
+    let mut cal = Calibration::builder(&motor, &bench.rows)
+        .tolerances(&tolerances)
+        .options(&FitOptions::default())
+        .refit_bounds(true)
+        .run()
         .map_err(|e| anyhow!("{}: {e}", a.data))?;
     rescale_uncertainties(&mut cal, &bench.rows);
     let chi2_per = cal.chi2 / cal.n_readings.max(1) as f64;

@@ -18,7 +18,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use trum_core::quantities::QUANTITIES;
 use trum_core::solve::{solve_prepared, Prepared};
-use trum_core::sweep::{solve_range, Axis, Grid};
+use trum_core::sweep::{axis_values, chunk_count, chunk_range, solve_range, Axis, Grid, AXES};
 use trum_core::{Motor, OperatingPoint, Solution};
 
 /// Largest grid `trum plot --motor` solves in memory; bigger ones go through `trum map`.
@@ -307,27 +307,26 @@ fn plot_grid(motor: &Motor, a: &PlotArgs, sweep: &trum_core::params::SweepTable,
 }
 
 fn solve_grid(motor: &Motor, grid: &Grid) -> Data {
+    // Smaller chunks than a map's (`trum_core::sweep::CHUNK_POINTS`): a plot grid of a few
+    // thousand points is then still solved on every core.
     const CHUNK: u64 = 512;
     let total = grid.len();
     let prep = Prepared::new(motor);
-    let chunks: Vec<Vec<(OperatingPoint, Solution)>> = (0..total.div_ceil(CHUNK))
+    let chunks: Vec<Vec<(OperatingPoint, Solution)>> = (0..chunk_count(total, CHUNK))
         .into_par_iter()
         .map(|c| {
             let mut v = Vec::new();
-            solve_range(motor, &prep, grid, c * CHUNK..((c + 1) * CHUNK).min(total), |_, op, s| {
-                v.push((*op, s.clone()))
-            });
+            solve_range(motor, &prep, grid, chunk_range(total, CHUNK, c), |_, op, s| v.push((*op, s.clone())));
             v
         })
         .collect();
-    let mut names: Vec<String> = ["preload_n", "torque_nm", "voltage_v", "frequency_hz"].map(String::from).to_vec();
+    let mut names: Vec<String> = AXES.map(String::from).to_vec();
     names.extend(QUANTITIES.iter().map(|q| q.name.to_string()));
     let mut cols = vec![Vec::with_capacity(total as usize); names.len()];
     for (op, s) in chunks.iter().flatten() {
         let valid = s.status.is_valid();
-        let row = [op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz]
-            .into_iter()
-            .chain(QUANTITIES.iter().map(|q| if valid { (q.get)(s) } else { f64::NAN }));
+        let row =
+            axis_values(op).into_iter().chain(QUANTITIES.iter().map(|q| if valid { (q.get)(s) } else { f64::NAN }));
         for (c, v) in cols.iter_mut().zip(row) {
             c.push(v);
         }

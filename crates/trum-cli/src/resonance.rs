@@ -18,7 +18,7 @@ use trum_core::dynamics::hertz::{
     identify_beta, BetaIdentificationInput, Branch, FamilyCurve, HertzError, HertzOscillator, OperatingPoint,
     ResponseMethod,
 };
-use trum_core::layout::{response_rows, response_status, response_summary, RESPONSE_COLUMNS};
+use trum_core::layout::{response_rows, response_status, response_summary, ResponseCell, RESPONSE_COLUMNS};
 use trum_core::sweep::Axis;
 
 /// Oscillator parameters: defaults, then `--oscillator FILE`, then the flags.
@@ -212,17 +212,17 @@ fn response_csv(curves: &[FamilyCurve]) -> String {
     let mut s = RESPONSE_COLUMNS.join(",");
     s.push('\n');
     for r in response_rows(curves) {
-        let stable = r.stable.map(|b| b.to_string()).unwrap_or_default();
-        s.push_str(&format!(
-            "{},{},{},{},{},{},{},{stable}\n",
-            csv_number(r.voltage_v),
-            csv_number(r.preload_n),
-            csv_number(r.frequency_hz),
-            r.branch,
-            r.status,
-            csv_number(r.amplitude_m),
-            csv_number(r.phase_lag_rad),
-        ));
+        let cells: Vec<String> = r
+            .cells()
+            .iter()
+            .map(|c| match *c {
+                ResponseCell::Number(x) => csv_number(x),
+                ResponseCell::Word(w) => w.to_string(),
+                ResponseCell::Flag(f) => f.map(|b| b.to_string()).unwrap_or_default(),
+            })
+            .collect();
+        s.push_str(&cells.join(","));
+        s.push('\n');
     }
     s
 }

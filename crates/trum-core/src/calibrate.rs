@@ -8,121 +8,15 @@
 
 use crate::effects::{Effect, Instrument};
 use crate::error::TrumError;
+pub use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
 use crate::sensitivity::{solve_kept, Solved};
 #[cfg(test)]
 use crate::solve::Status;
-use crate::solve::{solve_prepared, OperatingPoint, Prepared, Solution};
+use crate::solve::{solve_prepared, Prepared, Solution};
+pub use crate::tolerances::{Needs, Tolerance, TOLERANCES};
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
-
-/// A measured quantity the model predicts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Observable {
-    /// Mean rotor speed [rev/min].
-    SpeedRpm,
-    /// Electrical input power, both phases [W].
-    InputPowerW,
-    /// Drive current amplitude per phase [A].
-    CurrentA,
-    /// Efficiency [-].
-    Efficiency,
-    /// Feedback electrode voltage amplitude [V].
-    FeedbackV,
-    /// Stator temperature [°C].
-    TemperatureC,
-    /// Speed standard deviation over a revolution [rev/min].
-    SpeedStdRpm,
-}
-
-impl Observable {
-    /// All observables, in column order.
-    pub const ALL: [Observable; 7] = [
-        Observable::SpeedRpm,
-        Observable::InputPowerW,
-        Observable::CurrentA,
-        Observable::Efficiency,
-        Observable::FeedbackV,
-        Observable::TemperatureC,
-        Observable::SpeedStdRpm,
-    ];
-
-    /// The measurement-file column name.
-    pub fn column(self) -> &'static str {
-        match self {
-            Observable::SpeedRpm => "speed_rpm",
-            Observable::InputPowerW => "input_power_w",
-            Observable::CurrentA => "current_a",
-            Observable::Efficiency => "efficiency",
-            Observable::FeedbackV => "feedback_v",
-            Observable::TemperatureC => "temperature_c",
-            Observable::SpeedStdRpm => "speed_std_rpm",
-        }
-    }
-
-    /// The model's prediction from a solution (`ambient_c` for temperatures).
-    pub fn predict(self, s: &Solution, ambient_c: f64) -> f64 {
-        match self {
-            Observable::SpeedRpm => s.speed_rpm,
-            Observable::InputPowerW => s.input_power_w,
-            Observable::CurrentA => s.current_a,
-            Observable::Efficiency => s.efficiency,
-            Observable::FeedbackV => s.feedback_v,
-            Observable::TemperatureC => ambient_c + s.temperature_rise_at_elapsed_k,
-            Observable::SpeedStdRpm => s.speed_std_rpm,
-        }
-    }
-
-    /// The expected reading of this quantity in row `row` when the model gives `model` and
-    /// the reading's noise has standard deviation `sigma`. Where the bench clips the speed
-    /// standard deviation at zero (`ObservedRow::speed_std_clipped`), its readings of a
-    /// smoothly running motor (true value near 0) are the non-negative part of the noise,
-    /// whose mean, σ/√(2π) at a true value of zero, a model predicting 0 misses in every
-    /// reading alike (eccentricity, which adds a speed ripple, then fits that bias: 1000-row
-    /// null data, evidence 9.6). The expected reading of max(0, m + ε), ε ~ N(0, σ²), is
-    /// m·Φ(m/σ) + σ·φ(m/σ), which is m to within 1e-9·σ once m > 6σ. Otherwise, and for
-    /// every other quantity: `model`.
-    pub fn expected_reading(self, row: &ObservedRow, model: f64, sigma: f64) -> f64 {
-        match self {
-            Observable::SpeedStdRpm if row.speed_std_clipped && sigma > 0.0 && model < 8.0 * sigma => {
-                let x = model / sigma;
-                model * crate::noise::normal_cdf(x) + sigma * crate::noise::normal_pdf(x)
-            }
-            _ => model,
-        }
-    }
-
-    /// Default noise level of one reading when the data do not say (documented in
-    /// docs/DIAGNOSIS.md): an absolute floor plus a relative part.
-    pub fn default_sigma(self, value: f64) -> f64 {
-        let v = value.abs();
-        match self {
-            Observable::SpeedRpm => 0.5 + 0.01 * v,
-            Observable::InputPowerW => 0.05 + 0.02 * v,
-            Observable::CurrentA => 0.002 + 0.015 * v,
-            Observable::Efficiency => 0.005 + 0.03 * v,
-            Observable::FeedbackV => 0.2 + 0.01 * v,
-            Observable::TemperatureC => 0.2,
-            Observable::SpeedStdRpm => 0.05 + 0.1 * v,
-        }
-    }
-}
-
-/// One measured row: the operating point and the readings taken there.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ObservedRow {
-    /// Operating point (elapsed time included for time series).
-    pub op: OperatingPoint,
-    /// Readings: (what, value, noise level σ).
-    pub readings: Vec<(Observable, f64, f64)>,
-    /// Ambient temperature for temperature readings [°C].
-    pub ambient_c: f64,
-    /// The bench reports this row's speed standard deviation clipped at zero, and its σ is
-    /// the readings' own noise level: the reading is compared with the expected reading of
-    /// clipped noise ([`Observable::expected_reading`]). Set by the diagnosis where the
-    /// data show both (docs/DIAGNOSIS.md, "Calibration").
-    pub speed_std_clipped: bool,
-}
 
 /// Which parameter a fit moves.
 #[derive(Clone, Debug, PartialEq)]
@@ -242,63 +136,22 @@ impl FitParam {
     }
 }
 
-/// How well a baseline parameter is known before the data are seen: the standard
-/// deviation of its logarithm (a relative tolerance) and the bounds of its fit, as
-/// factors on the nominal value.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Tolerance {
-    /// Dotted motor key.
-    pub key: &'static str,
-    /// Prior standard deviation of ln(value / nominal) [-].
-    pub rel_sd: f64,
-    /// Lower bound of the fit as a factor on the nominal value.
-    pub lo: f64,
-    /// Upper bound of the fit as a factor on the nominal value.
-    pub hi: f64,
-    /// The readings that must be present for the data to see it.
-    pub needs: Needs,
+// Next to the residuals that use it, not in `crate::observable`: the observation types
+// stay independent of the solver, whose effects' instrument model reads them.
+impl Observable {
+    /// The model's prediction from a solution (`ambient_c` for temperatures).
+    pub fn predict(self, s: &Solution, ambient_c: f64) -> f64 {
+        match self {
+            Observable::SpeedRpm => s.speed_rpm,
+            Observable::InputPowerW => s.input_power_w,
+            Observable::CurrentA => s.current_a,
+            Observable::Efficiency => s.efficiency,
+            Observable::FeedbackV => s.feedback_v,
+            Observable::TemperatureC => ambient_c + s.temperature_rise_at_elapsed_k,
+            Observable::SpeedStdRpm => s.speed_std_rpm,
+        }
+    }
 }
-
-/// Which readings a baseline parameter needs before it is fitted.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Needs {
-    /// Any data (it moves the speed).
-    Always,
-    /// Feedback-electrode voltages.
-    Feedback,
-    /// Electrical readings (input power or current).
-    Electrical,
-    /// A temperature time series.
-    ThermalSeries,
-}
-
-/// Default tolerances of the baseline parameters, by class (docs/DIAGNOSIS.md,
-/// "Calibration"). Material and contact constants are known to a factor of a few (broad
-/// priors, bounds at about ±2σ); machined geometry to a few percent; the modal mass and
-/// the electrical constants in between. A real motor differs from its nominal file in all
-/// of them at once, so all are fitted: a parameter the data cannot determine stays at its
-/// prior instead of leaving a structured residual for an effect to fill.
-pub const TOLERANCES: &[Tolerance] = &[
-    Tolerance { key: "friction_layer.friction_coefficient", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::Always },
-    Tolerance { key: "friction_layer.youngs_modulus_pa", rel_sd: 1.15, lo: 0.1, hi: 10.0, needs: Needs::Always },
-    Tolerance { key: "stator.modal_damping_ns_per_m", rel_sd: 0.8, lo: 0.2, hi: 5.0, needs: Needs::Always },
-    Tolerance { key: "stator.force_factor_n_per_v", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::Always },
-    Tolerance { key: "stator.resonance_frequency_hz", rel_sd: 0.015, lo: 0.97, hi: 1.03, needs: Needs::Always },
-    Tolerance { key: "geometry.neutral_plane_distance_m", rel_sd: 0.05, lo: 0.8, hi: 1.25, needs: Needs::Always },
-    Tolerance { key: "geometry.mean_radius_m", rel_sd: 0.02, lo: 0.93, hi: 1.07, needs: Needs::Always },
-    Tolerance { key: "stator.modal_mass_kg", rel_sd: 0.1, lo: 0.7, hi: 1.4, needs: Needs::Always },
-    Tolerance { key: "electrical.feedback_gain_v_per_m", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::Feedback },
-    Tolerance { key: "electrical.clamped_capacitance_f", rel_sd: 0.35, lo: 0.5, hi: 2.0, needs: Needs::Electrical },
-    Tolerance { key: "electrical.dielectric_loss_tangent", rel_sd: 0.4, lo: 0.3, hi: 3.0, needs: Needs::Electrical },
-    Tolerance { key: "thermal.heat_capacity_j_per_k", rel_sd: 0.6, lo: 0.3, hi: 3.0, needs: Needs::ThermalSeries },
-    Tolerance {
-        key: "thermal.heat_transfer_coefficient_w_per_m2k",
-        rel_sd: 0.6,
-        lo: 0.3,
-        hi: 3.0,
-        needs: Needs::ThermalSeries,
-    },
-];
 
 /// The uncertain baseline parameters of a motor, their bounds and priors
 /// ([`TOLERANCES`]): every parameter the data can see. See [`baseline_params_with`].
@@ -424,7 +277,7 @@ pub fn effect_params(effect: Effect) -> Vec<FitParam> {
 }
 
 /// Absolute stopping tolerance of a fit on the (weighted) sum of squared normalised
-/// residuals: see `calibrate`.
+/// residuals: see `Calibrate::run`.
 const FIT_CHI2_TOL: f64 = 1e-4;
 
 /// A fit also stops when a full Gauss–Newton step could remove less than this from the
@@ -497,7 +350,7 @@ pub struct Calibration {
     pub evaluations: usize,
     /// Warnings (bounds, identifiability, failed solves).
     pub warnings: Vec<String>,
-    /// Abandoned as collapsing onto the nested model (`calibrate_adding`).
+    /// Abandoned as collapsing onto the nested model ([`Calibrate::adding`]).
     pub(crate) abandoned: bool,
     /// The fit linearised at its optimum (for approximate leave-block-out refits).
     pub(crate) lin: Linearisation,
@@ -523,7 +376,7 @@ impl Linearisation {
     }
 }
 
-/// One Levenberg–Marquardt run of `problem` at its current weights (see `calibrate`
+/// One Levenberg–Marquardt run of `problem` at its current weights (see `Calibrate::run`
 /// for the budget and the tolerances).
 fn lm_pass<'a>(problem: Problem<'a>, opts: &FitOptions) -> (Problem<'a>, levenberg_marquardt::MinimizationReport<f64>) {
     let np1 = problem.params.len() + 1;
@@ -997,81 +850,140 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 }
 
-/// Calibrates `params` of `motor` to `rows`. Errors when there are fewer readings than
-/// parameters or a bound is invalid; a fit that does not converge still returns its best
-/// point with a warning.
-pub fn calibrate(
-    motor: &Motor,
-    rows: &[ObservedRow],
-    params: &[FitParam],
-    opts: &FitOptions,
-) -> Result<Calibration, TrumError> {
-    calibrate_adding(motor, rows, params, opts, &[])
-}
-
-/// [`calibrate`], refitted from its own end when a parameter ends on a bound, keeping the
-/// better of the two fits. The logistic transform all but freezes a parameter at its bound
-/// (its slope vanishes there), while a start on a bound is placed 1e-3 inside it, from where
-/// it can move on. (1000-row diagnosis benchmark, seeds 31-38: the modal damping on its
-/// upper bound at χ² 0.72 million; refitted from there, 0.27 million.) Used for the
-/// baseline by `trum calibrate` and the diagnosis.
-pub fn calibrate_refitting_bounds(
-    motor: &Motor,
-    rows: &[ObservedRow],
-    params: &[FitParam],
-    opts: &FitOptions,
-) -> Result<Calibration, TrumError> {
-    let first = calibrate(motor, rows, params, opts)?;
-    if !first.params.iter().any(|p| p.at_bound) {
-        return Ok(first);
-    }
-    Ok(match calibrate(&first.motor, rows, params, opts) {
-        Ok(again) if again.chi2 < first.chi2 => again,
-        _ => first,
-    })
-}
-
-/// [`calibrate`] for a model that adds the effects `added` to a nested model already fitted
-/// (the baseline for a single effect, the lead effect's fit for a pair), from `start`
-/// (which sets the early stops, [`Start`]). The fit is abandoned (returned where it
-/// stopped, with a warning and without its parameters' uncertainties) when the primary
-/// strength of an added effect is pressed against zero: it is collapsing onto the nested
-/// model, whose fit exists, and would otherwise crawl there through the logistic transform
-/// for many passes.
-pub(crate) fn calibrate_nested(
-    motor: &Motor,
-    rows: &[ObservedRow],
-    params: &[FitParam],
-    opts: &FitOptions,
-    added: &[Effect],
+/// The one entry point of calibration, in builder style: what to fit (`motor`, `rows`,
+/// [`Calibrate::params`] or the baseline parameters with [`Calibrate::tolerances`]) and
+/// how ([`Calibrate::options`], [`Calibrate::refit_bounds`]), then [`Calibrate::run`].
+///
+/// ```
+/// use trum_core::calibrate::{Calibration, FitOptions};
+/// # fn demo(motor: &trum_core::Motor, rows: &[trum_core::calibrate::ObservedRow]) {
+/// let cal = Calibration::builder(motor, rows).options(&FitOptions::default()).refit_bounds(true).run();
+/// # }
+/// ```
+#[derive(Clone, Debug)]
+#[must_use = "a calibration is computed by `run`"]
+pub struct Calibrate<'a> {
+    motor: &'a Motor,
+    rows: &'a [ObservedRow],
+    params: Option<&'a [FitParam]>,
+    tolerances: Option<&'a std::collections::BTreeMap<String, f64>>,
+    options: Option<&'a FitOptions>,
+    refit_bounds: bool,
+    added: &'a [Effect],
     start: Start,
-) -> Result<Calibration, TrumError> {
-    fit(motor, rows, params, opts, added, None, start)
+    weights: Option<Vec<f64>>,
 }
 
-/// [`calibrate_nested`] from a fresh start.
-pub(crate) fn calibrate_adding(
-    motor: &Motor,
-    rows: &[ObservedRow],
-    params: &[FitParam],
-    opts: &FitOptions,
-    added: &[Effect],
-) -> Result<Calibration, TrumError> {
-    calibrate_nested(motor, rows, params, opts, added, Start::Fresh)
+impl Calibration {
+    /// A calibration of `motor` to `rows` to be configured and [`Calibrate::run`]: by
+    /// default the baseline parameters ([`baseline_params`]) with [`FitOptions::default`],
+    /// not refitted from a bound.
+    pub fn builder<'a>(motor: &'a Motor, rows: &'a [ObservedRow]) -> Calibrate<'a> {
+        Calibrate {
+            motor,
+            rows,
+            params: None,
+            tolerances: None,
+            options: None,
+            refit_bounds: false,
+            added: &[],
+            start: Start::Fresh,
+            weights: None,
+        }
+    }
 }
 
-/// [`calibrate`] with the Huber weights fixed at `weights` (one per reading, in row order):
-/// one least-squares pass, no reweighting. A leave-block-out refit of a weighted fit
-/// (the diagnosis's approximate cross-validation, where its first-order step moved far)
-/// keeps the full-data fit's weights on its training readings, as the step does.
-pub(crate) fn calibrate_weighted(
-    motor: &Motor,
-    rows: &[ObservedRow],
-    params: &[FitParam],
-    opts: &FitOptions,
-    weights: Vec<f64>,
-) -> Result<Calibration, TrumError> {
-    fit(motor, rows, params, opts, &[], Some(weights), Start::Fresh)
+impl<'a> Calibrate<'a> {
+    /// The parameters to fit, with their bounds and priors (in place of the baseline
+    /// parameters; [`Calibrate::tolerances`] then has no effect).
+    pub fn params(mut self, params: &'a [FitParam]) -> Self {
+        self.params = Some(params);
+        self
+    }
+
+    /// The baseline parameters with these relative tolerances in place of the defaults
+    /// ([`baseline_params_with`]); ignored when [`Calibrate::params`] is given.
+    pub fn tolerances(mut self, tolerances: &'a std::collections::BTreeMap<String, f64>) -> Self {
+        self.tolerances = Some(tolerances);
+        self
+    }
+
+    /// Loss, reweighting and budget of the fit.
+    pub fn options(mut self, options: &'a FitOptions) -> Self {
+        self.options = Some(options);
+        self
+    }
+
+    /// Refit from the fit's own end when a parameter ends on a bound, keeping the better
+    /// of the two fits. The logistic transform all but freezes a parameter at its bound
+    /// (its slope vanishes there), while a start on a bound is placed 1e-3 inside it, from
+    /// where it can move on. (1000-row diagnosis benchmark, seeds 31-38: the modal damping
+    /// on its upper bound at χ² 0.72 million; refitted from there, 0.27 million.) Used for
+    /// the baseline by `trum calibrate` and the diagnosis. The refit is a fresh fit of the
+    /// same parameters.
+    pub fn refit_bounds(mut self, yes: bool) -> Self {
+        self.refit_bounds = yes;
+        self
+    }
+
+    /// A model that adds the effects `added` to a nested model already fitted (the
+    /// baseline for a single effect, the lead effect's fit for a pair); [`Calibrate::start`]
+    /// sets the early stops. The fit is abandoned (returned where it stopped, with a
+    /// warning and without its parameters' uncertainties) when the primary strength of an
+    /// added effect is pressed against zero: it is collapsing onto the nested model, whose
+    /// fit exists, and would otherwise crawl there through the logistic transform for many
+    /// passes.
+    pub(crate) fn adding(mut self, added: &'a [Effect]) -> Self {
+        self.added = added;
+        self
+    }
+
+    /// Where the fit starts ([`Start`]; default [`Start::Fresh`]).
+    pub(crate) fn start(mut self, start: Start) -> Self {
+        self.start = start;
+        self
+    }
+
+    /// The Huber weights fixed at `weights` (one per reading, in row order): one
+    /// least-squares pass, no reweighting. A leave-block-out refit of a weighted fit (the
+    /// diagnosis's approximate cross-validation, where its first-order step moved far)
+    /// keeps the full-data fit's weights on its training readings, as the step does.
+    pub(crate) fn weights(mut self, weights: Vec<f64>) -> Self {
+        self.weights = Some(weights);
+        self
+    }
+
+    /// Runs the fit. Errors when there are fewer readings than parameters or a bound is
+    /// invalid; a fit that does not converge still returns its best point with a warning.
+    pub fn run(self) -> Result<Calibration, TrumError> {
+        let default_options;
+        let opts = match self.options {
+            Some(o) => o,
+            None => {
+                default_options = FitOptions::default();
+                &default_options
+            }
+        };
+        let owned;
+        let params = match self.params {
+            Some(p) => p,
+            None => {
+                owned = match self.tolerances {
+                    Some(t) => baseline_params_with(self.motor, self.rows, t),
+                    None => baseline_params(self.motor, self.rows),
+                };
+                &owned[..]
+            }
+        };
+        let first = fit(self.motor, self.rows, params, opts, self.added, self.weights, self.start)?;
+        if !self.refit_bounds || !first.params.iter().any(|p| p.at_bound) {
+            return Ok(first);
+        }
+        Ok(match fit(&first.motor, self.rows, params, opts, &[], None, Start::Fresh) {
+            Ok(again) if again.chi2 < first.chi2 => again,
+            _ => first,
+        })
+    }
 }
 
 /// Where a fit starts, which sets its early stops.
@@ -1355,6 +1267,7 @@ fn fit(
 #[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 pub(crate) mod tests {
     use super::*;
+    use crate::solve::OperatingPoint;
 
     /// Noise-free readings (speed, input power, feedback voltage at their default σ) of `m`
     /// at each operating point of `ops`.
@@ -1417,8 +1330,16 @@ pub(crate) mod tests {
         truth.geometry.neutral_plane_distance_m *= 1.03;
         let rows = rows_on_grid(&truth, &[100.0, 175.0, 250.0, 325.0, 400.0], &[0.0, 0.15, 0.3, 0.45]);
         let fit = FitOptions::default();
-        let map = calibrate(&nominal, &rows, &baseline_params(&nominal, &rows), &fit).expect("MAP fit");
-        let classic = calibrate(&nominal, &rows, &classic_params(&nominal, &rows), &fit).expect("classic fit");
+        let map = Calibration::builder(&nominal, &rows)
+            .params(&baseline_params(&nominal, &rows))
+            .options(&fit)
+            .run()
+            .expect("MAP fit");
+        let classic = Calibration::builder(&nominal, &rows)
+            .params(&classic_params(&nominal, &rows))
+            .options(&fit)
+            .run()
+            .expect("classic fit");
         // the data alone are met by both (the classic five absorb the 3 %)
         assert!(classic.chi2 < 1e-2, "classic χ² {}", classic.chi2);
         assert!(map.chi2 - map.prior_chi2 < 1e-2, "MAP data χ² {}", map.chi2 - map.prior_chi2);
@@ -1454,7 +1375,7 @@ pub(crate) mod tests {
             fit_rel(&start, "friction_layer.friction_coefficient", 0.3, 3.0),
             fit_rel(&start, "stator.modal_damping_ns_per_m", 0.2, 5.0),
         ];
-        let cal = calibrate(&start, &rows, &params, &FitOptions::default()).unwrap();
+        let cal = Calibration::builder(&start, &rows).params(&params).options(&FitOptions::default()).run().unwrap();
         let mu = cal.motor.friction_layer.friction_coefficient;
         let c = cal.motor.stator.modal_damping_ns_per_m;
         assert!((mu - 0.3).abs() < 1e-4, "mu {mu}");
@@ -1484,11 +1405,11 @@ pub(crate) mod tests {
         let mut params = vec![fit_rel(&truth, "friction_layer.friction_coefficient", 0.3, 3.0)];
         let tor = torque_offset_param(&rows, &std::collections::BTreeMap::new()).expect("a load sweep");
         assert!(tor.lo < -offset && tor.hi > offset, "{tor:?}");
-        let without = calibrate(&truth, &rows, &params, &FitOptions::default()).unwrap();
+        let without = Calibration::builder(&truth, &rows).params(&params).run().unwrap();
         let mu_without = without.motor.friction_layer.friction_coefficient;
         assert!(without.chi2 > 1.0 || (mu_without - 0.3).abs() > 1e-3, "χ² {} μ {mu_without}", without.chi2);
         params.push(tor);
-        let cal = calibrate(&truth, &rows, &params, &FitOptions::default()).unwrap();
+        let cal = Calibration::builder(&truth, &rows).params(&params).run().unwrap();
         // the prior (σ = 1 % of the largest reading, 0.003 N·m) pulls a maximum a posteriori
         // fit a little towards zero; without it the offset comes back exactly
         let got = cal.motor.effects.instrument().torque_offset_nm;
@@ -1497,7 +1418,7 @@ pub(crate) mod tests {
         let n = params.len();
         params[n - 1] = torque_offset_param(&rows, &free).expect("a load sweep");
         assert!(params[n - 1].prior.is_none());
-        let cal = calibrate(&truth, &rows, &params, &FitOptions::default()).unwrap();
+        let cal = Calibration::builder(&truth, &rows).params(&params).run().unwrap();
         let got = cal.motor.effects.instrument().torque_offset_nm;
         assert!((got - offset).abs() < 0.02 * offset, "offset without a prior {got}");
         let mu = cal.motor.friction_layer.friction_coefficient;
@@ -1528,7 +1449,8 @@ pub(crate) mod tests {
         start.effects.set(e, &[0.1, e.info().params[1].start()]);
         let params = effect_params(e);
         assert_eq!((params[1].lo, params[1].hi), (0.0, 1.0), "a shape parameter spans its range");
-        let cal = calibrate(&start, &rows, &params, &FitOptions::default()).expect("fit");
+        let cal =
+            Calibration::builder(&start, &rows).params(&params).options(&FitOptions::default()).run().expect("fit");
         let (s, lam) = (cal.motor.effects.value(e, 0), cal.motor.effects.value(e, 1));
         assert!((s / 0.2 - 1.0).abs() < 1e-3 && (lam - 0.8).abs() < 1e-3, "scale {s}, fraction {lam}");
     }
@@ -1550,19 +1472,29 @@ pub(crate) mod tests {
         ];
         let opts = FitOptions::default();
         let n: usize = rows.iter().map(|r| r.readings.len()).sum();
-        let huber = calibrate(&start, &rows, &params, &opts).unwrap();
+        let huber = Calibration::builder(&start, &rows).params(&params).options(&opts).run().unwrap();
         assert!(huber.lin.weights.iter().any(|&w| w < 0.5), "the outlier was not downweighted");
-        let fixed = calibrate_weighted(&start, &rows, &params, &opts, huber.lin.weights.clone()).unwrap();
+        let fixed = Calibration::builder(&start, &rows)
+            .params(&params)
+            .options(&opts)
+            .weights(huber.lin.weights.clone())
+            .run()
+            .unwrap();
         assert_eq!(fixed.lin.weights, huber.lin.weights);
         // the same weighted problem: the same optimum
         let mu = |c: &Calibration| c.motor.friction_layer.friction_coefficient;
         assert!((mu(&fixed) / mu(&huber) - 1.0).abs() < 1e-4, "{} vs {}", mu(&fixed), mu(&huber));
         // unit weights: the plain least-squares fit, which the outlier pulls further
-        let ones = calibrate_weighted(&start, &rows, &params, &opts, vec![1.0; n]).unwrap();
-        let plain = calibrate(&start, &rows, &params, &FitOptions { irls_passes: 0, ..opts.clone() }).unwrap();
+        let ones =
+            Calibration::builder(&start, &rows).params(&params).options(&opts).weights(vec![1.0; n]).run().unwrap();
+        let plain = Calibration::builder(&start, &rows)
+            .params(&params)
+            .options(&FitOptions { irls_passes: 0, ..opts.clone() })
+            .run()
+            .unwrap();
         assert!((ones.chi2 / plain.chi2 - 1.0).abs() < 1e-9, "{} vs {}", ones.chi2, plain.chi2);
         assert!(ones.chi2 < fixed.chi2, "unweighted χ²: {} (fit to it) vs {}", ones.chi2, fixed.chi2);
-        let short = calibrate_weighted(&start, &rows, &params, &opts, vec![1.0; n - 1]);
+        let short = Calibration::builder(&start, &rows).params(&params).options(&opts).weights(vec![1.0; n - 1]).run();
         assert!(short.is_err_and(|e| e.to_string().contains("weights")));
     }
 
@@ -1627,7 +1559,7 @@ pub(crate) mod tests {
         ];
         let mut start = truth.clone();
         start.stator.modal_damping_ns_per_m *= 1.5;
-        let cal = calibrate(&start, &rows, &params, &FitOptions::default()).unwrap();
+        let cal = Calibration::builder(&start, &rows).params(&params).options(&FitOptions::default()).run().unwrap();
         let c = cal.motor.stator.modal_damping_ns_per_m / truth.stator.modal_damping_ns_per_m;
         // (noise-free data: the fit stops once no step can remove FIT_DECREMENT_TOL)
         assert!((c - 1.0).abs() < 5e-3, "damping {c} × the truth");
@@ -1691,16 +1623,16 @@ pub(crate) mod tests {
         let opts = FitOptions::default();
         // data without the effect
         let clean = rows_from(&nominal);
-        let added = calibrate_adding(&start, &clean, &params, &opts, &[rf]).unwrap();
+        let added = Calibration::builder(&start, &clean).params(&params).options(&opts).adding(&[rf]).run().unwrap();
         assert!(added.abandoned, "{:?}", added.warnings);
         assert!(added.warnings.iter().any(|w| w.contains("went to zero")), "{:?}", added.warnings);
-        let plain = calibrate(&start, &clean, &params, &opts).unwrap();
+        let plain = Calibration::builder(&start, &clean).params(&params).options(&opts).run().unwrap();
         assert!(!plain.abandoned);
         assert!(added.evaluations < plain.evaluations, "{} vs {}", added.evaluations, plain.evaluations);
         assert!(plain.motor.effects.value(rf, 0) < 1.2, "{}", plain.motor.effects.value(rf, 0));
         // data with it: fitted to its strength
         let rows = rows_from(&with_rf(&nominal, 300.0));
-        let fit = calibrate_adding(&start, &rows, &params, &opts, &[rf]).unwrap();
+        let fit = Calibration::builder(&start, &rows).params(&params).options(&opts).adding(&[rf]).run().unwrap();
         assert!(!fit.abandoned, "{:?}", fit.warnings);
         let r = fit.motor.effects.value(rf, 0);
         assert!((r - 300.0).abs() < 3.0, "source resistance {r}");
@@ -1941,7 +1873,11 @@ pub(crate) mod tests {
             ambient_c: 25.0,
             speed_std_clipped: false,
         }];
-        let err = calibrate(&m, &rows, &classic_params(&m, &rows), &FitOptions::default()).unwrap_err();
+        let err = Calibration::builder(&m, &rows)
+            .params(&classic_params(&m, &rows))
+            .options(&FitOptions::default())
+            .run()
+            .unwrap_err();
         assert!(err.to_string().contains("cannot determine"), "{err}");
     }
 
@@ -1967,7 +1903,7 @@ pub(crate) mod tests {
         let params = classic_params(&nominal, &rows);
         let fit_with = |fold_rtol: f64| {
             let opts = FitOptions { irls_passes: 1, fold_rtol, ..FitOptions::default() };
-            calibrate(&nominal, &rows, &params, &opts).expect("fit")
+            Calibration::builder(&nominal, &rows).params(&params).options(&opts).run().expect("fit")
         };
         let (stopped, crawled) = (fit_with(FOLD_RTOL), fit_with(0.0));
         // (94 and 50 passes when written)

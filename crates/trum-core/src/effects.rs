@@ -7,7 +7,7 @@
 //! to the part of the model it changes and is applied by [`crate::solve`].
 
 use crate::error::ParamError;
-use crate::params::{fmt_toml_number, line_of_key, Num};
+use crate::toml_text::{fmt_toml_number, line_of_key, Num};
 use std::fmt;
 
 /// One strength parameter of an effect.
@@ -324,9 +324,9 @@ impl Instrument {
     }
 
     /// What the instrument shows of quantity `o` when the motor's value is `model`.
-    pub fn reading(&self, o: crate::calibrate::Observable, model: f64) -> f64 {
+    pub fn reading(&self, o: crate::observable::Observable, model: f64) -> f64 {
         match o {
-            crate::calibrate::Observable::SpeedStdRpm if self.speed_std_floor_rpm > 0.0 => {
+            crate::observable::Observable::SpeedStdRpm if self.speed_std_floor_rpm > 0.0 => {
                 model.hypot(self.speed_std_floor_rpm)
             }
             _ => model,

@@ -12,18 +12,14 @@ use crate::solve::Status;
 pub const STATUSES: [Status; 5] =
     [Status::Ok, Status::Stall, Status::Clamped, Status::NoConvergence, Status::InvalidInput];
 
-/// The status words in code order (each is `Status::as_str`; a test checks it).
-pub const STATUS_NAMES: [&str; 5] = ["ok", "stall", "clamped", "no_convergence", "invalid_input"];
+/// The status words in code order: [`Status::as_str`] of each of [`STATUSES`].
+pub const STATUS_NAMES: [&str; 5] =
+    [STATUSES[0].as_str(), STATUSES[1].as_str(), STATUSES[2].as_str(), STATUSES[3].as_str(), STATUSES[4].as_str()];
 
 /// The code of a status: its index in [`STATUSES`].
 pub fn status_code(s: Status) -> u8 {
-    match s {
-        Status::Ok => 0,
-        Status::Stall => 1,
-        Status::Clamped => 2,
-        Status::NoConvergence => 3,
-        Status::InvalidInput => 4,
-    }
+    // (every status is in STATUSES, which has five entries: the cast cannot truncate)
+    STATUSES.iter().position(|&x| x == s).unwrap_or(STATUSES.len()) as u8
 }
 
 /// The status with code `code`, if there is one.
@@ -49,7 +45,7 @@ pub const RESPONSE_COLUMNS: [&str; 8] =
 
 /// One row of the response table. Numbers that a row does not have are NaN (written as
 /// empty CSV cells, NaN in Python); `stable` is `None` where stability does not apply.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ResponseRow {
     /// Drive voltage of the curve [V].
     pub voltage_v: f64,
@@ -68,6 +64,34 @@ pub struct ResponseRow {
     pub phase_lag_rad: f64,
     /// Stability of the solution (branch rows; `false` at the saddle nodes).
     pub stable: Option<bool>,
+}
+
+/// One cell of the response table.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ResponseCell {
+    /// A number (NaN where the row has none).
+    Number(f64),
+    /// A word (`branch`, `status`).
+    Word(&'static str),
+    /// A flag that may not apply (`stable`).
+    Flag(Option<bool>),
+}
+
+impl ResponseRow {
+    /// The row's cells, in [`RESPONSE_COLUMNS`] order.
+    pub fn cells(&self) -> [ResponseCell; 8] {
+        use ResponseCell::{Flag, Number, Word};
+        [
+            Number(self.voltage_v),
+            Number(self.preload_n),
+            Number(self.frequency_hz),
+            Word(self.branch),
+            Word(self.status),
+            Number(self.amplitude_m),
+            Number(self.phase_lag_rad),
+            Flag(self.stable),
+        ]
+    }
 }
 
 /// The status word of a response curve: `ok`, `no_static_equilibrium` (the softening
@@ -178,6 +202,44 @@ mod tests {
             assert_eq!(s.is_valid(), i < 3, "{s:?}");
         }
         assert_eq!(status_of_code(5), None);
+        // every status is listed: a new one stops this match compiling until it is
+        let listed = |s: Status| match s {
+            Status::Ok | Status::Stall | Status::Clamped | Status::NoConvergence | Status::InvalidInput => {
+                STATUSES.contains(&s)
+            }
+        };
+        assert!(STATUSES.iter().all(|&s| listed(s)) && STATUSES.len() == 5);
+    }
+
+    /// Each cell of a row sits under its own column, with the row's value.
+    #[test]
+    fn response_cells_follow_the_columns() {
+        let r = ResponseRow {
+            voltage_v: 1.0,
+            preload_n: 2.0,
+            frequency_hz: 3.0,
+            branch: "upper",
+            status: "ok",
+            amplitude_m: 4.0,
+            phase_lag_rad: 5.0,
+            stable: Some(false),
+        };
+        let cells = r.cells();
+        let expect = [
+            ("voltage_v", ResponseCell::Number(1.0)),
+            ("preload_n", ResponseCell::Number(2.0)),
+            ("frequency_hz", ResponseCell::Number(3.0)),
+            ("branch", ResponseCell::Word("upper")),
+            ("status", ResponseCell::Word("ok")),
+            ("amplitude_m", ResponseCell::Number(4.0)),
+            ("phase_lag_rad", ResponseCell::Number(5.0)),
+            ("stable", ResponseCell::Flag(Some(false))),
+        ];
+        assert_eq!(expect.len(), RESPONSE_COLUMNS.len());
+        for (name, cell) in expect {
+            let j = RESPONSE_COLUMNS.iter().position(|c| *c == name);
+            assert_eq!(j.map(|j| cells[j]), Some(cell), "{name}");
+        }
     }
 
     #[test]

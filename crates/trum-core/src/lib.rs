@@ -21,6 +21,7 @@
 //! SI units everywhere; every public quantity name carries its unit.
 #![warn(missing_docs)]
 
+pub mod axis;
 pub mod calibrate;
 pub mod contact;
 pub mod criterion;
@@ -35,18 +36,24 @@ pub mod layout;
 pub mod losses;
 pub mod measurements;
 pub mod noise;
+mod normal;
+pub mod observable;
 pub mod observations;
+pub mod operating_point;
 pub mod papers;
 pub mod params;
 pub mod presets;
 pub mod quad;
 pub mod quantities;
 mod sensitivity;
+pub mod solution;
 pub mod solve;
 pub mod stator;
 pub mod sweep;
 pub mod synth;
 pub mod thermal;
+pub mod tolerances;
+mod toml_text;
 
 pub use effects::{Effect, Effects};
 pub use error::{ParamError, TrumError};

@@ -10,7 +10,8 @@
 //! squared residuals divided by the median of χ²₁ (0.4549), which keeps the few triples
 //! where the curve bends sharply (resonance peak, stall) from inflating it.
 
-use crate::calibrate::{Observable, ObservedRow};
+use crate::normal::{normal_cdf, normal_pdf};
+use crate::observable::{Observable, ObservedRow};
 use std::collections::BTreeMap;
 
 /// Median of the χ² distribution with one degree of freedom.
@@ -18,17 +19,6 @@ const CHI2_1_MEDIAN: f64 = 0.454_936_423_119_572_8;
 
 /// Fewest line residuals per quantity for an estimate.
 pub const MIN_TRIPLES: usize = 8;
-
-/// The standard normal distribution function Φ(x) (through `libm::erfc`: to full relative
-/// accuracy in the lower tail; take the upper tail 1 − Φ(x) as Φ(−x)).
-pub(crate) fn normal_cdf(x: f64) -> f64 {
-    0.5 * libm::erfc(-x / std::f64::consts::SQRT_2)
-}
-
-/// The standard normal density φ(x).
-pub(crate) fn normal_pdf(x: f64) -> f64 {
-    (-0.5 * x * x).exp() / (2.0 * std::f64::consts::PI).sqrt()
-}
 
 /// Fewest readings for the censored estimate of a clipped speed std: a zero says less than
 /// a reading, and the eight readings of one stability run gave a factor 30 % off (a

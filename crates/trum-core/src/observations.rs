@@ -2,9 +2,9 @@
 //! observed rows that calibration and diagnosis fit, and synthetic campaigns become
 //! measurement files.
 
-use crate::calibrate::{Observable, ObservedRow};
 use crate::error::TrumError;
 use crate::measurements::{Column, Measurements, Row};
+use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
 use crate::solve::OperatingPoint;
 use crate::synth::SynthRow;

@@ -7,7 +7,7 @@
 
 use crate::effects::Effects;
 use crate::error::ParamError;
-use serde::de::{self, Deserializer, Visitor};
+use crate::toml_text::{fmt_toml_number, line_of_key, line_of_offset, Num};
 use serde::Deserialize;
 use std::fmt::Write as _;
 
@@ -37,32 +37,6 @@ impl Check {
             }
             _ => None,
         }
-    }
-}
-
-/// A number that may be written as a TOML integer or float.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Num(pub f64);
-
-impl<'de> Deserialize<'de> for Num {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl Visitor<'_> for V {
-            type Value = Num;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a number")
-            }
-            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Num, E> {
-                Ok(Num(v))
-            }
-            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Num, E> {
-                Ok(Num(v as f64))
-            }
-            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Num, E> {
-                Ok(Num(v as f64))
-            }
-        }
-        d.deserialize_any(V)
     }
 }
 
@@ -248,9 +222,10 @@ struct MotorFile {
 /// logarithm (0.05 ≈ ±5 %; 0 holds the parameter at its file value; `inf` fits it without a
 /// prior). Keys are dotted motor keys (`"geometry.neutral_plane_distance_m" = 0.02`) or
 /// sub-tables (`[tolerances.geometry]`), limited to the parameters calibration fits
-/// ([`crate::calibrate::TOLERANCES`], docs/DIAGNOSIS.md); the bench's speed-std floor is
+/// ([`crate::tolerances::TOLERANCES`], docs/DIAGNOSIS.md); the bench's speed-std floor is
 /// `bench.speed_std_floor_rpm` (0: the bench has none), the torque transducer's zero offset
-/// `bench.torque_offset_nm` (the prior's standard deviation in N·m; 0: no offset). Empty without a table; errors name
+/// `bench.torque_offset_nm` (the prior's standard deviation in N·m; 0: no offset). Empty
+/// without a table; errors name
 /// the file, line and key.
 pub fn tolerances_from_toml_str(
     text: &str,
@@ -264,7 +239,7 @@ pub fn tolerances_from_toml_str(
     })?;
     let mut out = std::collections::BTreeMap::new();
     let Some(table) = file.tolerances else { return Ok(out) };
-    let valid: Vec<String> = crate::calibrate::TOLERANCES
+    let valid: Vec<String> = crate::tolerances::TOLERANCES
         .iter()
         .map(|t| t.key.to_string())
         .chain(["bench.speed_std_floor_rpm", "bench.torque_offset_nm"].map(String::from))
@@ -377,13 +352,13 @@ struct SweepPatch {
 #[derive(Debug, Default, Clone, PartialEq)]
 pub struct SweepTable {
     /// Preload axis [N], if set.
-    pub preload_n: Option<crate::sweep::Axis>,
+    pub preload_n: Option<crate::axis::Axis>,
     /// Voltage axis [V], if set.
-    pub voltage_v: Option<crate::sweep::Axis>,
+    pub voltage_v: Option<crate::axis::Axis>,
     /// Frequency axis [Hz], if set.
-    pub frequency_hz: Option<crate::sweep::Axis>,
+    pub frequency_hz: Option<crate::axis::Axis>,
     /// Torque axis [N·m], if set.
-    pub torque_nm: Option<crate::sweep::Axis>,
+    pub torque_nm: Option<crate::axis::Axis>,
 }
 
 fn axis_from_spec(
@@ -391,7 +366,7 @@ fn axis_from_spec(
     key: &str,
     text: &str,
     source_name: &str,
-) -> Result<Option<crate::sweep::Axis>, ParamError> {
+) -> Result<Option<crate::axis::Axis>, ParamError> {
     let err = |reason: String| ParamError {
         source_name: source_name.into(),
         line: line_of_key(text, "sweep", key),
@@ -400,12 +375,12 @@ fn axis_from_spec(
     };
     let axis = match spec {
         None => return Ok(None),
-        Some(AxisSpec::Value(v)) => crate::sweep::Axis::fixed(v.0),
+        Some(AxisSpec::Value(v)) => crate::axis::Axis::fixed(v.0),
         Some(AxisSpec::Range((a, b, n))) => {
             if !(n.0.fract() == 0.0 && n.0 >= 1.0 && n.0 <= 1e12) {
                 return Err(err(format!("the point count {} must be a positive whole number", n.0)));
             }
-            crate::sweep::Axis::linspace(a.0, b.0, n.0 as usize)
+            crate::axis::Axis::linspace(a.0, b.0, n.0 as usize)
         }
     };
     let strict = key != "torque_nm";
@@ -415,34 +390,6 @@ fn axis_from_spec(
         }
     }
     Ok(Some(axis))
-}
-
-/// 1-based line of `key` inside `[section]` (or a dotted/inline form) in TOML text.
-/// Used only to point error messages at the right line; `None` when not found.
-pub(crate) fn line_of_key(text: &str, section: &str, key: &str) -> Option<usize> {
-    let mut current = String::new();
-    for (i, raw) in text.lines().enumerate() {
-        let line = raw.trim();
-        if let Some(h) = line.strip_prefix('[') {
-            current = h.trim_end_matches(']').trim().trim_end_matches(']').trim().to_string();
-            if !section.is_empty() && current == format!("{section}.{key}") {
-                return Some(i + 1);
-            }
-            continue;
-        }
-        let lhs = line.split('=').next().unwrap_or("").trim();
-        let full = if current.is_empty() { lhs.to_string() } else { format!("{current}.{lhs}") };
-        let want = if section.is_empty() { key.to_string() } else { format!("{section}.{key}") };
-        if full == want || (current.is_empty() && lhs == want) {
-            return Some(i + 1);
-        }
-    }
-    None
-}
-
-/// 1-based line number of a byte offset.
-pub(crate) fn line_of_offset(text: &str, offset: usize) -> usize {
-    text.as_bytes()[..offset.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1
 }
 
 impl Motor {
@@ -686,20 +633,6 @@ impl Motor {
     /// Plain TOML (no provenance notes).
     pub fn to_toml(&self) -> String {
         self.to_toml_annotated(&format!("trum motor file: {}", self.name), &|_| None)
-    }
-}
-
-/// A TOML float or integer literal that reads back bit-identical.
-pub(crate) fn fmt_toml_number(v: f64, integer: bool) -> String {
-    if integer && v.fract() == 0.0 && v.abs() < 1e15 {
-        return format!("{}", v as i64);
-    }
-    // `{:?}` gives the shortest representation that round-trips; make sure it reads as a float.
-    let s = format!("{v:?}");
-    if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
-        s
-    } else {
-        format!("{s}.0")
     }
 }
 

@@ -1,7 +1,7 @@
 //! The one table of output quantities shared by `trum point`, CSV maps and the Python
 //! result object: column name (with unit suffix), unit, meaning, and accessor.
 
-use crate::solve::Solution;
+use crate::solution::Solution;
 
 /// One output quantity.
 #[derive(Clone, Copy)]

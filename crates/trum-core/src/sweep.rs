@@ -4,6 +4,7 @@
 //! The grid is enumerated lazily (index → point), so a 10^8-point map never exists in
 //! memory. Parallelism and writing live in the front ends.
 
+pub use crate::axis::Axis;
 use crate::error::TrumError;
 use crate::params::Motor;
 use crate::solve::{OperatingPoint, Prepared, Solution, SweepPoint, SWEEP_HISTORY};
@@ -36,37 +37,6 @@ pub fn chunk_count(len: u64, chunk: u64) -> u64 {
 pub fn chunk_range(len: u64, chunk: u64, c: u64) -> std::ops::Range<u64> {
     let chunk = chunk.max(1);
     (c * chunk).min(len)..((c + 1) * chunk).min(len)
-}
-
-/// One axis: `n` points from `start` to `stop` inclusive (n = 1: just `start`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Axis {
-    /// First value.
-    pub start: f64,
-    /// Last value.
-    pub stop: f64,
-    /// Number of points, ≥ 1.
-    pub n: usize,
-}
-
-impl Axis {
-    /// A single value.
-    pub fn fixed(v: f64) -> Axis {
-        Axis { start: v, stop: v, n: 1 }
-    }
-    /// `n` evenly spaced values.
-    pub fn linspace(start: f64, stop: f64, n: usize) -> Axis {
-        Axis { start, stop, n }
-    }
-    /// Value `i`.
-    #[inline]
-    pub fn at(&self, i: usize) -> f64 {
-        if self.n <= 1 {
-            self.start
-        } else {
-            self.start + (self.stop - self.start) * (i as f64) / ((self.n - 1) as f64)
-        }
-    }
 }
 
 /// A full-factorial grid over preload × voltage × frequency × torque.

@@ -5,8 +5,8 @@
 //! which differ in form from the candidates the diagnosis fits — and every reading gets
 //! realistic noise. Reproducible from the seed.
 
-use crate::calibrate::{Observable, ObservedRow};
 use crate::error::TrumError;
+use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
 use crate::solve::{solve_prepared, OperatingPoint, Prepared, Status};
 use rand::{RngExt, SeedableRng};

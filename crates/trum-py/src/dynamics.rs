@@ -11,7 +11,9 @@ use trum_core::dynamics::hertz::{
     identify_beta, BetaIdentificationInput, HertzError, HertzOscillator, OperatingPoint, ResponseMethod,
 };
 use trum_core::dynamics::transient::{steady_comparison, step_response, TransientConfig, TransientError};
-use trum_core::layout::{response_rows, response_status, response_summary, ResponseRow, RESPONSE_COLUMNS};
+use trum_core::layout::{
+    response_rows, response_status, response_summary, ResponseCell, ResponseRow, RESPONSE_COLUMNS,
+};
 
 /// The oscillator: defaults with `params` (name, value) applied; a bad name or value is a
 /// `ParameterError` naming the key.
@@ -122,19 +124,30 @@ pub fn hertz_response<'py>(
     // the table `trum resonance -o` writes, as columns
     let rows = response_rows(&family);
     let table = PyDict::new(py);
-    let num = |f: fn(&ResponseRow) -> f64| PyArray::from_vec(py, rows.iter().map(f).collect::<Vec<f64>>());
-    for (name, f) in [
-        ("voltage_v", (|r| r.voltage_v) as fn(&ResponseRow) -> f64),
-        ("preload_n", |r| r.preload_n),
-        ("frequency_hz", |r| r.frequency_hz),
-        ("amplitude_m", |r| r.amplitude_m),
-        ("phase_lag_rad", |r| r.phase_lag_rad),
-    ] {
-        table.set_item(name, num(f))?;
+    // every column of the core's layout: the numbers as arrays, then the words and the
+    // flags as lists (the kind of a column is that of its cell in any row)
+    let cells: Vec<[ResponseCell; 8]> = rows.iter().map(ResponseRow::cells).collect();
+    let kind = |j: usize| ResponseRow::default().cells()[j];
+    for (j, name) in RESPONSE_COLUMNS.iter().enumerate() {
+        if let ResponseCell::Number(_) = kind(j) {
+            let col: Vec<f64> =
+                cells.iter().map(|c| if let ResponseCell::Number(x) = c[j] { x } else { f64::NAN }).collect();
+            table.set_item(*name, PyArray::from_vec(py, col))?;
+        }
     }
-    table.set_item("branch", rows.iter().map(|r| r.branch).collect::<Vec<&str>>())?;
-    table.set_item("status", rows.iter().map(|r| r.status).collect::<Vec<&str>>())?;
-    table.set_item("stable", rows.iter().map(|r| r.stable).collect::<Vec<Option<bool>>>())?;
+    for (j, name) in RESPONSE_COLUMNS.iter().enumerate() {
+        if let ResponseCell::Word(_) = kind(j) {
+            let col: Vec<&str> = cells.iter().map(|c| if let ResponseCell::Word(w) = c[j] { w } else { "" }).collect();
+            table.set_item(*name, col)?;
+        }
+    }
+    for (j, name) in RESPONSE_COLUMNS.iter().enumerate() {
+        if let ResponseCell::Flag(_) = kind(j) {
+            let col: Vec<Option<bool>> =
+                cells.iter().map(|c| if let ResponseCell::Flag(f) = c[j] { f } else { None }).collect();
+            table.set_item(*name, col)?;
+        }
+    }
     let out = PyDict::new(py);
     out.set_item("frequency_hz", PyArray::from_vec(py, freqs))?;
     out.set_item("curves", curves)?;

@@ -17,7 +17,7 @@
 //! - **Instrument floors** are nuisance parameters of the fit itself
 //!   ([`crate::effects::Instrument`]).
 
-use crate::calibrate::{Observable, ObservedRow};
+use crate::observable::{Observable, ObservedRow};
 use std::collections::BTreeMap;
 
 /// Largest coefficient of variation of a run's column that is taken as a constant set

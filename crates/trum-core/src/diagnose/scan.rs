@@ -10,8 +10,9 @@
 //! nominal motor). A valley that lies beyond the fit's bounds, or lower on the scan's rows
 //! than where the fit ended, is handed back as a start.
 
-use crate::calibrate::{residuals, FitParam, ObservedRow, ParamRef};
+use crate::calibrate::{residuals, FitParam, ParamRef};
 use crate::effects::Effect;
+use crate::observable::ObservedRow;
 use crate::params::Motor;
 
 /// Most rows the scan evaluates (evenly spaced through the data).

@@ -14,8 +14,9 @@
 //! negative strength would remove is no evidence for the effect.
 
 use super::pseudo_inverse;
-use crate::calibrate::{residuals, Calibration, ObservedRow};
+use crate::calibrate::{residuals, Calibration};
 use crate::effects::Effect;
+use crate::observable::ObservedRow;
 use nalgebra::{DMatrix, DVector};
 
 /// Probe strength of the primary parameter, as a fraction of its typical value.
@@ -126,7 +127,7 @@ pub(crate) fn overlap(a: &Signature, b: &Signature) -> f64 {
 mod tests {
     use super::*;
     use crate::calibrate::tests::classic_params;
-    use crate::calibrate::{calibrate, FitOptions};
+    use crate::calibrate::FitOptions;
 
     fn rows_of(truth: &crate::Motor) -> Vec<ObservedRow> {
         crate::calibrate::tests::rows_on_grid(truth, &[100.0, 175.0, 250.0, 325.0, 400.0], &[0.0, 0.15, 0.3, 0.45])
@@ -144,7 +145,7 @@ mod tests {
         let rows = rows_of(&truth);
         let fit = FitOptions::default();
         let params = crate::calibrate::tests::classic_params(&nominal, &rows);
-        let base = calibrate(&nominal, &rows, &params, &fit).unwrap();
+        let base = Calibration::builder(&nominal, &rows).params(&params).options(&fit).run().unwrap();
         let sig = signature(&base, &rows, Effect::RadialFriction).unwrap();
         assert!(sig.matched > 0.95, "match {}", sig.matched);
         for e in crate::effects::ALL.into_iter().filter(|&e| e != Effect::RadialFriction) {
@@ -156,7 +157,7 @@ mod tests {
         params.extend(crate::calibrate::effect_params(Effect::RadialFriction));
         let mut start = base.motor.clone();
         start.effects.set(Effect::RadialFriction, &[0.1]);
-        let with = calibrate(&start, &rows, &params, &fit).unwrap();
+        let with = Calibration::builder(&start, &rows).params(&params).options(&fit).run().unwrap();
         let removed = base.chi2 - with.chi2;
         assert!(removed > 0.0 && with.chi2 < 1e-3 * base.chi2, "{} -> {}", base.chi2, with.chi2);
         let ratio = sig.linear_chi2_drop / removed;
@@ -166,7 +167,11 @@ mod tests {
 
         // baseline data: the calibrated baseline fits exactly, nothing is left to explain
         let clean = rows_of(&nominal);
-        let base0 = calibrate(&nominal, &clean, &classic_params(&nominal, &clean), &fit).unwrap();
+        let base0 = Calibration::builder(&nominal, &clean)
+            .params(&classic_params(&nominal, &clean))
+            .options(&fit)
+            .run()
+            .unwrap();
         let s0 = signature(&base0, &clean, Effect::RadialFriction).unwrap();
         assert!(s0.linear_chi2_drop < 1e-6 * sig.linear_chi2_drop.max(1.0), "{}", s0.linear_chi2_drop);
         // overlap is symmetric, 1 with itself, within [0, 1]
@@ -244,7 +249,11 @@ mod tests {
             .collect();
         let fit = FitOptions::default();
         let score = |rows: &[ObservedRow]| {
-            let base = calibrate(&nominal, rows, &classic_params(&nominal, rows), &fit).unwrap();
+            let base = Calibration::builder(&nominal, rows)
+                .params(&classic_params(&nominal, rows))
+                .options(&fit)
+                .run()
+                .unwrap();
             let s = signature(&base, rows, Effect::VoltageSag).unwrap();
             (s.linear_chi2_drop, s.matched, base.chi2)
         };

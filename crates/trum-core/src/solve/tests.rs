@@ -18,7 +18,7 @@ use rand::{RngExt, SeedableRng};
 fn amplitude_map_falls_with_the_load_and_stays_below_the_detuned_bound() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(14);
     let (mut stalled, mut moving) = (0, 0);
-    for name in ["trum60a", "trum60-qut", "generic60"] {
+    for name in crate::presets::PRESETS.iter().map(|p| p.name) {
         for fx in [None, Some(Effect::PreloadStiffening), Some(Effect::HertzSoftening)] {
             let mut m = crate::presets::frozen(name).expect("preset");
             if let Some(e) = fx {
@@ -70,7 +70,7 @@ fn amplitude_map_falls_with_the_load_and_stays_below_the_detuned_bound() {
 fn the_trial_slope_is_the_derivative_of_the_amplitude_residual() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(29);
     let mut seen = [0usize; 4]; // running, stalled, full contact, narrow contact
-    for name in ["trum60a", "trum60-qut", "generic60"] {
+    for name in crate::presets::PRESETS.iter().map(|p| p.name) {
         let m = crate::presets::frozen(name).expect("preset");
         let p = Prepared::new(&m);
         for _ in 0..2000 {

@@ -1,0 +1,208 @@
+//! The calibrated baseline: the full-data fit of the nominal motor's uncertain
+//! parameters, its held-out predictions, errors and evidence, and the held-out NRMSE
+//! that noise alone would give.
+
+use super::candidates::fit_params;
+use super::context::{applied_factor, Context};
+use super::folds::{approx_cv, cross_validate, errors, predict, CvResult};
+use crate::calibrate::Calibration;
+use crate::error::TrumError;
+use crate::observable::{Observable, ObservedRow};
+use crate::params::Motor;
+use std::collections::BTreeMap;
+
+/// The calibrated baseline and its held-out figures.
+pub(super) struct Baseline {
+    /// The full-data fit (the start of every other fit; "where", BIC, reported parameters).
+    pub(super) cal: Calibration,
+    /// Its motor, the start of every candidate's fit.
+    pub(super) start: Motor,
+    /// Held-out predictions, each block by the baseline refitted without it.
+    pub(super) cv: CvResult,
+    /// Held-out NRMSE.
+    pub(super) nrmse: f64,
+    /// Held-out mean squared normalised residual (each reading's clipped at `OUTLIER_Z2`).
+    pub(super) z2: f64,
+    /// Per held-out reading: squared residual over the quantity's scale.
+    pub(super) e2: Vec<f64>,
+    /// Held-out NRMSE that noise alone gives, with the best noise levels
+    /// ([`noise_nrmse_best`]; the reported `noise_nrmse`).
+    pub(super) noise_best: f64,
+    /// BIC of the full-data fit.
+    pub(super) bic: f64,
+}
+
+/// The Bayesian information criterion of a fit with χ² `chi2` and `kpar` parameters on
+/// `n_read` readings: χ² + k·ln n.
+pub(super) fn bic(chi2: f64, kpar: usize, n_read: usize) -> f64 {
+    chi2 + kpar as f64 * (n_read as f64).ln()
+}
+
+/// Calibrates the baseline on all rows of `ctx` and predicts each fold's block held out.
+pub(super) fn fit(ctx: &Context) -> Result<Baseline, TrumError> {
+    let (motor, rows, opts, reduced, sc) = (ctx.motor, &ctx.rows[..], &ctx.opts, ctx.reduced, &ctx.sc);
+    let (folds, k, est) = (&ctx.folds[..], ctx.k, &ctx.est);
+    // full-data baseline fit (the start of every other fit; "where", BIC, reported parameters)
+    let (start0, bparams) = fit_params(motor, motor, rows, &[], reduced, &opts.tolerances);
+    // A baseline that ends with a parameter on a bound is refitted from its own end
+    // (`Calibrate::refit_bounds`). (1000-row benchmark, seeds 31-38: every single fit,
+    // started from the baseline left on the damping bound, first refitted the baseline
+    // whatever its effect.)
+    let base_cal = Calibration::builder(&start0, rows).params(&bparams).options(&opts.fit).refit_bounds(true).run()?;
+    let start = base_cal.motor.clone();
+    let base_cv = if opts.exact_cv {
+        cross_validate(motor, &start, rows, folds, k, &[], opts, reduced)
+    } else {
+        approx_cv(&base_cal, rows, folds, k, &opts.fit)
+    };
+    let (base_nrmse, base_z2, base_e2, _) = errors(rows, &base_cv.preds, sc);
+    // The noise NRMSE reported (the spec's `noise_nrmse`) is the best estimate of what noise
+    // alone gives; the tests beyond the noise below keep the weights' levels, upper bounds
+    // consistent with the χ² the fits minimise (with the best levels in those tests the
+    // blind benchmark lost 3 of its 45 correct verdicts: docs/DIAGNOSIS.md).
+    let noise_best = {
+        // the model's own values, not expected clipped readings
+        let plain: Vec<ObservedRow> =
+            rows.iter().map(|r| ObservedRow { speed_std_clipped: false, ..r.clone() }).collect();
+        let refs: Vec<&ObservedRow> = plain.iter().collect();
+        let best = noise_estimate(motor, &ctx.unscaled, ctx.groups, est);
+        noise_nrmse_best(rows, est, &best, &predict(&base_cal.motor, &refs), sc)
+    };
+    Ok(Baseline {
+        bic: bic(base_cal.chi2, bparams.len(), ctx.n_read),
+        start,
+        cv: base_cv,
+        nrmse: base_nrmse,
+        z2: base_z2,
+        e2: base_e2,
+        noise_best,
+        cal: base_cal,
+    })
+}
+
+/// Noise factors per quantity (`noise::estimate`), each the smaller of two estimates:
+/// from the readings themselves (`raw`, as estimated), and from their residuals from the nominal motor's
+/// predictions. Both are biased upwards only by what the lines through neighbouring
+/// readings cannot follow; the model follows most of the curvature (stall knee, efficiency
+/// peak, resonance) that dominates that bias on coarse grids, the raw readings follow what
+/// the nominal model gets wrong in shape (a temperature time series).
+pub(super) fn noise_estimate(
+    motor: &Motor,
+    rows: &[ObservedRow],
+    groups: &[String],
+    raw: &BTreeMap<Observable, crate::noise::NoiseScale>,
+) -> BTreeMap<Observable, crate::noise::NoiseScale> {
+    let refs: Vec<&ObservedRow> = rows.iter().collect();
+    // (a speed std keeps its readings: whether one is clipped is a property of the reading,
+    // and a residual from a model that predicts a spread is ≤ 0 half the time)
+    let detrended: Vec<ObservedRow> = rows
+        .iter()
+        .zip(predict(motor, &refs))
+        .map(|(r, p)| {
+            let mut r = r.clone();
+            for (x, y) in r.readings.iter_mut().zip(p) {
+                if x.0 != Observable::SpeedStdRpm {
+                    x.1 -= y;
+                }
+            }
+            r
+        })
+        .collect();
+    let model = crate::noise::estimate(&detrended, groups);
+    raw.iter()
+        .map(|(&o, &n)| match model.get(&o) {
+            Some(&m) if m.factor < n.factor => (o, m),
+            _ => (o, n),
+        })
+        .collect()
+}
+
+/// Mean squared residual, over σ², of a reading max(0, m + σZ) (Z standard normal, x = m/σ)
+/// that the bench clips at zero (a speed standard deviation): about its mean when the
+/// reading is compared with the expected clipped reading (`centred`), else about m.
+pub(super) fn clipped_second_moment(x: f64, centred: bool) -> f64 {
+    let (cdf, upper, pdf) = (crate::normal::normal_cdf(x), crate::normal::normal_cdf(-x), crate::normal::normal_pdf(x));
+    // E[(Y/σ − x)²] = Φ(x) − xφ(x) + x²(1 − Φ(x)); the mean of Y/σ − x is φ(x) − x(1 − Φ(x))
+    let about_m = cdf - x * pdf + x * x * upper;
+    let bias = pdf - x * upper;
+    if centred {
+        (about_m - bias * bias).max(0.0)
+    } else {
+        about_m
+    }
+}
+
+/// The held-out NRMSE that noise alone gives, with the best noise levels (`noise_estimate`):
+/// each reading's σ rescaled from the weights' factor `est` to `best`. A speed std is
+/// clipped at zero, its noise taken about the model's value `pred` (or about the expected
+/// clipped reading where it is compared with that). A quantity without an
+/// estimate of its own (fewer than `noise::MIN_TRIPLES` line residuals: the speed std of
+/// one stability run) takes the speed's factor if it is the speed std (the same sensor),
+/// and counts with the smaller of that noise and the baseline's own mean squared residual
+/// for it, both upper bounds of its noise (the default levels are 2.5× the synthetic
+/// bench's for the speed std, whose eight readings then outweighed the rest of the noise).
+pub(super) fn noise_nrmse_best(
+    rows: &[ObservedRow],
+    est: &BTreeMap<Observable, crate::noise::NoiseScale>,
+    best: &BTreeMap<Observable, crate::noise::NoiseScale>,
+    pred: &[Vec<f64>],
+    sc: &BTreeMap<Observable, f64>,
+) -> f64 {
+    let best_factor = |o: Observable| {
+        let same_sensor = o == Observable::SpeedStdRpm && !best.contains_key(&o);
+        applied_factor(best, if same_sensor { Observable::SpeedRpm } else { o })
+    };
+    // per quantity: Σ noise²/sc², Σ residual²/sc²
+    let mut acc: BTreeMap<Observable, (f64, f64)> = BTreeMap::new();
+    let mut n = 0usize;
+    for (r, p) in rows.iter().zip(pred) {
+        for (&(o, y, s), &m) in r.readings.iter().zip(p) {
+            let sigma = s / applied_factor(est, o) * best_factor(o);
+            let var = if o == Observable::SpeedStdRpm && sigma > 0.0 {
+                let x = if m.is_finite() { m / sigma } else { 0.0 };
+                sigma * sigma * clipped_second_moment(x, r.speed_std_clipped)
+            } else {
+                sigma * sigma
+            };
+            let e = acc.entry(o).or_default();
+            e.0 += var / sc[&o].powi(2);
+            e.1 += if m.is_finite() { (m - y).powi(2) / sc[&o].powi(2) } else { f64::INFINITY };
+            n += 1;
+        }
+    }
+    let total: f64 =
+        acc.iter().map(|(o, &(noise, res))| if best.contains_key(o) { noise } else { noise.min(res) }).sum();
+    (total / n.max(1) as f64).sqrt()
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
+mod tests {
+    use super::super::tests::{data, quick, sag_data};
+    use super::*;
+
+    /// Data of the nominal motor itself: the calibrated baseline predicts held-out regions
+    /// at the noise level, its NRMSE near what noise alone gives. Data with a voltage sag
+    /// the baseline cannot follow: a held-out gap well beyond the noise. The BIC is
+    /// χ² + k·ln n of the full-data fit.
+    #[test]
+    fn the_baseline_misses_held_out_data_only_where_an_effect_is_missing() {
+        let nominal = crate::calibrate::tests::reference_motor();
+        let (rows, groups) = data(&nominal, 1.0, 5);
+        let ctx = Context::new(&nominal, &rows, &groups, &quick(false)).unwrap();
+        let base = fit(&ctx).unwrap();
+        assert!(base.z2 < 2.0, "held-out χ² per reading {}", base.z2);
+        assert!(base.nrmse < 1.5 * base.noise_best, "NRMSE {} against noise {}", base.nrmse, base.noise_best);
+        assert!(base.cv.preds.iter().flatten().all(|p| p.is_finite()));
+        assert_eq!(base.e2.len(), ctx.n_read);
+        let k = base.cal.params.len();
+        assert!((base.bic - (base.cal.chi2 + k as f64 * (ctx.n_read as f64).ln())).abs() < 1e-9 * base.bic);
+        assert_eq!(base.start, base.cal.motor);
+
+        let (nominal, rows, groups) = sag_data();
+        let ctx = Context::new(&nominal, &rows, &groups, &quick(false)).unwrap();
+        let sag = fit(&ctx).unwrap();
+        assert!(sag.z2 > 4.0, "held-out χ² per reading {}", sag.z2);
+        assert!(sag.nrmse > 2.0 * sag.noise_best, "NRMSE {} against noise {}", sag.nrmse, sag.noise_best);
+    }
+}

@@ -1,0 +1,352 @@
+//! The sim-to-real gap diagnosis (`shared/spec/diagnose.md`): where the calibrated
+//! baseline misses, which unmodelled effect causes it, and how far the gap shrinks on
+//! held-out operating regions once that effect is added.
+//!
+//! Method (docs/DIAGNOSIS.md):
+//! 1. Rows are grouped into operating regions (run, preload level, frequency band, time
+//!    window); regions are dealt round-robin into K folds — block cross-validation, never
+//!    random rows, so a held-out block is an operating region the fit never saw.
+//! 2. The baseline is calibrated on each training set and predicts its held-out block;
+//!    the held-out normalised error is compared with the noise level.
+//! 3. Every candidate effect is refitted together with the baseline parameters the same
+//!    way and scored by its held-out error and by the BIC of the full-data fit (evidence =
+//!    ½·ΔBIC, a log Bayes factor: > 3 strong, > 5 very strong). Pairs of the best
+//!    candidates follow when no single one closes the gap or when two are supported, and
+//!    win only by beating the best single on held-out data as well as in evidence.
+//!    Each candidate's sensitivity signature (`signature`) is compared with the baseline's
+//!    residual pattern (a score test) and with the verdict's signature: effects whose
+//!    signatures the data see as one shape are reported as confounded; at the lead effect's
+//!    fit the same test screens which second effects are worth a pair fit.
+//! 4. Where: baseline residuals grouped by quantity and region; a group is reported when
+//!    its mean normalised residual is more than 3.5 standard errors from zero (z-test;
+//!    3.5 keeps the family-wise false-alarm rate near 1 % over ~50 groups).
+//!
+//! The stages, each in a module of its own over one context (`context::Context`): the prepared
+//! rows and their `folds`, the calibrated `baseline`, the `candidates` scored (and their
+//! `pairs`), the `verdict`, and where the gap lies (`where_`).
+
+mod baseline;
+mod bench;
+mod candidates;
+mod context;
+mod folds;
+pub mod json;
+mod pairs;
+mod scan;
+mod signature;
+#[cfg(test)]
+mod tests;
+mod verdict;
+mod where_;
+
+use crate::calibrate::FitOptions;
+use crate::effects::{Effect, ALL};
+use crate::error::TrumError;
+use crate::observable::{Observable, ObservedRow};
+use crate::params::Motor;
+use crate::solve::Status;
+use candidates::{Fits, Scorer};
+use context::Context;
+use folds::pseudo_inverse;
+pub use folds::OUTLIER_Z2;
+use std::collections::BTreeMap;
+use verdict::{GapTests, Verdict};
+
+/// Options of a diagnosis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DiagnoseOptions {
+    /// Number of cross-validation folds (≥ 2).
+    pub folds: usize,
+    /// Candidate effects (all seven by default).
+    pub candidates: Vec<Effect>,
+    /// Try pairs of the best candidates when no single effect closes the gap.
+    pub try_pairs: bool,
+    /// Bootstrap resamples for the shrink interval.
+    pub bootstrap: usize,
+    /// Seed of the bootstrap.
+    pub seed: u64,
+    /// Calibration settings.
+    pub fit: FitOptions,
+    /// Refit every model on every training fold (slow) instead of the approximate
+    /// leave-block-out refit from the full-data optimum (the default; docs/DIAGNOSIS.md).
+    pub exact_cv: bool,
+    /// Relative tolerances of baseline parameters in place of the defaults
+    /// ([`crate::calibrate::baseline_params_with`]): dotted key → prior standard deviation
+    /// of the logarithm (0 holds a parameter at its nominal value).
+    pub tolerances: BTreeMap<String, f64>,
+}
+
+impl Default for DiagnoseOptions {
+    fn default() -> Self {
+        DiagnoseOptions {
+            folds: 4,
+            candidates: ALL.to_vec(),
+            try_pairs: true,
+            bootstrap: 200,
+            seed: 7,
+            fit: FitOptions { huber_k: 3.0, irls_passes: 1, max_evaluations: 300, ..FitOptions::default() },
+            exact_cv: false,
+            tolerances: BTreeMap::new(),
+        }
+    }
+}
+
+/// A region where the baseline misses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GapRegion {
+    /// Measured quantity (column name).
+    pub quantity: String,
+    /// Region in words, e.g. `torque_nm < 0.3`.
+    pub region: String,
+    /// Mean residual measured − model, in the quantity's unit.
+    pub mean_residual: f64,
+    /// Readings in the region.
+    pub n: usize,
+    /// z statistic of the mean normalised residual.
+    pub z: f64,
+}
+
+/// One candidate's score.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RankEntry {
+    /// Effect name, or two names joined with `+`.
+    pub effect: String,
+    /// ½·(BIC_baseline − BIC_effect) on the full data (larger = stronger).
+    pub evidence: f64,
+    /// Held-out NRMSE with the effect added.
+    pub heldout_nrmse_after: f64,
+    /// Held-out mean squared normalised residual with the effect added (1 = noise level).
+    pub heldout_chi2_after: f64,
+    /// 1 − after/before on the held-out readings.
+    pub shrink: f64,
+    /// Bootstrap 90 % interval of the shrink.
+    pub shrink_interval: (f64, f64),
+    /// Fitted effect parameters on the full data (name, value).
+    pub params: Vec<(String, f64)>,
+    /// Score test at the calibrated baseline (single effects): cos of the angle between
+    /// the baseline's residual and the effect's signature, signed so that +1 means the
+    /// effect, raised from zero, moves the model exactly towards the data.
+    pub signature_match: Option<f64>,
+    /// Score test at the calibrated baseline: the χ² the effect removes to first order.
+    pub linear_chi2_drop: Option<f64>,
+    /// |cos| between this effect's signature and the verdict's (1: the data see one shape).
+    pub signature_overlap: Option<f64>,
+    /// Cross-validation folds whose refit could not be moved off this fit's full-data
+    /// optimum, so their held-out blocks were predicted in-sample (the held-out figures are
+    /// then optimistic; 0 with exact CV, and for an entry its nested model stands in for).
+    pub heldout_in_sample_folds: usize,
+}
+
+/// The diagnosis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Diagnosis {
+    /// One effect, several joined with `+`, `none` or `unexplained`.
+    pub verdict: String,
+    /// True when the verdict leaves no held-out gap beyond the noise (`none`, or an effect
+    /// that closes the gap); false for `unexplained` and for an effect named because it
+    /// closes a material part of the gap but not all of it.
+    pub complete: bool,
+    /// Effects that explain the data about as well as the verdict.
+    pub confounded_with: Vec<String>,
+    /// With an `unexplained` verdict, the supported effect that explains part of the gap
+    /// (the strongest; its ranking entry says how much): present, but not all that is
+    /// missing. `None` for every other verdict, and when no effect is supported.
+    pub partial: Option<String>,
+    /// Held-out NRMSE of the calibrated baseline.
+    pub baseline_heldout_nrmse: f64,
+    /// Held-out NRMSE the measurement noise alone would give, with the best noise levels
+    /// (`noise_nrmse_best`): what a model without error would score.
+    pub noise_nrmse: f64,
+    /// The same with the noise levels the fits weigh readings by (upper bounds: the
+    /// verdict's tests beyond the noise use these).
+    pub noise_nrmse_weights: f64,
+    /// Held-out mean squared normalised residual of the baseline (1 = at noise level).
+    pub baseline_heldout_chi2_per_reading: f64,
+    /// Noise levels estimated from the data (crate::noise): quantity, factor applied to
+    /// the stated noise levels, line residuals it rests on.
+    pub noise_scale: Vec<(String, f64, usize)>,
+    /// Where the gap lies.
+    pub gap_where: Vec<GapRegion>,
+    /// Every candidate tried, strongest first.
+    pub ranking: Vec<RankEntry>,
+    /// What the data can and cannot support.
+    pub notes: Vec<String>,
+    /// Rows, readings, regions and folds used.
+    pub n_rows: usize,
+    /// Readings used.
+    pub n_readings: usize,
+    /// Folds used.
+    pub folds: usize,
+    /// Baseline parameters calibrated on all data (name, value).
+    pub baseline_params: Vec<(String, f64)>,
+    /// Per held-out reading: (row index, observable, measured, baseline prediction,
+    /// prediction with the verdict's effects) — for plots.
+    pub heldout: Vec<HeldOut>,
+}
+
+/// One held-out reading with its predictions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeldOut {
+    /// Row index in the input.
+    pub row: usize,
+    /// What was measured.
+    pub observable: Observable,
+    /// Measured value.
+    pub measured: f64,
+    /// Baseline prediction (trained without this row's region).
+    pub baseline: f64,
+    /// Prediction with the verdict's effect(s) (equal to baseline for `none`).
+    pub after: f64,
+}
+
+/// The quantity scales of the held-out NRMSEs a diagnosis of `rows` (runs `groups`)
+/// reports ([`scales`] with the noise levels it estimates from the data): for outside
+/// figures on the same scale, such as the blind benchmark's model without error.
+pub fn nrmse_scales(rows: &[ObservedRow], groups: &[String]) -> BTreeMap<Observable, f64> {
+    let groups = &bench::runs(rows, groups)[..];
+    let rows = context::bench_model(rows, groups).0;
+    context::scales(&context::noise_scaled(&rows, &crate::noise::estimate(&rows, groups)))
+}
+
+/// Diagnoses `rows` (with `groups[i]` the run of row i; empty strings are fine) against
+/// `motor`. Errors on data that cannot support any held-out test.
+pub fn diagnose(
+    motor: &Motor,
+    rows: &[ObservedRow],
+    groups: &[String],
+    opts: &DiagnoseOptions,
+) -> Result<Diagnosis, TrumError> {
+    // runs inferred from the set points where the data name none
+    let named = groups.iter().any(|g| !g.is_empty());
+    let groups = &bench::runs(rows, groups)[..];
+    let mut ctx = Context::new(motor, rows, groups, opts)?;
+    let mut notes = std::mem::take(&mut ctx.notes);
+    if !named && !rows.is_empty() {
+        let n = groups.iter().collect::<std::collections::BTreeSet<_>>().len();
+        notes.insert(
+            0,
+            format!("the data name no runs (run_id): {n} run(s) inferred from the preload and voltage levels"),
+        );
+    }
+    let ctx = ctx;
+    let base = baseline::fit(&ctx)?;
+    // candidates in parallel; each returns its entry and its held-out predictions
+    let probes = candidates::probe(&ctx, &base);
+    notes.extend(probes.at_rest_note.clone());
+    let scorer = Scorer::new(&ctx, &base, &probes);
+    let mut fits = Fits::default();
+    let mut ranking = candidates::score_singles(&scorer, &mut fits);
+
+    let tests = GapTests { base_nrmse: base.nrmse, gap_noise: base.noise_best };
+    // The gap is real when the baseline misses held-out data beyond twice the noise
+    // variance, or when some effect closes a material part of it (a small, consistent gap).
+    let gap = base.z2 > 2.0 || ranking.iter().any(|r| tests.material(r));
+    let mut decided = Verdict {
+        verdict: String::from("none"),
+        complete: true,
+        confounded: Vec::new(),
+        partial: None,
+        notes: Vec::new(),
+    };
+    let mut screened_note = None;
+    if gap {
+        let best_single = ranking.iter().find(|r| GapTests::supported(r)).cloned();
+        let single_closes = best_single.as_ref().is_some_and(|b| tests.closes(b));
+        // Pairs are tried when no single effect closes the gap, and also when one does: it
+        // may close the gap on average yet leave another effect's signature in one quantity
+        // or corner of the data, and that second effect need not be supported on its own
+        // (the first one's gap dominates its single fit). Which second effects are worth a
+        // pair fit is screened by their score test at the lead's fit (`pairs`).
+        let mut best_pair = None;
+        if ctx.opts.try_pairs && ranking.len() >= 2 {
+            (best_pair, screened_note) =
+                pairs::fit_pairs(&scorer, &mut fits, &mut ranking, &best_single, single_closes);
+        }
+        decided = verdict::decide(
+            &ctx,
+            &tests,
+            &mut ranking,
+            &fits.cv_preds,
+            best_single,
+            single_closes,
+            best_pair,
+            &probes.base_sigs,
+        );
+        notes.append(&mut decided.notes);
+    } else {
+        notes.push(format!(
+            "the calibrated baseline predicts the held-out regions at the noise level (mean squared normalised residual {:.2}) and no candidate effect is supported; no effect is needed",
+            base.z2
+        ));
+    }
+    let Verdict { verdict, complete, confounded, partial, .. } = decided;
+    notes.extend(screened_note);
+    notes.extend(scorer.into_notes());
+    notes.extend(folds::in_sample_note(base.cv.in_sample, &ranking, ctx.k));
+    if ctx.reduced && verdict != "none" {
+        notes.push(format!("with so few readings the verdict '{verdict}' is tentative; measure more operating points"));
+    }
+    let (gap_where, where_note) = where_::locate(&ctx, &base);
+    notes.extend(where_note);
+    let heldout = held_out(&ctx.rows, &base.cv.preds, &fits.cv_preds, &verdict);
+    Ok(Diagnosis {
+        verdict,
+        complete,
+        confounded_with: confounded,
+        partial,
+        baseline_heldout_nrmse: base.nrmse,
+        noise_nrmse: base.noise_best,
+        noise_nrmse_weights: ctx.noise_weights,
+        baseline_heldout_chi2_per_reading: base.z2,
+        noise_scale: ctx.noise_scale.clone(),
+        gap_where,
+        ranking,
+        notes,
+        n_rows: ctx.rows.len(),
+        n_readings: ctx.n_read,
+        folds: ctx.k,
+        baseline_params: base.cal.params.iter().map(|p| (p.name.clone(), p.value)).collect(),
+        heldout,
+    })
+}
+
+/// Every reading of `rows` with its baseline held-out prediction (`base_preds`) and the
+/// held-out prediction with the verdict's effects (from `cv_preds`; the baseline's for
+/// `none`). Pairs were scored under the unsorted name, so they are looked up by the set of
+/// names.
+fn held_out(
+    rows: &[ObservedRow],
+    base_preds: &[Vec<f64>],
+    cv_preds: &BTreeMap<String, Vec<Vec<f64>>>,
+    verdict: &str,
+) -> Vec<HeldOut> {
+    let after_preds =
+        cv_preds.iter().find(|(name, _)| same_set(name, verdict)).map(|(_, p)| &p[..]).unwrap_or(base_preds);
+    let mut heldout = Vec::new();
+    for (i, r) in rows.iter().enumerate() {
+        for (j, &(o, v, _)) in r.readings.iter().enumerate() {
+            heldout.push(HeldOut {
+                row: i,
+                observable: o,
+                measured: v,
+                baseline: base_preds[i][j],
+                after: after_preds[i][j],
+            });
+        }
+    }
+    heldout
+}
+
+/// Two effect lists (`a+b`) name the same set.
+pub fn same_set(a: &str, b: &str) -> bool {
+    let mut x: Vec<&str> = a.split('+').collect();
+    let mut y: Vec<&str> = b.split('+').collect();
+    x.sort_unstable();
+    y.sort_unstable();
+    x == y
+}
+
+/// True for rows where the model must run (used by callers to pre-check data).
+pub fn status_ok(s: Status) -> bool {
+    s.is_valid()
+}

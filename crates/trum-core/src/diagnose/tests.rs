@@ -1,0 +1,581 @@
+//! Tests of the whole diagnosis and of its helpers.
+
+use super::baseline::clipped_second_moment;
+use super::candidates::{added_near_zero, fit_params};
+use super::context::{noise_scaled, scales, speed_std_clipped};
+use super::folds::{approx_cv, predict};
+use super::pairs::{first_order_gains, held_out_need, pair_gains, pair_may_beat, worth_pair_fit, PAIR_GAIN};
+use super::*;
+use crate::calibrate::tests::classic_tolerances;
+use crate::calibrate::{residuals, Calibration, FittedParam, ParamRef};
+use crate::synth::{synthesize, Campaign, SynthConfig};
+
+pub(super) fn data(m: &Motor, noise: f64, seed: u64) -> (Vec<ObservedRow>, Vec<String>) {
+    let cfg = SynthConfig { campaign: Campaign::PreloadTorque, noise, seed, ..SynthConfig::default() };
+    let rows = synthesize(m, &cfg).expect("synth");
+    (rows.iter().map(|r| r.observed()).collect(), rows.iter().map(|r| r.run_id.clone()).collect())
+}
+
+pub(super) fn quick(exact_cv: bool) -> DiagnoseOptions {
+    DiagnoseOptions {
+        candidates: vec![Effect::VoltageSag, Effect::PreloadStiffening],
+        try_pairs: false,
+        bootstrap: 50,
+        exact_cv,
+        ..DiagnoseOptions::default()
+    }
+}
+
+/// The nominal trum60a and seeded preload-torque data of it with voltage sag (300 Ω).
+pub(super) fn sag_data() -> (Motor, Vec<ObservedRow>, Vec<String>) {
+    let mut m = crate::calibrate::tests::reference_motor();
+    m.effects.set_strength(Effect::VoltageSag, 300.0);
+    let (rows, groups) = data(&m, 1.0, 11);
+    (crate::calibrate::tests::reference_motor(), rows, groups)
+}
+
+/// A fold step that overshoots is halved until the training fit improves, not dropped:
+/// with the Jacobian four times too small the full step is four times too long, and the
+/// damped route still removes the held-out block's influence (predictions as with the
+/// right Jacobian), where dropping the step left the full-data fit, predicting the
+/// held-out block in-sample.
+#[test]
+fn an_overshooting_fold_step_is_damped_not_dropped() {
+    let (nominal, rows, _) = sag_data();
+    let fit = FitOptions::default();
+    let (s0, params) = fit_params(&nominal, &nominal, &rows, &[], false, &BTreeMap::new());
+    let cal = Calibration::builder(&s0, &rows).params(&params).options(&fit).run().expect("baseline");
+    // folds by preload, so each held-out block moves the parameters
+    let mut loads: Vec<f64> = rows.iter().map(|r| r.op.preload_n).collect();
+    loads.sort_by(f64::total_cmp);
+    loads.dedup();
+    let folds: Vec<usize> =
+        rows.iter().map(|r| loads.iter().position(|&l| l == r.op.preload_n).unwrap_or(0) % 4).collect();
+    let right = approx_cv(&cal, &rows, &folds, 4, &fit);
+    assert_eq!(right.in_sample, 0);
+    let right = right.preds;
+    let mut short = cal.clone();
+    short.lin.jacobian *= 0.25;
+    let damped = approx_cv(&short, &rows, &folds, 4, &fit);
+    assert_eq!(damped.in_sample, 0);
+    let damped = damped.preds;
+    let all: Vec<&ObservedRow> = rows.iter().collect();
+    let in_sample = predict(&cal.motor, &all);
+    // largest difference in units of the readings' σ
+    let sigmas: Vec<f64> = rows.iter().flat_map(|r| r.readings.iter().map(|x| x.2)).collect();
+    let gap = |a: &[Vec<f64>], b: &[Vec<f64>]| {
+        let d = a.iter().flatten().zip(b.iter().flatten()).zip(&sigmas).map(|((x, y), s)| ((x - y) / s).abs());
+        d.fold(0.0, f64::max)
+    };
+    let moved = gap(&right, &in_sample);
+    assert!(moved > 0.3, "the held-out blocks do not move the fit: {moved} σ");
+    assert!(gap(&damped, &right) < 0.2 * moved, "damped {} vs held-out shift {moved}", gap(&damped, &right));
+    // 64 times too long: even a quarter of it overshoots, the folds keep the full-data
+    // fit and say so
+    short.lin.jacobian *= 1.0 / 16.0;
+    let stuck = approx_cv(&short, &rows, &folds, 4, &fit);
+    assert_eq!(stuck.in_sample, 4);
+    assert!(gap(&stuck.preds, &in_sample) < 1e-9, "{}", gap(&stuck.preds, &in_sample));
+}
+
+/// The residual moments of a reading clipped at zero, against direct integration over
+/// the normal density.
+#[test]
+fn clipped_noise_moments_are_those_of_the_clipped_normal() {
+    let phi = |z: f64| (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    for x in [-3.0f64, -1.0, -0.2, 0.0, 0.7, 2.0, 6.0] {
+        // Y = max(0, x + Z): zero below z = −x
+        let zero = (-x).max(-12.0);
+        let below = crate::quad::integral(phi, -12.0, zero);
+        let m1 = crate::quad::integral(|z| (x + z) * phi(z), zero, 12.0);
+        let m2 = crate::quad::integral(|z| (x + z) * (x + z) * phi(z), zero, 12.0);
+        let about_m = m2 - 2.0 * x * m1 + x * x * (below + crate::quad::integral(phi, zero, 12.0));
+        let var = m2 - m1 * m1;
+        assert!(
+            (clipped_second_moment(x, false) - about_m).abs() < 1e-9,
+            "x {x}: {} vs {about_m}",
+            clipped_second_moment(x, false)
+        );
+        assert!(
+            (clipped_second_moment(x, true) - var).abs() < 1e-9,
+            "x {x}: {} vs {var}",
+            clipped_second_moment(x, true)
+        );
+    }
+    assert!((clipped_second_moment(0.0, true) - (0.5 - 0.5 / std::f64::consts::PI)).abs() < 1e-15);
+}
+
+/// On data without any effect a model without error scores the noise alone: the
+/// reported noise NRMSE is the baseline's held-out NRMSE within their scatter (over six
+/// seeds 0.91-1.13 in the preload-torque campaign and 0.98-1.20 in the combined one;
+/// the weights' upper-bound levels give 1.5-1.8 and 3.3-4.1), and never above the
+/// weights' level.
+#[test]
+fn the_noise_nrmse_is_what_a_model_without_error_scores() {
+    let m = crate::calibrate::tests::reference_motor();
+    let opts = DiagnoseOptions {
+        candidates: vec![Effect::VoltageSag],
+        try_pairs: false,
+        bootstrap: 20,
+        ..DiagnoseOptions::default()
+    };
+    for campaign in [Campaign::PreloadTorque, Campaign::Combined] {
+        for seed in [1, 2, 3] {
+            let cfg = SynthConfig { campaign, noise: 1.0, seed, ..SynthConfig::default() };
+            let synth = synthesize(&m, &cfg).expect("synth");
+            let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
+            let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+            let d = diagnose(&m, &rows, &groups, &opts).expect("diagnosis");
+            let ratio = d.noise_nrmse / d.baseline_heldout_nrmse;
+            assert!(
+                (0.8..1.3).contains(&ratio),
+                "{campaign:?} seed {seed}: noise {} vs baseline {}",
+                d.noise_nrmse,
+                d.baseline_heldout_nrmse
+            );
+            assert!(d.noise_nrmse <= d.noise_nrmse_weights, "{} > {}", d.noise_nrmse, d.noise_nrmse_weights);
+            assert_eq!(d.verdict, "none");
+        }
+    }
+}
+
+#[test]
+fn approximate_and_exact_block_cross_validation_agree() {
+    let (nominal, rows, groups) = sag_data();
+    let a = diagnose(&nominal, &rows, &groups, &quick(false)).expect("approximate");
+    let e = diagnose(&nominal, &rows, &groups, &quick(true)).expect("exact");
+    // the refit step is first-order: held-out errors within 10 %, same verdict
+    let rel = (a.baseline_heldout_nrmse / e.baseline_heldout_nrmse - 1.0).abs();
+    assert!(rel < 0.1, "baseline held-out NRMSE {} vs {}", a.baseline_heldout_nrmse, e.baseline_heldout_nrmse);
+    assert_eq!(a.verdict, e.verdict);
+    assert_eq!(a.verdict, "voltage_sag");
+    let sag = |d: &Diagnosis| d.ranking.iter().find(|r| r.effect == "voltage_sag").map(|r| r.shrink).unwrap_or(0.0);
+    assert!((sag(&a) - sag(&e)).abs() < 0.1, "shrink {} vs {}", sag(&a), sag(&e));
+}
+
+#[test]
+fn noisier_bench_than_assumed_is_not_mistaken_for_an_effect() {
+    // three times the nominal bench noise: the stated noise levels are too small, the
+    // estimate from the data rescales them, and nothing is claimed
+    let m = crate::calibrate::tests::reference_motor();
+    let (rows, groups) = data(&m, 3.0, 5);
+    let d = diagnose(&m, &rows, &groups, &quick(false)).expect("diagnosis");
+    assert_eq!(d.verdict, "none", "{:?}", d.ranking);
+    let speed = d.noise_scale.iter().find(|(q, _, _)| q == "speed_rpm").expect("speed noise estimated");
+    assert!(speed.1 > 1.0, "{speed:?}");
+}
+
+/// The pair screen's first-order gains are what a refit removes, in both held-out
+/// measures' terms: on noise-free data of moderate radial friction (0.6: the calibrated
+/// baseline's Huber weights go down to 0.45, and they are taken back out), at the
+/// calibrated baseline, against the refit with the effect; and the pair screen's bars
+/// on them.
+#[test]
+fn first_order_gains_are_what_the_refit_removes() {
+    let nominal = crate::calibrate::tests::reference_motor();
+    let mut truth = nominal.clone();
+    truth.effects.set(Effect::RadialFriction, &[0.6]);
+    let loads = [100.0, 175.0, 250.0, 325.0, 400.0];
+    let rows = crate::calibrate::tests::rows_on_grid(&truth, &loads, &[0.0, 0.15, 0.3, 0.45]);
+    let fit = FitOptions::default();
+    let (s0, params) = fit_params(&nominal, &nominal, &rows, &[], false, &classic_tolerances());
+    let base = Calibration::builder(&s0, &rows).params(&params).options(&fit).run().expect("baseline");
+    let sig = signature::signature(&base, &rows, Effect::RadialFriction).expect("signature");
+    let sc = scales(&rows);
+    let (d_chi2, d_e2) = first_order_gains(&base, &rows, &sig, &sc);
+    let (s1, params) =
+        fit_params(&nominal, &base.motor, &rows, &[Effect::RadialFriction], false, &classic_tolerances());
+    let with = Calibration::builder(&s1, &rows)
+        .params(&params)
+        .options(&fit)
+        .adding(&[Effect::RadialFriction])
+        .run()
+        .expect("refit");
+    assert!(!with.abandoned);
+    // Σ z² and Σ e² of a motor's residuals
+    let sums = |m: &Motor| {
+        let z = residuals(m, &rows);
+        let scale = rows.iter().flat_map(|r| r.readings.iter().map(|&(o, _, s)| s / sc[&o]));
+        z.iter().zip(scale).fold((0.0, 0.0), |a, (z, k)| (a.0 + z * z, a.1 + (z * k).powi(2)))
+    };
+    let (b, a) = (sums(&base.motor), sums(&with.motor));
+    assert!(a.0 < 1e-2 * b.0, "the refit removes the gap: {} -> {}", b.0, a.0);
+    let (r_chi2, r_e2) = (d_chi2 / (b.0 - a.0), d_e2 / (b.1 - a.1));
+    assert!((0.8..=1.05).contains(&r_chi2), "χ²: first order {d_chi2} vs refit {}", b.0 - a.0);
+    assert!((0.8..=1.05).contains(&r_e2), "Σe²: first order {d_e2} vs refit {}", b.1 - a.1);
+
+    // the screen on these gains: a quarter of what is needed in either held-out measure
+    let worth = |held| worth_pair_fit(Some(&base), &rows, Effect::RadialFriction, 10.0, held, &sc).0;
+    assert!(worth(None));
+    assert!(worth(Some((3.9 * d_chi2, f64::INFINITY))) && worth(Some((0.0, 3.9 * d_e2))));
+    assert!(!worth(Some((4.1 * d_chi2, 4.1 * d_e2))));
+    // nothing to remove beyond the noise: no pair can beat the lead
+    assert!(!worth(Some((0.0, 0.0))));
+    // the evidence bar still holds on its own
+    let (worth_it, why) =
+        worth_pair_fit(Some(&base), &rows, Effect::RadialFriction, 4.1 * sig.linear_chi2_drop, None, &sc);
+    assert!(!worth_it && why.starts_with("score Δχ²"), "{why}");
+    // a failed held-out bar says so, with its numbers
+    let (worth_it, why) =
+        worth_pair_fit(Some(&base), &rows, Effect::RadialFriction, 10.0, Some((4.1 * d_chi2, 4.1 * d_e2)), &sc);
+    assert!(!worth_it && why.starts_with("Σz² ") && why.contains(" and Σe² "), "{why}");
+
+    // the screen of pairs that lead nothing, with the baseline as the first effect's fit
+    // (evidence 0): the pair must remove 2·best + ln n + 10 to beat a best single of
+    // evidence `best`; fitted when the first-order gain is a quarter of that
+    let ln_n = (rows.iter().map(|r| r.readings.len()).sum::<usize>() as f64).ln();
+    let may = |need_over_gain: f64| {
+        let best = 0.5 * (need_over_gain * d_chi2 - ln_n - 10.0);
+        pair_may_beat(&base, 0.0, best, &rows, Effect::RadialFriction, &sc)
+    };
+    assert_eq!(may(3.9), Some(true));
+    assert_eq!(may(4.1), Some(false));
+    // an effect the fit already carries has no signature: nothing to screen on
+    assert_eq!(pair_may_beat(&with, 0.0, 1e9, &rows, Effect::RadialFriction, &sc), None);
+}
+
+/// An effect that moves no prediction of the rows (thermal drift without a time series)
+/// is ranked with the baseline's fit and its parameter penalty, not fitted; the other
+/// candidate is.
+#[test]
+fn an_effect_the_data_cannot_see_is_not_fitted() {
+    let (nominal, rows, groups) = sag_data();
+    let opts = DiagnoseOptions { candidates: vec![Effect::VoltageSag, Effect::ThermalDrift], ..quick(false) };
+    let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+    let entry = |name: &str| d.ranking.iter().find(|r| r.effect == name).expect("ranked");
+    let thermal = entry("thermal_drift");
+    let penalty = 0.5 * Effect::ThermalDrift.info().params.len() as f64 * (d.n_readings as f64).ln();
+    assert!(thermal.params.is_empty() && thermal.shrink == 0.0, "{thermal:?}");
+    assert!((thermal.evidence + penalty).abs() < 1e-9 * penalty, "{} vs −{penalty}", thermal.evidence);
+    assert!(thermal.signature_match.is_none());
+    let sag = entry("voltage_sag");
+    assert!(!sag.params.is_empty() && sag.evidence > 5.0 && sag.signature_match.is_some(), "{sag:?}");
+    assert!(d.notes.iter().any(|n| n.contains("thermal_drift cannot act")));
+    // the same when the nominal motor already carries it (no probe then: switched off)
+    let mut carrying = nominal.clone();
+    let typical: Vec<f64> = Effect::ThermalDrift.info().params.iter().map(|p| p.typical).collect();
+    carrying.effects.set(Effect::ThermalDrift, &typical);
+    let d = diagnose(&carrying, &rows, &groups, &opts).expect("diagnosis");
+    let thermal = d.ranking.iter().find(|r| r.effect == "thermal_drift").expect("ranked");
+    assert!(thermal.params.is_empty() && thermal.shrink == 0.0, "{thermal:?}");
+}
+
+/// One motor (`motor_seed` = `seed`) measured in a run of `campaign` at each drive
+/// voltage, noise seeds `seed`, `seed` + 1, ...; run ids prefixed with the voltage.
+fn one_motor(truth: &Motor, campaign: Campaign, seed: u64, voltages: &[f64]) -> (Vec<ObservedRow>, Vec<String>) {
+    let (mut rows, mut groups) = (Vec::new(), Vec::new());
+    for (i, &v) in voltages.iter().enumerate() {
+        let cfg = SynthConfig {
+            campaign,
+            seed: seed + i as u64,
+            motor_seed: Some(seed),
+            voltage_v: v,
+            ..SynthConfig::default()
+        };
+        for r in synthesize(truth, &cfg).expect("synth") {
+            rows.push(r.observed());
+            groups.push(format!("v{v}-{}", r.run_id));
+        }
+    }
+    (rows, groups)
+}
+
+/// `trum60a` with `effect` at `strength` (truth forms), synthesised on `campaign` at
+/// `noise` with `seed`, diagnosed with single `candidates` only (no pairs).
+fn diagnosed_single(
+    effect: Effect,
+    strength: f64,
+    campaign: Campaign,
+    noise: f64,
+    seed: u64,
+    candidates: &[Effect],
+) -> Diagnosis {
+    let nominal = crate::calibrate::tests::reference_motor();
+    let mut truth = nominal.clone();
+    truth.effects.set_strength(effect, strength);
+    let cfg = SynthConfig { campaign, noise, seed, ..SynthConfig::default() };
+    let synth = synthesize(&truth, &cfg).expect("synth");
+    let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
+    let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+    let opts = DiagnoseOptions {
+        candidates: candidates.to_vec(),
+        try_pairs: false,
+        bootstrap: 200,
+        // (mechanism tests written on the classic baseline)
+        tolerances: classic_tolerances(),
+        ..DiagnoseOptions::default()
+    };
+    diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis")
+}
+
+/// On a `combined` campaign the weights' noise levels put the whole held-out NRMSE of
+/// the baseline inside the noise, where noise alone gives a small fraction of it. The
+/// test "half of the NRMSE beyond the noise is gone" measured against the weights'
+/// level would then hold for every supported effect, and a `radial_friction` closing a
+/// fifth of a preload-stiffening gap would pass for the whole answer. Against the best
+/// noise estimate it closes only part: named, as the best partial explanation among the
+/// candidates (the truth is left out of them), with `complete: false`.
+#[test]
+fn a_gap_inside_the_weights_noise_is_not_closed_by_every_effect() {
+    let d = diagnosed_single(Effect::PreloadStiffening, 0.05, Campaign::Combined, 0.5, 136, &[Effect::RadialFriction]);
+    // the premise: the weights' noise is above the baseline's gap, the best estimate far below
+    assert!(
+        d.noise_nrmse_weights > d.baseline_heldout_nrmse,
+        "{} vs {}",
+        d.noise_nrmse_weights,
+        d.baseline_heldout_nrmse
+    );
+    assert!(d.noise_nrmse < 0.5 * d.baseline_heldout_nrmse, "{} vs {}", d.noise_nrmse, d.baseline_heldout_nrmse);
+    let rf = d.ranking.iter().find(|r| r.effect == "radial_friction").expect("ranked");
+    assert!(rf.evidence > 5.0 && rf.shrink_interval.0 > 0.0, "radial friction no longer supported: {rf:?}");
+    assert!(rf.shrink < 0.5 && rf.heldout_chi2_after > 2.0, "{rf:?}");
+    assert_eq!(d.verdict, "radial_friction");
+    assert!(!d.complete, "a remaining gap is reported");
+    assert!(d.notes.iter().any(|n| n.starts_with("radial_friction closes") && n.contains("not all")), "{:?}", d.notes);
+}
+
+/// A strong `radial_friction` (ρ = 3) stalls the rotor from 200 N on. A baseline
+/// calibration can end with the rotor at rest at every reading, the turning ones too,
+/// where six of the seven candidates move no prediction; probed at the nominal motor as
+/// well, they stay testable, and the strong-effect starts find ρ.
+#[test]
+fn a_strong_radial_friction_that_stalls_the_rotor_is_found() {
+    let candidates = [Effect::RadialFriction, Effect::ThermalDrift, Effect::TangentialCompliance];
+    let d = diagnosed_single(Effect::RadialFriction, 3.0, Campaign::PreloadTorque, 0.5, 1201, &candidates);
+    assert_eq!(d.verdict, "radial_friction");
+    let rf = d.ranking.iter().find(|r| r.effect == "radial_friction").expect("ranked");
+    let rho = rf.params.first().map(|p| p.1).unwrap_or(0.0);
+    assert!((rho / 3.0 - 1.0).abs() < 0.05 && rf.shrink > 0.9, "{rf:?}");
+    // thermal_drift without a time series is still untestable: not fitted
+    let td = d.ranking.iter().find(|r| r.effect == "thermal_drift").expect("ranked");
+    assert!(td.params.is_empty(), "{td:?}");
+}
+
+/// Just above the weights' noise level the "half beyond the noise" test measured against
+/// that level would let almost any shrink close the gap: with the truth left out of the
+/// candidates, an effect closing a sliver of a `voltage_sag` or `radial_friction` gap
+/// (held-out χ² far above the noise left) must be no verdict. Against the best noise
+/// estimate none closes it, and a sliver is no material part either.
+#[test]
+fn an_effect_that_closes_a_sliver_of_the_gap_is_no_verdict() {
+    let cases = [
+        (Effect::VoltageSag, 150.0, Campaign::Combined, 1.0, 158, [Effect::RadialFriction, Effect::ThermalDrift]),
+        (
+            Effect::RadialFriction,
+            0.3,
+            Campaign::PreloadTorque,
+            0.5,
+            101,
+            [Effect::HertzSoftening, Effect::PreloadStiffening],
+        ),
+    ];
+    for (truth_effect, strength, campaign, noise, seed, candidates) in cases {
+        let d = diagnosed_single(truth_effect, strength, campaign, noise, seed, &candidates);
+        let best = &d.ranking[0];
+        assert!(best.shrink < 0.2 && best.heldout_chi2_after > 3.0, "{truth_effect:?}: {best:?}");
+        assert_eq!(d.verdict, "unexplained", "{truth_effect:?}: {:?}", d.ranking);
+    }
+}
+
+/// One motor measured at four drive voltages (preload-torque runs, radial friction in its
+/// truth form): calibrated from the nominal motor, the baseline presses the modal damping
+/// onto its upper bound, where the logistic transform holds it (a radial-friction fit
+/// started there stays in that valley, held-out χ² 108 per reading, without the second
+/// start from the nominal motor). Refitted from its own end, the baseline leaves
+/// the bound at a fraction of the χ²; `Calibrate::refit_bounds` and so the diagnosis
+/// do that, and the diagnosis finds radial friction at its truth.
+#[test]
+fn a_baseline_left_on_a_bound_is_refitted_from_its_end() {
+    let nominal = crate::calibrate::tests::reference_motor();
+    let mut truth = nominal.clone();
+    truth.effects.set_strength(Effect::RadialFriction, 1.0);
+    let (rows, groups) = one_motor(&truth, Campaign::PreloadTorque, 31, &[165.0, 185.0, 205.0, 225.0]);
+    let opts = DiagnoseOptions {
+        candidates: vec![Effect::RadialFriction],
+        try_pairs: false,
+        bootstrap: 50,
+        tolerances: classic_tolerances(),
+        ..DiagnoseOptions::default()
+    };
+    // (the rows as the diagnosis fits them: σ scaled by the estimated noise levels)
+    let scaled = noise_scaled(&rows, &crate::noise::estimate(&rows, &groups));
+    let (s0, bp) = fit_params(&nominal, &nominal, &scaled, &[], false, &classic_tolerances());
+    let on_damping_bound =
+        |c: &Calibration| c.params.iter().any(|p| p.name.ends_with("modal_damping_ns_per_m") && p.at_bound);
+    let first = Calibration::builder(&s0, &scaled).params(&bp).options(&opts.fit).run().expect("baseline");
+    assert!(on_damping_bound(&first), "the baseline no longer ends on the damping bound: the test needs new data");
+    let again = Calibration::builder(&first.motor, &scaled).params(&bp).options(&opts.fit).run().expect("refit");
+    assert!(!on_damping_bound(&again));
+    // (χ² 1.74e5 → 6.3e4 when written)
+    assert!(again.chi2 < 0.5 * first.chi2, "χ² {} → {}", first.chi2, again.chi2);
+    // what `trum calibrate` and the diagnosis call does both
+    let refitted =
+        Calibration::builder(&s0, &scaled).params(&bp).options(&opts.fit).refit_bounds(true).run().expect("refitting");
+    assert_eq!(refitted.chi2, again.chi2);
+    assert_eq!(refitted.motor, again.motor);
+    let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnose");
+    let damping = d.baseline_params.iter().find(|p| p.0.ends_with("modal_damping_ns_per_m")).expect("damping").1;
+    assert!(damping < 49.0, "the diagnosis's baseline damping {damping}");
+    let rf = d.ranking.iter().find(|r| r.effect == "radial_friction").expect("ranked");
+    assert_eq!(d.verdict, "radial_friction");
+    assert!(rf.heldout_chi2_after < 5.0, "held-out χ² per reading {}", rf.heldout_chi2_after);
+    let rho = rf.params[0].1;
+    assert!((rho - 1.0).abs() < 0.1, "ρ {rho}");
+}
+
+/// A motor without eccentricity measured in eight stability runs (64 readings of the
+/// speed standard deviation, true value near zero): the readings are the non-negative
+/// part of the noise, biased upwards in every row alike. Compared with the model's
+/// expected reading (`Observable::expected_reading`) that bias is no gap; compared with
+/// the model value itself, eccentricity fitted it (evidence 10.2, verdict
+/// `eccentricity`).
+#[test]
+fn the_positive_bias_of_speed_std_readings_is_not_eccentricity() {
+    let nominal = crate::calibrate::tests::reference_motor();
+    let voltages = [165.0, 175.0, 185.0, 195.0, 205.0, 215.0, 225.0, 235.0];
+    let (rows, groups) = one_motor(&nominal, Campaign::Stability, 41, &voltages);
+    let zeros = rows.iter().flat_map(|r| &r.readings).filter(|x| x.0 == Observable::SpeedStdRpm && x.1 == 0.0);
+    assert!(zeros.count() >= 16, "the readings are no longer clipped noise: the test needs new data");
+    let opts = DiagnoseOptions {
+        candidates: vec![Effect::Eccentricity],
+        try_pairs: false,
+        bootstrap: 50,
+        ..DiagnoseOptions::default()
+    };
+    // (the data clip and estimate; one run of the same data estimates no noise level)
+    let est = crate::noise::estimate(&rows, &groups);
+    assert!(speed_std_clipped(&rows, est.contains_key(&Observable::SpeedStdRpm)));
+    let one_run: Vec<usize> = (0..rows.len()).filter(|&i| groups[i].starts_with("v165")).collect();
+    let (rows1, groups1): (Vec<ObservedRow>, Vec<String>) =
+        one_run.iter().map(|&i| (rows[i].clone(), groups[i].clone())).unzip();
+    assert!(!crate::noise::estimate(&rows1, &groups1).contains_key(&Observable::SpeedStdRpm));
+    assert!(!speed_std_clipped(&rows1, false));
+    let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnose");
+    let ecc = d.ranking.iter().find(|r| r.effect == "eccentricity").expect("ranked");
+    assert_eq!(d.verdict, "none", "evidence {}", ecc.evidence);
+    assert!(ecc.evidence < 3.0, "evidence {}", ecc.evidence);
+}
+
+/// A supported ranking entry with the given held-out χ² per reading and NRMSE.
+pub(super) fn ranked(effect: &str, chi2: f64, nrmse: f64) -> RankEntry {
+    RankEntry {
+        effect: effect.into(),
+        evidence: 100.0,
+        heldout_nrmse_after: nrmse,
+        heldout_chi2_after: chi2,
+        shrink: 0.5,
+        shrink_interval: (0.4, 0.6),
+        params: Vec::new(),
+        signature_match: None,
+        linear_chi2_drop: None,
+        signature_overlap: None,
+        heldout_in_sample_folds: 0,
+    }
+}
+
+/// The held-out need is the pair that gains exactly PAIR_GAIN of the single's excess in
+/// `pair_beats_single`'s terms: √(χ² − 1) and √(NRMSE² − noise²) per reading.
+#[test]
+fn the_held_out_need_is_a_pair_gain_of_exactly_a_third() {
+    let (n, noise) = (1000, 0.12);
+    let single = ranked("radial_friction", 40.0, 0.2);
+    let (chi2, e2) = held_out_need(&single, n, noise);
+    let pair = RankEntry {
+        effect: "radial_friction+voltage_sag".into(),
+        heldout_chi2_after: single.heldout_chi2_after - chi2 / n as f64,
+        heldout_nrmse_after: (single.heldout_nrmse_after.powi(2) - e2 / n as f64).sqrt(),
+        ..single.clone()
+    };
+    let (g_nrmse, g_chi2) = pair_gains(&single, &pair, n, noise);
+    assert!((g_chi2 - PAIR_GAIN).abs() < 1e-12 && (g_nrmse - PAIR_GAIN).abs() < 1e-12, "{g_chi2} {g_nrmse}");
+    // at the noise level nothing is left to gain
+    let quiet = RankEntry { heldout_chi2_after: 0.8, heldout_nrmse_after: 0.1, ..single.clone() };
+    assert_eq!(held_out_need(&quiet, n, noise), (0.0, 0.0));
+    // nor within two standard errors of the noise's mean z² (2·√(2/1000) = 0.089)
+    let close = RankEntry { heldout_chi2_after: 1.085, heldout_nrmse_after: 0.1, ..single.clone() };
+    assert_eq!(held_out_need(&close, n, noise), (0.0, 0.0));
+    let beyond = RankEntry { heldout_chi2_after: 1.095, heldout_nrmse_after: 0.1, ..single.clone() };
+    assert!(held_out_need(&beyond, n, noise).0 > 0.0);
+}
+
+/// `pair_beats_single`'s gains: a single within the noise tolerance leaves nothing to gain
+/// in χ², however far below it the pair goes (the blind `hertz_softening` at 3 × typical,
+/// 1.03 per reading at 679 readings, and `voltage_sag` polishing it to 0.90), while the
+/// pair's own excess is never zeroed: a pair ending at 1.03 removes √0.03 less than all
+/// of a single's excess of 2 (χ² 5). And the NRMSE gain is of the part beyond the noise.
+#[test]
+fn a_pair_gains_nothing_on_a_single_within_the_noise() {
+    let entry = ranked;
+    let n = 679;
+    let within = entry("hertz_softening", 1.03, 0.05);
+    let polished = entry("hertz_softening+voltage_sag", 0.90, 0.05);
+    assert_eq!(pair_gains(&within, &polished, n, 0.05).1, 0.0);
+    let far = entry("hertz_softening", 5.0, 0.05);
+    let g = pair_gains(&far, &entry("hertz_softening+voltage_sag", 1.03, 0.05), n, 0.05).1;
+    assert!((g - (1.0 - 0.03f64.sqrt() / 2.0)).abs() < 1e-12, "{g}");
+    // NRMSE: 0.05 beyond a noise of 0.03 is an excess of 0.04; a pair at 0.0427 (excess
+    // 0.0222) removes 0.445 of it
+    let (gn, _) = pair_gains(&entry("a", 2.0, 0.05), &entry("a+b", 2.0, 0.0427), n, 0.03);
+    let expect = 1.0 - (0.0427f64.powi(2) - 0.0009).sqrt() / 0.04;
+    assert!((gn - expect).abs() < 1e-12, "{gn} vs {expect}");
+    // nothing beyond the noise: nothing to gain
+    assert_eq!(pair_gains(&entry("a", 2.0, 0.02), &entry("a+b", 2.0, 0.01), n, 0.03).0, 0.0);
+}
+
+#[test]
+fn a_pair_refits_both_effects_and_starts_from_the_lead_fit() {
+    let nominal = crate::calibrate::tests::reference_motor();
+    let (rows, _) = data(&nominal, 1.0, 3);
+    let mut lead = nominal.clone();
+    lead.effects.set_strength(Effect::RadialFriction, 0.8);
+    let (m, params) =
+        fit_params(&nominal, &lead, &rows, &[Effect::RadialFriction, Effect::VoltageSag], false, &BTreeMap::new());
+    let names: Vec<String> = params.iter().map(|p| p.param.name()).collect();
+    for e in [Effect::RadialFriction, Effect::VoltageSag] {
+        assert!(names.iter().any(|n| n.starts_with(&format!("effects.{}.", e.name()))), "{e:?} not fitted: {names:?}");
+    }
+    // the lead keeps its fitted strength; the new effect starts at half its typical one
+    assert_eq!(m.effects.value(Effect::RadialFriction, 0), 0.8);
+    let typical = Effect::VoltageSag.info().params[0].typical;
+    assert_eq!(m.effects.value(Effect::VoltageSag, 0), 0.5 * typical);
+}
+
+/// A fit that ends with an added effect within 1 % of zero counts as collapsed for the
+/// second start (`added_near_zero`): the rule on fitted values, and fits of
+/// `tangential_compliance` to data without it (ending at or next to zero) and with it.
+#[test]
+fn an_effect_fitted_to_next_to_zero_counts_as_collapsed() {
+    let tc = Effect::TangentialCompliance;
+    let nominal = crate::calibrate::tests::reference_motor();
+    let grid =
+        |m: &Motor| crate::calibrate::tests::rows_on_grid(m, &[100.0, 200.0, 300.0, 400.0], &[0.0, 0.2, 0.4, 0.6]);
+    let rows = grid(&nominal);
+    let (start, params) = fit_params(&nominal, &nominal, &rows, &[tc], false, &BTreeMap::new());
+    let hi = params.iter().find(|fp| fp.param == ParamRef::Effect(tc, 0)).expect("strength").hi;
+    let fitted = |v: f64| {
+        params
+            .iter()
+            .map(|fp| FittedParam {
+                name: fp.param.name(),
+                value: if fp.param == ParamRef::Effect(tc, 0) { v } else { fp.lo },
+                std_error: 0.0,
+                at_bound: false,
+                identifiable: true,
+                prior_rel_sd: None,
+            })
+            .collect::<Vec<_>>()
+    };
+    assert!(added_near_zero(&params, &fitted(0.009 * hi), &[tc]));
+    assert!(!added_near_zero(&params, &fitted(0.011 * hi), &[tc]));
+    // only an added effect's strength counts (for a pair, the lead's is not added)
+    assert!(!added_near_zero(&params, &fitted(0.0), &[Effect::RadialFriction]));
+    let opts = FitOptions { huber_k: 3.0, irls_passes: 1, max_evaluations: 300, ..FitOptions::default() };
+    let without = Calibration::builder(&start, &rows).params(&params).options(&opts).adding(&[tc]).run().expect("fit");
+    // (not abandoned when written: 0.3 % of the range, on its bound by the 0.5 % rule)
+    assert!(without.abandoned || added_near_zero(&params, &without.params, &[tc]), "{:?}", without.params);
+    let mut truth = nominal.clone();
+    truth.effects.set(tc, &[tc.info().params[0].typical]);
+    let with =
+        Calibration::builder(&start, &grid(&truth)).params(&params).options(&opts).adding(&[tc]).run().expect("fit");
+    assert!(!with.abandoned && !added_near_zero(&params, &with.params, &[tc]), "{:?}", with.params);
+}

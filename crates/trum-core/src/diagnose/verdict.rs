@@ -1,0 +1,276 @@
+//! The verdict: which tests a candidate passes (supported, material, closes the gap),
+//! whether a pair beats its single, the effect(s) named, and what they are confounded with.
+
+use super::candidates::bootstrap_shrink;
+use super::context::Context;
+use super::folds::errors;
+use super::pairs::{pair_gains, rounded, PAIR_GAIN};
+use super::{same_set, signature, RankEntry};
+use crate::effects::Effect;
+use std::collections::BTreeMap;
+
+/// The tests of a ranking entry against the held-out gap of the baseline.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct GapTests {
+    /// The baseline's held-out NRMSE.
+    pub(super) base_nrmse: f64,
+    /// The noise of the gap tests "beyond the noise": the best estimate of what noise
+    /// alone gives (`noise_best`, the reported `noise_nrmse`), not the weights' level: on `combined`
+    /// campaigns that is 3-4 × higher, often above the baseline's whole held-out NRMSE, and
+    /// then there was no gap "beyond the noise" for half of it to go. Every supported effect
+    /// closed it: a `radial_friction` that closed 18 % with χ² 4.2 per reading left was the
+    /// verdict for a truth of preload stiffening (blind benchmark, seed 136). Just above that
+    /// level the same test let a 1.4 % shrink close (a review's `thermal_drift` on
+    /// `voltage_sag` data, χ² 8.1 left), so no switch between the two levels will do.
+    pub(super) gap_noise: f64,
+}
+
+impl GapTests {
+    /// A candidate is supported when the full-data evidence is very strong (½ΔBIC > 5)
+    /// and its held-out improvement is real (the bootstrap 5 % bound of the shrink is
+    /// above zero). (It closes the gap, [`GapTests::closes`], when the held-out residual is
+    /// back near the noise, or at least half of the held-out NRMSE is gone, or at least
+    /// half of the part of it beyond the noise, √(NRMSE² − noise²): the truth may differ in
+    /// form from the candidate and leave a remainder, and a gap only a little above the
+    /// noise can never lose half of its total NRMSE.)
+    pub(super) fn supported(r: &RankEntry) -> bool {
+        r.evidence > 5.0 && r.shrink > 0.0 && r.shrink_interval.0 > 0.0
+    }
+
+    /// x beyond the noise, √(x² − noise²) (0 below the noise).
+    fn beyond(&self, x: f64) -> f64 {
+        (x * x - self.gap_noise * self.gap_noise).max(0.0).sqrt()
+    }
+
+    /// The fraction of the held-out gap beyond the noise an entry closes.
+    pub(super) fn excess_shrink(&self, r: &RankEntry) -> f64 {
+        let before = self.beyond(self.base_nrmse);
+        if before > 0.0 {
+            1.0 - self.beyond(r.heldout_nrmse_after) / before
+        } else {
+            0.0
+        }
+    }
+
+    /// A material part of the gap: a fifth of the held-out NRMSE or a quarter of its part
+    /// beyond the noise (with the supported test's bootstrap bound above zero).
+    pub(super) fn material(&self, r: &RankEntry) -> bool {
+        Self::supported(r) && (r.shrink >= 0.2 || self.excess_shrink(r) >= 0.25)
+    }
+
+    /// An entry closes the gap when it removes a material part of it and what it leaves is
+    /// at the noise level (held-out mean z² ≤ 2), or it removes half of the NRMSE or half of
+    /// its part beyond the noise. (A held-out mean z² ≤ 2 alone is no closing: a baseline
+    /// already at the noise passes it with any supported polish.)
+    pub(super) fn closes(&self, r: &RankEntry) -> bool {
+        let before = self.beyond(self.base_nrmse);
+        self.material(r)
+            && (r.heldout_chi2_after <= 2.0
+                || r.shrink >= 0.5
+                || (before > 0.0 && self.beyond(r.heldout_nrmse_after) <= 0.5 * before))
+    }
+}
+
+/// A verdict and what goes with it.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Verdict {
+    /// One effect, several joined with `+`, or `unexplained` (`none` is decided before).
+    pub(super) verdict: String,
+    /// No held-out gap beyond the noise is left.
+    pub(super) complete: bool,
+    /// Effects that explain the data about as well as a single-effect verdict.
+    pub(super) confounded: Vec<String>,
+    /// With `unexplained`, the supported effect that explains part of the gap.
+    pub(super) partial: Option<String>,
+    /// Notes on an incomplete verdict.
+    pub(super) notes: Vec<String>,
+}
+
+/// Decides the verdict where there is a gap: the best pair `best_pair` when it beats the
+/// best supported single `best_single` (which closes the gap when `single_closes`) and
+/// closes the gap itself; else that single when it closes a material part; else
+/// `unexplained`. For a single-effect verdict, fills each entry's signature overlap with
+/// the verdict's (signatures `base_sigs` at the calibrated baseline) and lists the
+/// confounded effects. `cv_preds`: the held-out predictions of every scored model.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn decide(
+    ctx: &Context,
+    tests: &GapTests,
+    ranking: &mut [RankEntry],
+    cv_preds: &BTreeMap<String, Vec<Vec<f64>>>,
+    best_single: Option<RankEntry>,
+    single_closes: bool,
+    best_pair: Option<RankEntry>,
+    base_sigs: &BTreeMap<Effect, signature::Signature>,
+) -> Verdict {
+    let (rows, sc, opts, n_read, noise_weights) = (&ctx.rows[..], &ctx.sc, &ctx.opts, ctx.n_read, ctx.noise_weights);
+    let supported = GapTests::supported;
+    let material = |r: &RankEntry| tests.material(r);
+    let closes = |r: &RankEntry| tests.closes(r);
+    let excess_shrink = |r: &RankEntry| tests.excess_shrink(r);
+    let verdict: String;
+    let mut confounded = Vec::new();
+    let mut partial = None;
+    let mut complete = true;
+    let mut notes = Vec::new();
+    // A pair is two effects only when it beats the best single effect clearly, in
+    // evidence (½ΔBIC > 5 over the single) and on held-out data: no worse in either
+    // held-out measure, at least a third of what the single leaves beyond noise gone
+    // in one of them, and that gain above zero at the bootstrap 5 % bound. (Parsimony:
+    // a second effect that only polishes the first one's form error is not an effect.)
+    let pair_beats_single = |bp: &RankEntry| -> bool {
+        if !supported(bp) {
+            return false;
+        }
+        let Some(single) = best_single.as_ref() else { return closes(bp) };
+        if bp.evidence <= single.evidence + 5.0
+            || bp.heldout_nrmse_after > single.heldout_nrmse_after
+            || bp.heldout_chi2_after > single.heldout_chi2_after
+        {
+            return false;
+        }
+        let (gain_nrmse, gain_chi2) = pair_gains(single, bp, n_read, noise_weights);
+        let held = |name: &str| cv_preds.iter().find(|(n, _)| same_set(n, name)).map(|(_, p)| errors(rows, p, sc));
+        let (Some(hs), Some(hp)) = (held(&single.effect), held(&bp.effect)) else { return false };
+        let real = |before: &[f64], after: &[f64]| bootstrap_shrink(before, after, opts.bootstrap, opts.seed).0 > 0.0;
+        (gain_nrmse >= PAIR_GAIN && real(&hs.2, &hp.2)) || (gain_chi2 >= PAIR_GAIN && real(&hs.3, &hp.3))
+    };
+    match best_pair.filter(|bp| pair_beats_single(bp) && closes(bp)) {
+        Some(bp) => {
+            // name the stronger single effect first
+            let ev = |n: &str| ranking.iter().find(|r| r.effect == n).map(|r| r.evidence).unwrap_or(f64::NEG_INFINITY);
+            let mut ns: Vec<&str> = bp.effect.split('+').collect();
+            ns.sort_by(|a, b| ev(b).total_cmp(&ev(a)));
+            let joined = ns.join("+");
+            for r in ranking.iter_mut() {
+                if r.effect == bp.effect {
+                    r.effect = joined.clone();
+                }
+            }
+            verdict = joined;
+        }
+        None if single_closes => verdict = best_single.as_ref().map(|b| b.effect.clone()).unwrap_or_default(),
+        // The best supported single that closes a material part of the gap is the
+        // verdict even when a gap remains (`complete: false`): the data's form of the
+        // effect may lie outside every form its candidate family can take.
+        None => match best_single.as_ref().filter(|b| material(b)) {
+            Some(b) => {
+                verdict = b.effect.clone();
+                complete = false;
+                notes.push(format!(
+                    "{} closes {} % of the held-out gap ({} % of its part beyond the noise) but not all of it: \
+                     the data's form of the effect may differ from every form its candidate takes, or \
+                     something else remains",
+                    b.effect,
+                    rounded(100.0 * b.shrink),
+                    rounded(100.0 * excess_shrink(b))
+                ));
+            }
+            None => verdict = "unexplained".into(),
+        },
+    }
+    if verdict == "unexplained" {
+        complete = false;
+        partial = best_single.as_ref().map(|b| b.effect.clone());
+        if let Some(b) = best_single.as_ref() {
+            notes.push(format!(
+                "{} is supported (evidence {:.1}) but closes only {} % of the held-out gap; something else remains",
+                b.effect,
+                b.evidence,
+                rounded(100.0 * b.shrink)
+            ));
+        }
+    } else if !verdict.contains('+') {
+        // Confounded: another supported single effect that explains the data about as
+        // well (held-out error within 15 %, evidence within 5), or one that also closes
+        // the gap while the data see its signature and the verdict's as one shape
+        // (|cos| ≥ 0.95 at the calibrated baseline): then the held-out ranking between
+        // them rests on the candidates' form, not on what the data can separate.
+        let vsig = Effect::from_name(&verdict).ok().and_then(|e| base_sigs.get(&e));
+        for r in ranking.iter_mut() {
+            if let (Some(v), Some(e)) = (vsig, Effect::from_name(&r.effect).ok()) {
+                r.signature_overlap = base_sigs.get(&e).map(|s| signature::overlap(v, s));
+            }
+        }
+        if let Some(best) = ranking.iter().find(|r| r.effect == verdict).cloned() {
+            for r in ranking.iter() {
+                let alike =
+                    r.heldout_nrmse_after <= 1.15 * best.heldout_nrmse_after && best.evidence - r.evidence < 5.0;
+                // (for an incomplete verdict: any supported candidate the evidence does
+                // not separate from it)
+                let close_call = !complete && best.evidence - r.evidence < 5.0;
+                let one_shape = r.signature_overlap.is_some_and(|o| o >= 0.95) && (closes(r) || !complete);
+                if r.effect != best.effect
+                    && !r.effect.contains('+')
+                    && supported(r)
+                    && (alike || one_shape || close_call)
+                {
+                    confounded.push(r.effect.clone());
+                }
+            }
+        }
+    }
+    Verdict { verdict, complete, confounded, partial, notes }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
+mod tests {
+    use super::super::tests::{data, quick, ranked};
+    use super::*;
+
+    /// An entry with `shrink` of the held-out NRMSE 0.4 gone (to `nrmse`), χ² `chi2` per
+    /// reading left, evidence `evidence`.
+    fn entry(effect: &str, evidence: f64, shrink: f64, chi2: f64) -> RankEntry {
+        RankEntry { evidence, shrink, ..ranked(effect, chi2, 0.4 * (1.0 - shrink)) }
+    }
+
+    /// With a baseline NRMSE of 0.4 and noise 0.05: the tests of an entry, and the verdict
+    /// they give (a closing single; a material but incomplete one; a sliver, which leaves
+    /// the gap unexplained with a partial effect; a second single as good, confounded).
+    #[test]
+    fn the_verdict_follows_the_gap_tests() {
+        let motor = crate::calibrate::tests::reference_motor();
+        let (rows, groups) = data(&motor, 1.0, 3);
+        let ctx = Context::new(&motor, &rows, &groups, &quick(false)).unwrap();
+        let tests = GapTests { base_nrmse: 0.4, gap_noise: 0.05 };
+        let none = BTreeMap::new();
+        let decide_on = |ranking: &mut [RankEntry], closes: bool| {
+            let best = ranking.iter().find(|r| GapTests::supported(r)).cloned();
+            decide(&ctx, &tests, ranking, &BTreeMap::new(), best, closes, None, &none)
+        };
+
+        let closing = entry("voltage_sag", 100.0, 0.8, 1.5);
+        assert!(GapTests::supported(&closing) && tests.material(&closing) && tests.closes(&closing));
+        let v = decide_on(&mut [closing.clone()], true);
+        assert_eq!((v.verdict.as_str(), v.complete, v.partial.clone()), ("voltage_sag", true, None));
+        assert!(v.confounded.is_empty() && v.notes.is_empty());
+
+        // as good within 15 % of held-out error and 5 of evidence: confounded
+        let alike = RankEntry { heldout_nrmse_after: 1.1 * closing.heldout_nrmse_after, ..closing.clone() };
+        let alike = RankEntry { effect: "preload_stiffening".into(), evidence: 97.0, ..alike };
+        let v = decide_on(&mut [closing.clone(), alike], true);
+        assert_eq!(v.confounded, vec!["preload_stiffening".to_string()]);
+
+        // a quarter of the NRMSE gone, χ² 5 left: material, not closing
+        let part = entry("radial_friction", 100.0, 0.25, 5.0);
+        assert!(tests.material(&part) && !tests.closes(&part));
+        let v = decide_on(&mut [part], false);
+        assert_eq!((v.verdict.as_str(), v.complete, v.notes.len()), ("radial_friction", false, 1));
+
+        // 5 % gone: supported, not material; unexplained, the effect partial
+        let sliver = entry("eccentricity", 100.0, 0.05, 8.0);
+        assert!(GapTests::supported(&sliver) && !tests.material(&sliver));
+        let v = decide_on(&mut [sliver], false);
+        assert_eq!(
+            (v.verdict.as_str(), v.complete, v.partial.as_deref()),
+            ("unexplained", false, Some("eccentricity"))
+        );
+
+        // no supported entry (evidence below 5): unexplained without a partial effect
+        let weak = entry("eccentricity", 4.0, 0.8, 1.5);
+        assert!(!GapTests::supported(&weak));
+        let v = decide_on(&mut [weak], false);
+        assert_eq!((v.verdict.as_str(), v.partial), ("unexplained", None));
+    }
+}
