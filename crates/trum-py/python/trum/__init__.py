@@ -25,8 +25,9 @@ from ._registry import (
 )
 from ._result import Result
 from ._motor import Motor
-from ._api import Optimum, map, optimize
-from ._diagnosis import diagnose
+from ._axes import linspace
+from ._api import MapResult, Optimum, map, optimize
+from ._diagnosis import Diagnosis, diagnose
 from ._dynamics import (
     HertzIdentification,
     Resonance,
@@ -44,6 +45,9 @@ __all__ = [
     "Motor",
     "Result",
     "Optimum",
+    "MapResult",
+    "Diagnosis",
+    "linspace",
     # `map` is left out of __all__ so `from trum import *` does not shadow the builtin.
     "optimize",
     "resonance",
