@@ -26,6 +26,9 @@ pub struct CalibrateArgs {
     /// Write the fit result as JSON here (`-` for stdout instead of the table).
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    /// No progress spinner.
+    #[arg(short, long)]
+    quiet: bool,
 }
 
 pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
@@ -37,8 +40,10 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     let (_, bench) = read_data(&a.data, &motor, err)?;
     let tolerances = crate::motor::load_tolerances(&a.motor.motor)?;
     let params = baseline_params_with(&motor, &bench.rows, &tolerances);
-    let mut cal = calibrate_refitting_bounds(&motor, &bench.rows, &params, &FitOptions::default())
-        .map_err(|e| anyhow!("{}: {e}", a.data))?;
+    let spinner = crate::diagnose::spinner("calibrating the baseline parameters", a.quiet);
+    let cal = calibrate_refitting_bounds(&motor, &bench.rows, &params, &FitOptions::default());
+    spinner.finish_and_clear();
+    let mut cal = cal.map_err(|e| anyhow!("{}: {e}", a.data))?;
     rescale_uncertainties(&mut cal, &bench.rows);
     let chi2_per = cal.chi2 / cal.n_readings.max(1) as f64;
     if let Some(path) = &a.json {

@@ -123,7 +123,10 @@ impl Data {
     fn col(&self, name: &str, what: &str) -> Result<&[f64]> {
         match self.names.iter().position(|n| n == name) {
             Some(i) => Ok(&self.cols[i]),
-            None => bail!("{what} column '{name}' does not exist; available columns are: {}", self.names.join(", ")),
+            None => {
+                let hint = crate::suggest::hint(name, crate::suggest::names(self.names.iter().map(String::as_str)));
+                bail!("{what} column '{name}' does not exist{hint}; available columns are: {}", self.names.join(", "))
+            }
         }
     }
 }
@@ -348,7 +351,10 @@ fn read_csv(path: &Path, needed: &[&str]) -> Result<Data> {
     for n in needed {
         match all.iter().position(|h| h == n) {
             Some(i) => idx.push(i),
-            None => bail!("{shown}: column '{n}' does not exist; the columns are: {}", all.join(", ")),
+            None => {
+                let hint = crate::suggest::hint(n, crate::suggest::names(all.iter().map(String::as_str)));
+                bail!("{shown}: column '{n}' does not exist{hint}; the columns are: {}", all.join(", "))
+            }
         }
     }
     let mut cols = vec![Vec::new(); needed.len()];

@@ -149,6 +149,9 @@ pub struct ResonanceArgs {
     /// Plot of the curves (.png or .svg): stable branches solid, unstable and backbones dashed.
     #[arg(long, value_name = "FILE")]
     plot: Option<PathBuf>,
+    /// Print the summary of every curve as JSON (resonance, peak, jumps, hysteresis) instead of the table.
+    #[arg(long)]
+    json: bool,
 }
 
 fn axis_values(ax: &Axis, name: &str) -> Result<Vec<f64>> {
@@ -160,8 +163,11 @@ fn axis_values(ax: &Axis, name: &str) -> Result<Vec<f64>> {
 }
 
 pub fn run(a: &ResonanceArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
-    if a.output.is_none() && a.plot.is_none() {
-        bail!("nothing to write: give -o CSV and/or --plot FILE");
+    if a.output.is_none() && a.plot.is_none() && !a.json {
+        bail!("nothing to write: give -o CSV, --plot FILE and/or --json");
+    }
+    if a.json && a.output.as_deref().is_some_and(|p| p.as_os_str() == "-") {
+        bail!("-o - and --json cannot both go to stdout");
     }
     if let Some(p) = &a.plot {
         crate::plot::check_plot_path(p)?;
@@ -201,9 +207,45 @@ pub fn run(a: &ResonanceArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         write_figure(path, &response_plot(&curves, voltages.len() > 1, preloads.len() > 1), err)?;
     }
     let summary_to_stderr = a.output.as_deref().is_some_and(|p| p.as_os_str() == "-");
+    if a.json {
+        writeln!(out, "{}", serde_json::to_string_pretty(&summary_json(&curves))?)?;
+        return Ok(0);
+    }
     let summary_out: &mut dyn Write = if summary_to_stderr { err } else { out };
     write_summary(&curves, summary_out)?;
     Ok(0)
+}
+
+/// The summary table as JSON: one object per curve, `null` for numbers a curve lacks.
+fn summary_json(curves: &[FamilyCurve]) -> serde_json::Value {
+    let num = crate::data::num;
+    let list: Vec<_> = curves
+        .iter()
+        .map(|c| {
+            let op = c.operating_point;
+            let mut o = json!({
+                "voltage_v": op.voltage_v,
+                "preload_n": op.preload_n,
+                "status": response_status(c),
+            });
+            if let Err(e) = &c.response {
+                o["reason"] = json!(e.to_string());
+            }
+            let m = c.response.is_ok().then(|| response_summary(c));
+            for (k, f) in [
+                ("linear_resonance_hz", m.as_ref().map(|m| m.linear_resonance_hz)),
+                ("equivalent_beta_n_per_m3", m.as_ref().map(|m| m.equivalent_beta_n_per_m3)),
+                ("peak_amplitude_m", m.as_ref().map(|m| m.peak_amplitude_m)),
+                ("jump_up_hz", m.as_ref().map(|m| m.jump_up_hz)),
+                ("jump_down_hz", m.as_ref().map(|m| m.jump_down_hz)),
+                ("hysteresis_hz", m.as_ref().map(|m| m.hysteresis_hz)),
+            ] {
+                o[k] = num(f.unwrap_or(f64::NAN));
+            }
+            o
+        })
+        .collect();
+    json!({ "curves": list })
 }
 
 /// The response table (`trum_core::layout::response_rows`, the layout Python's

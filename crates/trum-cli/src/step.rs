@@ -35,7 +35,7 @@ pub struct StepArgs {
     /// Axial preload [N].
     #[arg(long, default_value_t = 260.0)]
     preload_n: f64,
-    /// Load torque [N m].
+    /// Load torque [N·m].
     #[arg(long, default_value_t = 0.0)]
     torque_nm: f64,
     /// Simulated time [s].
@@ -71,6 +71,12 @@ pub struct StepArgs {
     /// Plot of the friction-force distribution with the Coulomb limits ±μp (.png or .svg).
     #[arg(long, value_name = "FILE", requires = "snapshot_at_s")]
     snapshot_plot: Option<PathBuf>,
+    /// Print the result as JSON (one object per operating point: status and every quantity) instead of the table.
+    #[arg(long)]
+    json: bool,
+    /// No progress spinner.
+    #[arg(short, long)]
+    quiet: bool,
 }
 
 /// One operating point of the sweep and its outcome.
@@ -120,8 +126,8 @@ fn quantities(r: &Run) -> Vec<(&'static str, f64, &'static str, &'static str)> {
         ("final_speed_rpm", speed, "rpm", "mean speed over the last 20 % of the run"),
         ("steady_speed_rpm", r.steady.speed_rpm, "rpm", "steady-state solver at this point"),
         ("speed_difference", rel(speed, r.steady.speed_rpm), "-", "(final - steady) / steady"),
-        ("contact_torque_nm", torque, "N m", "mean contact torque over the last 20 %"),
-        ("steady_contact_torque_nm", r.steady.contact_torque_nm, "N m", "load + rotor viscous torque at steady speed"),
+        ("contact_torque_nm", torque, "N·m", "mean contact torque over the last 20 %"),
+        ("steady_contact_torque_nm", r.steady.contact_torque_nm, "N·m", "load + rotor viscous torque at steady speed"),
         ("torque_difference", rel(torque, r.steady.contact_torque_nm), "-", "(transient - steady) / steady"),
         ("amplitude_m", amp, "m", "mean wave amplitude over the last 20 %"),
         ("steady_amplitude_m", r.steady.amplitude_m, "m", "steady-state wave amplitude"),
@@ -182,6 +188,10 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
     for &(v, f, p) in &points {
         config(v, f, p).validate().map_err(|e| anyhow!("{}", flag_message(&e)))?;
     }
+    let spinner = crate::diagnose::spinner(
+        &format!("simulating {} operating point{}", points.len(), if single { "" } else { "s" }),
+        a.quiet,
+    );
     let runs: Vec<Run> = points
         .par_iter()
         .map(|&(v, f, p)| Run {
@@ -192,6 +202,7 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
             steady: steady_comparison(&motor, &config(v, f, p)),
         })
         .collect();
+    spinner.finish_and_clear();
     if single {
         if let Err(e) = &runs[0].result {
             bail!("{}", flag_message(e));
@@ -221,6 +232,33 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
         if let Some(path) = &a.snapshot_plot {
             write_figure(path, &snapshot_plot(resp, motor.friction_layer.friction_coefficient), err)?;
         }
+    }
+    if a.json {
+        if to_stderr {
+            bail!("--json and an output to stdout (`-`) cannot both go to stdout");
+        }
+        let list: Vec<_> = runs
+            .iter()
+            .map(|r| {
+                let mut q = serde_json::Map::new();
+                for (n, v, _, _) in quantities(r) {
+                    q.insert(n.into(), crate::data::num(v));
+                }
+                serde_json::json!({
+                    "voltage_v": r.voltage_v,
+                    "frequency_hz": r.frequency_hz,
+                    "phase_difference_deg": r.phase_deg,
+                    "preload_n": a.preload_n,
+                    "torque_nm": a.torque_nm,
+                    "status": status(&r.result),
+                    "steady_status": r.steady.status.to_string(),
+                    "quantities": q,
+                })
+            })
+            .collect();
+        let doc = serde_json::json!({ "motor": motor.name, "runs": list });
+        writeln!(out, "{}", serde_json::to_string_pretty(&doc)?)?;
+        return Ok(0);
     }
     let summary: &mut dyn Write = if to_stderr { err } else { out };
     if single {
@@ -255,7 +293,7 @@ fn print_single(r: &Run, motor: &Motor, a: &StepArgs, out: &mut dyn Write) -> Re
     writeln!(out, "motor    {}{source}", motor.name)?;
     writeln!(
         out,
-        "drive    {} V, {} Hz, phase {} deg, preload {} N, load {} N m",
+        "drive    {} V, {} Hz, phase {} deg, preload {} N, load {} N·m",
         fmt_sig(r.voltage_v, 6),
         fmt_sig(r.frequency_hz, 6),
         fmt_sig(r.phase_deg, 6),

@@ -91,7 +91,7 @@ class MapResult(dict):
         swept = self.swept
         keep = [i for i, a in enumerate(_NESTING) if a in swept]
         units = {q.name: (q.unit, q.doc) for q in quantities()}
-        axis_units = {"preload_n": "N", "voltage_v": "V", "frequency_hz": "Hz", "torque_nm": "N m"}
+        axis_units = {"preload_n": "N", "voltage_v": "V", "frequency_hz": "Hz", "torque_nm": "N·m"}
         coords: Dict[str, Any] = {}
         for a in _NESTING:
             attrs = {"units": axis_units[a], "long_name": _plot.label(a).split(" [")[0]}
