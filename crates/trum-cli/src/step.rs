@@ -6,10 +6,11 @@ use crate::args::MotorArgs;
 use crate::data::write_atomic;
 use crate::format::{csv_number, fmt_sig};
 use crate::grid::parse_axis;
-use crate::plot::{series_color, write_figure, Line, LinePlot};
+use crate::plot::{series_color, write_figure, Line, LinePlot, Stroke};
 use crate::table::{write_table, Align};
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
+use plotters::style::RGBColor;
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::PathBuf;
@@ -227,7 +228,7 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
             write_atomic(path, ".csv", &snapshots_csv(resp, motor.friction_layer.friction_coefficient), out)?;
         }
         if let Some(path) = &a.plot {
-            write_figure(path, &speed_plot(resp, &runs[0]), err)?;
+            write_figure(path, &speed_plot(resp, &runs[0], &motor, a), err)?;
         }
         if let Some(path) = &a.snapshot_plot {
             write_figure(path, &snapshot_plot(resp, motor.friction_layer.friction_coefficient), err)?;
@@ -419,17 +420,17 @@ fn snapshots_csv(r: &StepResponse, mu: f64) -> String {
     s
 }
 
-fn speed_plot(resp: &StepResponse, r: &Run) -> LinePlot {
+fn speed_plot(resp: &StepResponse, r: &Run, motor: &Motor, a: &StepArgs) -> LinePlot {
     let t = &resp.series;
-    let line = |y: &[f64], color, label: &str, dashed| Line {
+    let line = |y: &[f64], color, label: &str, stroke| Line {
         label: Some(label.into()),
         color,
         points: t.time_s.iter().copied().zip(y.iter().copied()).collect(),
-        dashed,
+        stroke,
     };
     let mut lines = vec![
-        line(&t.speed_rpm, series_color(0, 3), "speed_rpm", false),
-        line(&t.speed_period_mean_rpm, series_color(1, 3), "period mean", false),
+        line(&t.speed_rpm, RGBColor(170, 170, 170), "rotor speed", Stroke::Solid),
+        line(&t.speed_period_mean_rpm, series_color(0, 3), "mean over a drive period", Stroke::Solid),
     ];
     if r.steady.speed_rpm.is_finite() {
         let (t0, t1) = (t.time_s.first().copied().unwrap_or(0.0), t.time_s.last().copied().unwrap_or(0.0));
@@ -438,15 +439,18 @@ fn speed_plot(resp: &StepResponse, r: &Run) -> LinePlot {
             label: Some("steady-state solver".into()),
             color: series_color(2, 3),
             points: vec![(t0, v), (t1, v)],
-            dashed: true,
+            stroke: Stroke::Dashed,
         });
     }
     LinePlot {
-        title: format!(
-            "step response: {} V, {} Hz, {} deg",
+        title: format!("{}: rotor speed after switch-on (stick-slip contact)", motor.name),
+        subtitle: format!(
+            "drive voltage {} V, drive frequency {} kHz, phase {}°, preload {} N, load torque {} N·m",
             fmt_sig(r.voltage_v, 6),
-            fmt_sig(r.frequency_hz, 6),
-            fmt_sig(r.phase_deg, 6)
+            fmt_sig(r.frequency_hz / 1e3, 6),
+            fmt_sig(r.phase_deg, 6),
+            fmt_sig(a.preload_n, 6),
+            fmt_sig(a.torque_nm, 6)
         ),
         x: "time_s".into(),
         y: "speed_rpm".into(),
@@ -467,14 +471,20 @@ fn snapshot_plot(resp: &StepResponse, mu: f64) -> LinePlot {
             label: Some(format!("t = {} s: {st} stick, {sl} slip, {nc} no contact", fmt_sig(sn.time_s, 4))),
             color,
             points: pts(&|x| x.tangential_force_n_per_m),
-            dashed: false,
+            stroke: Stroke::Solid,
         });
         for sign in [1.0, -1.0] {
-            lines.push(Line { label: None, color, points: pts(&|x| sign * mu * x.pressure_n_per_m), dashed: true });
+            lines.push(Line {
+                label: None,
+                color,
+                points: pts(&|x| sign * mu * x.pressure_n_per_m),
+                stroke: Stroke::Dashed,
+            });
         }
     }
     LinePlot {
-        title: "friction force over one wavelength (dashed: Coulomb limits ±μp)".into(),
+        title: "Friction force over one wavelength".into(),
+        subtitle: format!("dashed: Coulomb limits ±μp (μ = {})", fmt_sig(mu, 3)),
         x: "position_m".into(),
         y: "tangential_force_n_per_m".into(),
         lines,

@@ -52,7 +52,7 @@ pub fn esc(s: &str) -> String {
 }
 
 /// A round step of about `span / n`.
-fn nice_step(span: f64, n: f64) -> f64 {
+pub fn nice_step(span: f64, n: f64) -> f64 {
     let raw = (span / n).max(1e-300);
     let mag = 10f64.powf(raw.log10().floor());
     let f = raw / mag;
