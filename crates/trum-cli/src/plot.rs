@@ -671,7 +671,7 @@ fn curves<DB: DrawingBackend>(
 
 /// The title area: `title` in bold-ish large type, `subtitle` (conditions, effects) below
 /// in smaller type; returns the area left for the chart.
-fn titled<'a, DB: DrawingBackend>(
+fn titled<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
     subtitle: &str,
@@ -942,7 +942,7 @@ fn colour_bar<DB: DrawingBackend>(
 ) -> Result<()> {
     let zspan = if z1 > z0 { z1 - z0 } else { 1.0 };
     let mut cb = ChartBuilder::on(bar);
-    cb.margin_top(look.px(if look.labels { 20.0 } else { 20.0 }))
+    cb.margin_top(look.px(20.0))
         .margin_bottom(look.px(if look.labels { 75.0 } else { 20.0 }))
         .margin_right(look.px(10.0));
     if look.labels {
@@ -975,8 +975,8 @@ fn colour_bar<DB: DrawingBackend>(
 /// `z` (efficiency) over the (load torque, speed) plane of a torque × preload grid, as
 /// motor makers draw efficiency maps: each quadrilateral between two neighbouring preload
 /// curves and two neighbouring torques is filled with its mean `z`, iso-`z` contours are
-/// drawn through it, and the stall boundary (the last running torque of each preload)
-/// is a dashed line. Cells with a stalled or invalid corner are left blank, not drawn as 0.
+/// drawn through it, and the stall boundary (the last running torque of each preload,
+/// before the rotor stalls or friction clamps the stator) is a dashed line. Cells with a stalled or invalid corner are left blank, not drawn as 0.
 fn efficiency_plane<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     spec: &Spec,
@@ -1058,10 +1058,11 @@ fn efficiency_plane<DB: DrawingBackend>(
         }
     }
     chart.draw_series(cells).map_err(de)?;
-    // preload curves, thin, so the grid can be read off
-    for row in &g {
+    // every fifth preload curve, thin, so the grid can be read off
+    let every = (up.len() / 8).max(1);
+    for row in g.iter().step_by(every) {
         let pts: Vec<(f64, f64)> = row.iter().filter(|c| c.1.is_finite()).map(|&c| xy(c)).collect();
-        chart.draw_series(LineSeries::new(pts, WHITE.mix(0.5).stroke_width(look.px(1.0)))).map_err(de)?;
+        chart.draw_series(LineSeries::new(pts, WHITE.mix(0.35).stroke_width(look.px(1.0)))).map_err(de)?;
     }
     // contours: marching squares on the (preload, torque) grid, mapped into the plane
     let step = crate::svg::nice_step(zspan * fz, 8.0);
@@ -1108,7 +1109,8 @@ fn efficiency_plane<DB: DrawingBackend>(
         let style = TextStyle::from(look.font(13.0)).color(&WHITE);
         chart.draw_series(labels.into_iter().map(|(at, text)| Text::new(text, at, style.clone()))).map_err(de)?;
     }
-    // stall boundary: per preload, the last running torque before a stalled one
+    // edge of the running region: per preload, the last running torque before the rotor
+    // stops (stall) or the stator is clamped
     let mut boundary = Vec::new();
     for row in &g {
         if let Some(last) = row.iter().rposition(|c| c.1.is_finite()) {
@@ -1117,12 +1119,15 @@ fn efficiency_plane<DB: DrawingBackend>(
             }
         }
     }
+    let k = look.k;
     if boundary.len() >= 2 {
         chart
             .draw_series(DashedLineSeries::new(boundary, look.px(9.0), look.px(5.0), BLACK.stroke_width(look.px(2.0))))
             .map_err(de)?
-            .label("stall boundary")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], BLACK.stroke_width(2)));
+            .label("stall (or clamp) boundary")
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + (22.0 * k) as i32, y)], BLACK.stroke_width((2.0 * k) as u32))
+            });
         if look.labels {
             chart
                 .configure_series_labels()
