@@ -82,10 +82,10 @@ fn detached<T: Send, F: FnOnce() -> T + Send>(py: Python<'_>, f: F) -> PyResult<
 #[pyclass(frozen, eq, name = "Motor", module = "trum._trum")]
 #[derive(Clone, PartialEq)]
 pub struct PyMotor {
-    inner: Motor,
+    pub(crate) inner: Motor,
     /// `(voltage_v, frequency_hz)` of the motor file's `[drive]` table, or of its preset's:
     /// what `solve` uses when the caller gives no drive, as the CLI's commands do.
-    drive: Option<(f64, f64)>,
+    pub(crate) drive: Option<(f64, f64)>,
 }
 
 /// The `[drive]` of a preset, as `(voltage_v, frequency_hz)`.
@@ -578,6 +578,7 @@ fn _trum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dynamics::hertz_identify, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::step, m)?)?;
     m.add_function(wrap_pyfunction!(diagnosis::diagnose_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnosis::calibrate_csv, m)?)?;
     m.add("STATUS_NAMES", STATUS_NAMES.to_vec())?;
     m.add("INPUTS", vector::INPUTS.to_vec())?;
     m.add("AXES", AXES.to_vec())?;

@@ -115,3 +115,37 @@ def test_ignored_columns_are_warned_about(tmp_path):
     with pytest.warns(UserWarning, match="operator"):
         d = trum.diagnose(RING, extra)
     assert d["verdict"] == "eccentricity"
+
+
+def test_calibrate_fits_the_baseline_and_reads_every_data_form():
+    c = trum.calibrate(RING, DATA)
+    # the eccentric bench is fitted about as well as its noise allows by the baseline alone
+    assert 0.2 < c.chi2_per_reading < 2.0 and c.n_rows == 8
+    byname = {p["name"]: p for p in c.params}
+    mu = byname["friction_layer.friction_coefficient"]
+    assert mu["identifiable"] and abs(mu["value"] / mu["nominal"] - 1) < 0.3
+    # the calibrated motor carries the fitted values
+    for p in c.params:
+        if not p["name"].startswith("bench."):
+            assert c.motor[p["name"]] == p["value"], p["name"]
+    assert len(repr(c)) < 200
+    pd = pytest.importorskip("pandas")
+    df = c.to_pandas()
+    assert list(df.columns) == ["name", "nominal", "value", "std_error", "change", "at_bound", "identifiable"]
+    c2 = trum.calibrate(RING, pd.read_csv(DATA))
+    # the DataFrame goes back to CSV at full precision: the same fit
+    for a, b in zip(c.params, c2.params):
+        assert a["name"] == b["name"] and a["value"] == pytest.approx(b["value"], rel=1e-9)
+
+
+@pytest.mark.skipif(not os.environ.get("TRUM_BIN"), reason="set TRUM_BIN to a trum CLI binary to compare with it")
+def test_calibrate_matches_trum_calibrate_json():
+    exe = shutil.which(os.environ["TRUM_BIN"]) or os.environ["TRUM_BIN"]
+    out = subprocess.run([exe, "calibrate", "--motor", str(RING_FILE), "--data", str(DATA), "--json", "-", "-q"],
+                         check=True, capture_output=True, text=True).stdout
+    cli = json.loads(out)
+    py = trum.calibrate(RING, str(DATA))
+    assert py.chi2 == pytest.approx(cli["chi2"], rel=1e-12)
+    for a, b in zip(py.params, cli["params"]):
+        assert a["name"] == b["name"] and a["value"] == pytest.approx(b["value"], rel=1e-12)
+        assert a["std_error"] == pytest.approx(b["std_error"], rel=1e-9)

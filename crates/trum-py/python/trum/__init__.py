@@ -27,7 +27,7 @@ from ._result import Result
 from ._motor import Motor
 from ._axes import linspace
 from ._api import MapResult, Optimum, map, optimize
-from ._diagnosis import Diagnosis, diagnose
+from ._diagnosis import Calibration, Diagnosis, calibrate, diagnose
 from ._dynamics import (
     HertzIdentification,
     Resonance,
@@ -54,6 +54,8 @@ __all__ = [
     "identify_hertz",
     "step",
     "diagnose",
+    "calibrate",
+    "Calibration",
     "hertz_defaults",
     "Resonance",
     "ResonanceCurve",

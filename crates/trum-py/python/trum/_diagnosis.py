@@ -4,7 +4,7 @@ from __future__ import annotations
 import json
 import os
 import warnings
-from typing import Any, Tuple, Union
+from typing import Any, Dict, List, Tuple, Union
 
 import numpy as np
 
@@ -145,3 +145,54 @@ def diagnose(
     for w in notes:
         warnings.warn(w, stacklevel=2)
     return Diagnosis(json.loads(text))
+
+
+class Calibration:
+    """Result of :func:`calibrate`: the calibrated motor and the fit, parameter by parameter.
+
+    ``motor`` (a ``trum.Motor``), ``params`` (list of dicts: ``name``, ``nominal``,
+    ``value``, ``std_error``, ``at_bound``, ``identifiable``), ``chi2``,
+    ``chi2_per_reading`` (1 = fits to within the assumed noise), ``n_rows``,
+    ``n_readings``, ``evaluations``, ``warnings``."""
+
+    def __init__(self, d: Dict[str, Any]) -> None:
+        self.motor: Motor = Motor._wrap(d["motor"])
+        keys = ("name", "nominal", "value", "std_error", "at_bound", "identifiable")
+        self.params = [dict(zip(keys, row)) for row in d["params"]]
+        self.chi2: float = d["chi2"]
+        self.chi2_per_reading: float = d["chi2_per_reading"]
+        self.n_rows: int = d["n_rows"]
+        self.n_readings: int = d["n_readings"]
+        self.evaluations: int = d["evaluations"]
+        self.warnings: List[str] = list(d["warnings"])
+
+    def to_pandas(self) -> Any:
+        """One row per fitted parameter: ``name``, ``nominal``, ``value``, ``std_error``,
+        ``change`` (value / nominal − 1), ``at_bound``, ``identifiable``."""
+        pd = _require_pandas()
+        df = pd.DataFrame(self.params, columns=["name", "nominal", "value", "std_error", "at_bound", "identifiable"])
+        df.insert(4, "change", df["value"] / df["nominal"] - 1.0)
+        return df
+
+    def __repr__(self) -> str:
+        ident = sum(1 for p in self.params if p["identifiable"])
+        return (f"<trum.Calibration {len(self.params)} parameters ({ident} identifiable), chi2/reading "
+                f"{self.chi2_per_reading:.3g} over {self.n_readings} readings; {len(self.warnings)} warnings>")
+
+
+def calibrate(motor: Union[Motor, str], data: DataLike) -> Calibration:
+    """Calibrates the uncertain baseline parameters of ``motor`` to measurements, as
+    ``trum calibrate`` does (a maximum a posteriori fit, each parameter's tolerance as its
+    prior; docs/DIAGNOSIS.md). ``data`` is a measurement table in the layout of
+    docs/MEASUREMENTS.md: a path, the file's bytes, an open file or a pandas DataFrame.
+    Returns a :class:`Calibration` (``.motor`` is the calibrated motor,
+    ``.to_pandas()`` the parameter table). The reader's notes (ignored columns) come as
+    ``warnings.warn``; a bad file raises ``trum.InputError`` naming the file, line and
+    column. A motor file's ``[tolerances]`` table is not read here: the default tolerances
+    apply. The GIL is released while it runs."""
+    m = _motor(motor)
+    raw, source = _read_data(data)
+    d = _trum.calibrate_csv(m, raw, source)
+    for w in d["notes"]:
+        warnings.warn(w, stacklevel=2)
+    return Calibration(d)
