@@ -411,7 +411,7 @@ fn fonts_available() -> bool {
 /// The grid for `--motor`: command line, then `[sweep]`, then the kind's defaults. An unset
 /// torque axis runs from zero to 5 % above the largest no-load stall torque.
 fn plot_grid(motor: &Motor, a: &PlotArgs, sweep: &trum_core::params::SweepTable, x: &str) -> Result<Grid> {
-    let (p, t, v, f) = match a.kind {
+    let (p, t, mut v, mut f) = match a.kind {
         Some(k) => k.default_axes(),
         None => {
             let d = crate::grid::default_grid();
@@ -419,6 +419,15 @@ fn plot_grid(motor: &Motor, a: &PlotArgs, sweep: &trum_core::params::SweepTable,
             (d.preload_n, t, d.voltage_v, d.frequency_hz)
         }
     };
+    // a fixed drive defaults to the motor's own (its [drive], as `trum map` and `trum optimize`)
+    if let Some(d) = a.motor.as_deref().map(crate::optimize::motor_drive).transpose()?.flatten() {
+        if v.n == 1 {
+            v = Axis::fixed(d.voltage_v);
+        }
+        if f.n == 1 {
+            f = Axis::fixed(d.frequency_hz);
+        }
+    }
     let mut grid =
         a.grid.resolve(sweep, &Grid { preload_n: p, torque_nm: Axis::fixed(0.0), voltage_v: v, frequency_hz: f });
     if a.grid.torque_nm.is_none() && sweep.torque_nm.is_none() {
