@@ -1,5 +1,5 @@
 """Every ```python block of docs/PYTHON.md and README.md runs as written: in order, sharing
-one namespace, as a reader pastes them into one session; a block that guards its work with
+one namespace, as a reader pastes them into one interpreter; a block that guards its work with
 ``if __name__ == "__main__":`` (the Dask example, whose worker processes import the script)
 runs as a script of its own in a fresh interpreter."""
 import re
