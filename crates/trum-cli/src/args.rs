@@ -26,7 +26,7 @@ pub struct GridArgs {
     /// Axial preload [N]: VALUE or START:STOP:N.
     #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = crate::grid::parse_axis, allow_hyphen_values = true)]
     pub preload_n: Option<Axis>,
-    /// Load torque [N m]: VALUE or START:STOP:N.
+    /// Load torque [N·m]: VALUE or START:STOP:N.
     #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = crate::grid::parse_axis, allow_hyphen_values = true)]
     pub torque_nm: Option<Axis>,
     /// Drive voltage amplitude per phase, zero-to-peak [V]: VALUE or START:STOP:N.

@@ -9,7 +9,7 @@ use clap::Args;
 use serde_json::json;
 use std::io::Write;
 use std::path::PathBuf;
-use trum_core::calibrate::{residuals, Calibration, FitOptions, ObservedRow};
+use trum_core::calibrate::{rescale_uncertainties, Calibration, FitOptions};
 
 #[derive(Args, Debug)]
 pub struct CalibrateArgs {
@@ -24,6 +24,9 @@ pub struct CalibrateArgs {
     /// Write the fit result as JSON here (`-` for stdout instead of the table).
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    /// No progress spinner.
+    #[arg(short, long)]
+    quiet: bool,
 }
 
 pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
@@ -34,12 +37,14 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     let (motor, _) = a.motor.load()?;
     let (_, bench) = read_data(&a.data, &motor, err)?;
     let tolerances = crate::motor::load_tolerances(&a.motor.motor)?;
-    let mut cal = Calibration::builder(&motor, &bench.rows)
+    let spinner = crate::diagnose::spinner("calibrating the baseline parameters", a.quiet);
+    let cal = Calibration::builder(&motor, &bench.rows)
         .tolerances(&tolerances)
         .options(&FitOptions::default())
         .refit_bounds(true)
-        .run()
-        .map_err(|e| anyhow!("{}: {e}", a.data))?;
+        .run();
+    spinner.finish_and_clear();
+    let mut cal = cal.map_err(|e| anyhow!("{}: {e}", a.data))?;
     rescale_uncertainties(&mut cal, &bench.rows);
     let chi2_per = cal.chi2 / cal.n_readings.max(1) as f64;
     if let Some(path) = &a.json {
@@ -141,106 +146,4 @@ fn print_table(
         &rows,
     )?;
     Ok(())
-}
-
-/// Standard errors recomputed with the Jacobian taken against *relative* parameter
-/// changes and the normal matrix equilibrated before inversion. (trum-core's values come
-/// from a pseudo-inverse of the unscaled JᵀJ, whose entries span ~30 decades between the
-/// friction coefficient and the Young's modulus, so its cutoff zeroes real variances.)
-/// Identifiable = relative standard error below 1 and a well-conditioned column.
-fn rescale_uncertainties(cal: &mut Calibration, rows: &[ObservedRow]) {
-    let n = cal.params.len();
-    let r0 = residuals(&cal.motor, rows);
-    let m = r0.len();
-    if n == 0 || m <= n {
-        return;
-    }
-    let h = 1e-5;
-    // columns: d r / d ln p (forward differences)
-    let mut cols: Vec<Vec<f64>> = Vec::with_capacity(n);
-    for p in &cal.params {
-        let mut mm = cal.motor.clone();
-        match mm.param_mut(&p.name) {
-            Some(v) if v.is_finite() && *v != 0.0 => *v *= 1.0 + h,
-            _ => return, // not a motor parameter: keep core's numbers
-        }
-        let r1 = residuals(&mm, rows);
-        cols.push(r1.iter().zip(&r0).map(|(a, b)| (a - b) / h).collect());
-    }
-    let mut a = vec![vec![0.0; n]; n];
-    for i in 0..n {
-        for j in 0..n {
-            a[i][j] = cols[i].iter().zip(&cols[j]).map(|(x, y)| x * y).sum();
-        }
-        // a prior on ln p is one more residual, (ln p − centre)/sd: 1/sd² on the diagonal
-        if let Some(sd) = cal.params[i].prior_rel_sd {
-            a[i][i] += 1.0 / (sd * sd);
-        }
-    }
-    let d: Vec<f64> = (0..n).map(|i| a[i][i].max(0.0).sqrt()).collect();
-    for i in 0..n {
-        for j in 0..n {
-            a[i][j] = if d[i] > 0.0 && d[j] > 0.0 { a[i][j] / (d[i] * d[j]) } else { 0.0 };
-        }
-    }
-    let inv = invert(a);
-    let s2 = (cal.chi2 / (m - n) as f64).max(1e-300);
-    let mut warn = Vec::new();
-    for (k, p) in cal.params.iter_mut().enumerate() {
-        // (with a prior: a posterior's covariance, the readings' σ as stated, as the core's)
-        let s2k = if p.prior_rel_sd.is_some() { s2.max(1.0) } else { s2 };
-        let var_rel = match &inv {
-            Some(inv) if d[k] > 0.0 => inv[k][k] / (d[k] * d[k]) * s2k,
-            _ => f64::NAN,
-        };
-        let rel = if var_rel.is_finite() && var_rel >= 0.0 { var_rel.sqrt() } else { f64::NAN };
-        p.std_error = rel * p.value.abs();
-        p.identifiable = rel.is_finite() && rel < p.prior_rel_sd.map_or(1.0, |sd| (0.7 * sd).min(1.0));
-        if !p.identifiable && p.prior_rel_sd.is_none() {
-            warn.push(format!(
-                "{} is not identifiable from these data (relative standard error {})",
-                p.name,
-                fmt_sig(rel, 2)
-            ));
-        }
-    }
-    cal.warnings.retain(|w| !w.contains("is not identifiable") && !w.starts_with("held near their prior"));
-    let held: Vec<&str> =
-        cal.params.iter().filter(|p| p.prior_rel_sd.is_some() && !p.identifiable).map(|p| p.name.as_str()).collect();
-    if !held.is_empty() {
-        warn.push(format!("held near their prior (the data do not narrow them): {}", held.join(", ")));
-    }
-    cal.warnings.extend(warn);
-}
-
-/// Gauss-Jordan inverse with partial pivoting of an equilibrated (unit-diagonal) matrix;
-/// `None` when it is singular to working precision.
-fn invert(mut a: Vec<Vec<f64>>) -> Option<Vec<Vec<f64>>> {
-    let n = a.len();
-    let mut inv: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| f64::from(u8::from(i == j))).collect()).collect();
-    for c in 0..n {
-        let p = (c..n).max_by(|&x, &y| a[x][c].abs().total_cmp(&a[y][c].abs()))?;
-        if a[p][c].abs() < 1e-13 {
-            return None;
-        }
-        a.swap(c, p);
-        inv.swap(c, p);
-        let piv = a[c][c];
-        for j in 0..n {
-            a[c][j] /= piv;
-            inv[c][j] /= piv;
-        }
-        for r in 0..n {
-            if r != c {
-                let f = a[r][c];
-                if f != 0.0 {
-                    for j in 0..n {
-                        a[r][j] -= f * a[c][j];
-                        inv[r][j] -= f * inv[c][j];
-                    }
-                }
-            }
-        }
-    }
-    Some(inv)
 }

@@ -10,7 +10,7 @@ use crate::table::{write_table, Align};
 use crate::verdict::{after_nrmse, verdict_words};
 use anyhow::{anyhow, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::time::Duration;
@@ -38,6 +38,9 @@ pub struct DiagnoseArgs {
     /// leave-block-out refit (slower; docs/DIAGNOSIS.md).
     #[arg(long)]
     exact_cv: bool,
+    /// No progress spinner.
+    #[arg(short, long)]
+    quiet: bool,
 }
 
 pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
@@ -47,7 +50,8 @@ pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     for p in [&a.json, &a.report].into_iter().flatten() {
         drop(crate::output::OutputTarget::create(p, ".tmp")?);
     }
-    let spinner = spinner();
+    let spinner =
+        spinner("diagnosing: calibrating the baseline and every candidate effect on held-out regions", a.quiet);
     let opts = DiagnoseOptions {
         exact_cv: a.exact_cv,
         tolerances: crate::motor::load_tolerances(&a.motor)?,
@@ -72,13 +76,17 @@ pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     Ok(0)
 }
 
-/// A spinner on stderr while the diagnosis runs (only on a terminal).
-fn spinner() -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
+/// A spinner with the elapsed time and `message` on stderr while a long step runs whose
+/// length is not known beforehand (only on a terminal, and not with `--quiet`).
+pub fn spinner(message: &str, quiet: bool) -> ProgressBar {
+    if quiet || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
     let b = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
-    b.set_message("diagnosing: calibrating the baseline and every candidate effect on held-out regions");
+    if let Ok(style) = ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}") {
+        b.set_style(style.tick_chars("⠋⠙⠹⠸⠼⠴⠦⠧⠇⠏ "));
+    }
+    b.set_message(message.to_string());
     b.enable_steady_tick(Duration::from_millis(120));
     b
 }

@@ -3,6 +3,7 @@
 use crate::table::{write_table, Align};
 use anyhow::{anyhow, Result};
 use clap::{Args, Subcommand};
+use serde_json::json;
 use std::io::Write;
 use trum_core::effects::EFFECTS;
 use trum_core::presets::{self, PRESETS};
@@ -11,6 +12,16 @@ use trum_core::presets::{self, PRESETS};
 pub struct PresetsArgs {
     #[command(subcommand)]
     action: Option<PresetsAction>,
+    /// Print the list as JSON (name, display name, summary, sources, drive).
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct EffectsArgs {
+    /// Print the registry as JSON (name, summary, source, parameters with range and typical value).
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Subcommand, Debug)]
@@ -24,6 +35,21 @@ enum PresetsAction {
 
 pub fn presets(a: &PresetsArgs, out: &mut dyn Write) -> Result<i32> {
     match &a.action {
+        None if a.json => {
+            let list: Vec<_> = PRESETS
+                .iter()
+                .map(|p| {
+                    json!({
+                        "name": p.name,
+                        "display_name": p.motor().name,
+                        "summary": p.summary,
+                        "sources": p.sources,
+                        "drive": p.drive().map(|d| json!({"voltage_v": d.voltage_v, "frequency_hz": d.frequency_hz})),
+                    })
+                })
+                .collect();
+            writeln!(out, "{}", serde_json::to_string_pretty(&list)?)?;
+        }
         None => {
             let rows: Vec<Vec<String>> = PRESETS
                 .iter()
@@ -33,14 +59,36 @@ pub fn presets(a: &PresetsArgs, out: &mut dyn Write) -> Result<i32> {
             writeln!(out, "\n`trum presets show NAME > motor.toml` writes one as a motor file to edit.")?;
         }
         Some(PresetsAction::Show { name }) => {
-            let p = presets::find(name).map_err(|e| anyhow!("{}", e.reason))?;
+            let p = presets::find(name).map_err(|e| anyhow!("{}{}", e.reason, crate::suggest::preset_hint(name)))?;
             write!(out, "{}", p.to_toml())?;
         }
     }
     Ok(0)
 }
 
-pub fn effects(out: &mut dyn Write) -> Result<i32> {
+pub fn effects(a: &EffectsArgs, out: &mut dyn Write) -> Result<i32> {
+    if a.json {
+        let list: Vec<_> = EFFECTS
+            .iter()
+            .map(|e| {
+                json!({
+                    "name": e.name,
+                    "summary": squash(e.summary),
+                    "source": e.source,
+                    "params": e.params.iter().enumerate().map(|(j, p)| json!({
+                        "name": p.name,
+                        "role": if j == 0 { "strength" } else if p.shape { "shape" } else { "parameter" },
+                        "min": p.min,
+                        "max": p.max,
+                        "typical": p.typical,
+                        "doc": squash(p.doc),
+                    })).collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+        writeln!(out, "{}", serde_json::to_string_pretty(&list)?)?;
+        return Ok(0);
+    }
     for (i, e) in EFFECTS.iter().enumerate() {
         if i > 0 {
             writeln!(out)?;

@@ -24,6 +24,7 @@ mod point;
 mod report;
 mod resonance;
 mod step;
+mod suggest;
 mod svg;
 mod synth;
 mod table;
@@ -53,7 +54,7 @@ enum Command {
     /// List the built-in motor presets, or print one as a motor file.
     Presets(info::PresetsArgs),
     /// List the switchable unmodelled effects and their parameters.
-    Effects,
+    Effects(info::EffectsArgs),
     /// Plot curves or heat maps from a motor or from a map CSV (.png or .svg).
     #[command(allow_negative_numbers = true)]
     Plot(plot::PlotArgs),
@@ -73,6 +74,12 @@ enum Command {
     /// Step response of the rotor speed with stick-slip contact ([BarTransient]: docs/REFERENCES.md); metrics vs the steady solver.
     #[command(allow_negative_numbers = true)]
     Step(step::StepArgs),
+    /// Print a shell completion script (`trum completions bash > ~/.local/share/bash-completion/completions/trum`).
+    Completions {
+        /// The shell: bash, zsh, fish, elvish or powershell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
 }
 
 /// Runs the CLI with the given arguments (the first is the program name) and returns
@@ -141,7 +148,7 @@ fn run(cli: Cli, out: &mut dyn Write, err: &mut dyn Write) -> anyhow::Result<i32
         Command::Map(a) => map::run(&a, out, err),
         Command::Optimize(a) => optimize::run(&a, out, err),
         Command::Presets(a) => info::presets(&a, out),
-        Command::Effects => info::effects(out),
+        Command::Effects(a) => info::effects(&a, out),
         Command::Plot(a) => plot::run(&a, err),
         Command::Synth(a) => synth::run(&a, out, err),
         Command::Calibrate(a) => calib::run(&a, out, err),
@@ -149,5 +156,12 @@ fn run(cli: Cli, out: &mut dyn Write, err: &mut dyn Write) -> anyhow::Result<i32
         Command::Resonance(a) => resonance::run(&a, out, err),
         Command::IdentifyHertz(a) => resonance::identify(&a, out),
         Command::Step(a) => step::run(&a, out, err),
+        Command::Completions { shell } => {
+            use clap::CommandFactory;
+            let mut buf = Vec::new();
+            clap_complete::generate(shell, &mut Cli::command(), "trum", &mut buf);
+            out.write_all(&buf)?;
+            Ok(0)
+        }
     }
 }

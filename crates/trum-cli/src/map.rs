@@ -9,6 +9,7 @@
 //! solved, one queued, one being written): memory is constant for any grid size.
 
 use crate::args::{GridArgs, MotorArgs};
+use crate::format::csv_number;
 use crate::grid::{check_grid, default_grid};
 use crate::output::{OutputTarget, Progress, WritebackFile};
 use anyhow::{anyhow, bail, Context, Result};
@@ -18,7 +19,7 @@ use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 use trum_core::quantities::{self, Quantity, QUANTITIES};
 use trum_core::solve::Prepared;
-use trum_core::sweep::{axis_values, chunk_count, chunk_range, solve_range, Grid, AXES, CHUNK_POINTS};
+use trum_core::sweep::{axis_values, chunk_count, chunk_range, solve_range, Axis, Grid, AXES, CHUNK_POINTS};
 use trum_core::Motor;
 
 /// Bytes between the early disk flushes of a map written to a file (4-32 MB measured the
@@ -51,6 +52,48 @@ pub struct MapArgs {
     chunk_points: u64,
 }
 
+/// The map of a motor when nothing sets the axes: preload 100-500 N in 9 steps, load
+/// torque from 0 to the stall torque at the highest preload in 25 steps (rounded up to
+/// two significant digits), at the motor's drive (its `[drive]`, else 200 V, 43 kHz).
+fn motor_default_grid(motor: &Motor, drive: Option<trum_core::params::Drive>) -> Result<Grid> {
+    let (v, f) = drive
+        .map_or((crate::grid::DEFAULT_VOLTAGE_V, crate::grid::DEFAULT_FREQUENCY_HZ), |d| (d.voltage_v, d.frequency_hz));
+    let preload = Axis::linspace(100.0, 500.0, 9);
+    let op = trum_core::OperatingPoint {
+        preload_n: preload.stop,
+        torque_nm: 0.0,
+        voltage_v: v,
+        frequency_hz: f,
+        elapsed_s: 0.0,
+    };
+    let stall = trum_core::solve(motor, &op).stall_torque_nm;
+    if !(stall.is_finite() && stall > 0.0) {
+        bail!(
+            "the motor does not run at {} N, {} V, {} Hz, so it has no default map: give the axes (e.g. --preload-n 100:500:9 --torque-nm 0:1:25)",
+            preload.stop,
+            v,
+            f
+        );
+    }
+    let step = 10f64.powf(stall.log10().floor() - 1.0);
+    let top = (stall / step).ceil() * step;
+    Ok(Grid {
+        preload_n: preload,
+        torque_nm: Axis::linspace(0.0, crate::format::round_sig(top, 2), 25),
+        voltage_v: Axis::fixed(v),
+        frequency_hz: Axis::fixed(f),
+    })
+}
+
+/// An axis as the command line writes it.
+fn axis_text(a: &Axis) -> String {
+    if a.n == 1 {
+        csv_number(a.start)
+    } else {
+        format!("{}:{}:{}", csv_number(a.start), csv_number(a.stop), a.n)
+    }
+}
+
 /// Parses `--columns`: known quantity names, no duplicates.
 pub fn parse_columns(spec: Option<&str>) -> Result<Vec<&'static Quantity>> {
     let Some(spec) = spec else { return Ok(QUANTITIES.iter().collect()) };
@@ -59,7 +102,10 @@ pub fn parse_columns(spec: Option<&str>) -> Result<Vec<&'static Quantity>> {
         if INPUT_COLUMNS.contains(&name) || name == "status" {
             bail!("--columns: '{name}' is always written (inputs and status come first); list only quantities");
         }
-        let q = quantities::find(name).map_err(|m| anyhow!("--columns: {m}"))?;
+        let q = quantities::find(name).map_err(|m| {
+            let hint = crate::suggest::hint(name, crate::suggest::names(quantities::QUANTITIES.iter().map(|q| q.name)));
+            anyhow!("--columns: {m}{hint}")
+        })?;
         if cols.iter().any(|c| c.name == q.name) {
             bail!("--columns: '{name}' is listed twice");
         }
@@ -71,9 +117,29 @@ pub fn parse_columns(spec: Option<&str>) -> Result<Vec<&'static Quantity>> {
     Ok(cols)
 }
 
-pub fn run(a: &MapArgs, out: &mut dyn Write, _err: &mut dyn Write) -> Result<i32> {
+pub fn run(a: &MapArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
     let (motor, sweep) = a.motor.load()?;
-    let grid = a.grid.resolve(&sweep, &default_grid());
+    let given = [a.grid.preload_n, a.grid.torque_nm, a.grid.voltage_v, a.grid.frequency_hz];
+    let in_file = [sweep.preload_n, sweep.torque_nm, sweep.voltage_v, sweep.frequency_hz];
+    let grid = if given.iter().chain(&in_file).all(Option::is_none) {
+        // Nothing says what to map: the motor's own map, not a single point.
+        let drive = crate::optimize::motor_drive(&a.motor.motor)?;
+        let g = motor_default_grid(&motor, drive)?;
+        if !a.quiet {
+            writeln!(
+                err,
+                "note: no axes given (command line or the motor file's [sweep]): mapping the motor's default grid \
+                 --preload-n {} --torque-nm {} --voltage-v {} --frequency-hz {}",
+                axis_text(&g.preload_n),
+                axis_text(&g.torque_nm),
+                axis_text(&g.voltage_v),
+                axis_text(&g.frequency_hz)
+            )?;
+        }
+        g
+    } else {
+        a.grid.resolve(&sweep, &default_grid())
+    };
     check_grid(&grid)?;
     let cols = parse_columns(a.columns.as_deref())?;
     if a.chunk_points == 0 {
@@ -161,10 +227,10 @@ impl ColumnMemo {
     }
 }
 
-/// Writes numbers as `format!("{v}")` (and so [`crate::format::csv_number`]) does —
-/// shortest round-trip digits, plain decimal notation, never an exponent — but through
-/// `zmij`, without allocating: number formatting cost more than solving in large maps
-/// (zmij takes 11 ns a number where ryu takes 19, for the same digits).
+/// Writes numbers as [`crate::format::csv_number`] does — shortest round-trip digits,
+/// plain decimals for magnitudes in [1e-5, 1e16), exponent form (`1e23`) outside — but
+/// through `zmij`, without allocating: number formatting cost more than solving in large
+/// maps (zmij takes 11 ns a number where ryu takes 19, for the same digits).
 pub struct NumberFormatter {
     digits: zmij::Buffer,
 }
@@ -188,7 +254,7 @@ impl NumberFormatter {
         }
         let a = v.abs();
         let s = self.digits.format_finite(v).as_bytes();
-        if (1e-5..1e16).contains(&a) {
+        if (crate::format::PLAIN_MIN..crate::format::PLAIN_MAX).contains(&a) {
             // zmij writes these magnitudes in decimal form (decimal exponent -5..=15: the
             // shortest digits of a double below 1e16, or at or above the double nearest
             // 1e-5, stay on the same side of the bound), an integer as "N.0", which
@@ -202,55 +268,12 @@ impl NumberFormatter {
             out.extend_from_slice(s.strip_suffix(b".0").unwrap_or(s));
             return;
         };
-        // Exponent form `[-]d[.ddd]e[+-]EXP` (one nonzero digit before the point): place the
-        // digits around the decimal point without an exponent.
-        let (neg, mant) = if s[0] == b'-' { (true, &s[1..e]) } else { (false, &s[..e]) };
-        let frac = mant.get(2..).unwrap_or(&[]);
-        let point = 1 + parse_exponent(&s[e + 1..]); // value = 0.DIGITS × 10^point
-        let n = 1 + frac.len() as i64;
-        if neg {
-            out.push(b'-');
-        }
-        if point <= 0 {
-            out.extend_from_slice(b"0.");
-            push_zeros(out, -point);
-            out.push(mant[0]);
-            out.extend_from_slice(frac);
-        } else if point >= n {
-            out.push(mant[0]);
-            out.extend_from_slice(frac);
-            push_zeros(out, point - n);
-        } else {
-            let k = point as usize - 1;
-            out.push(mant[0]);
-            out.extend_from_slice(&frac[..k]);
-            out.push(b'.');
-            out.extend_from_slice(&frac[k..]);
-        }
-    }
-}
-
-fn push_zeros(out: &mut Vec<u8>, n: i64) {
-    const ZEROS: [u8; 64] = [b'0'; 64];
-    let mut n = n.max(0) as usize;
-    while n > 0 {
-        let k = n.min(ZEROS.len());
-        out.extend_from_slice(&ZEROS[..k]);
-        n -= k;
-    }
-}
-
-fn parse_exponent(s: &[u8]) -> i64 {
-    let (neg, s) = match s.first() {
-        Some(b'-') => (true, &s[1..]),
-        Some(b'+') => (false, &s[1..]),
-        _ => (false, s),
-    };
-    let e = s.iter().fold(0i64, |acc, &b| acc * 10 + i64::from(b - b'0'));
-    if neg {
-        -e
-    } else {
-        e
+        // Exponent form `[-]d[.ddd]e[+-]EXP`: as `{:e}` writes it (no ".0", no "+").
+        let mant = &s[..e];
+        out.extend_from_slice(mant.strip_suffix(b".0").unwrap_or(mant));
+        out.push(b'e');
+        let exp = &s[e + 1..];
+        out.extend_from_slice(exp.strip_prefix(b"+").unwrap_or(exp));
     }
 }
 
@@ -319,13 +342,13 @@ mod tests {
             let mut out = Vec::new();
             f.push(&mut out, v);
             let got = String::from_utf8(out).expect("ascii");
-            let want = format!("{v}");
+            let want = crate::format::csv_number(v);
             // Same shortest round trip in the same notation. (Where two 17-digit strings
             // are equally short, zmij and std may pick different last digits: 1658206780088562.2
             // vs .3 for 1.6582067800885623e15; both parse back to v.)
             assert_eq!(got.parse::<f64>().map(f64::to_bits), Ok(v.to_bits()), "{v:e}: {got}");
             assert_eq!(got.len(), want.len(), "{v:e}: {got} vs {want}");
-            assert!(!got.contains('e'));
+            assert_eq!(got.contains('e'), want.contains('e'), "{v:e}: {got} vs {want}");
             exact += usize::from(got == want);
             total += 1;
         };

@@ -12,7 +12,7 @@ impl MotorArgs {
     pub fn load(&self) -> Result<(Motor, SweepTable)> {
         let (mut motor, sweep) = load_motor(&self.motor)?;
         for spec in &self.effects {
-            motor.effects.parse_assignment(spec).map_err(|m| anyhow!("--effect '{spec}': {m}"))?;
+            motor.effects.parse_assignment(spec).map_err(|m| anyhow!("--effect '{spec}': {m}{}", effect_hint(spec)))?;
         }
         Ok((motor, sweep))
     }
@@ -38,7 +38,8 @@ pub fn load_motor(spec: &str) -> Result<(Motor, SweepTable)> {
             if looks_like_file {
                 bail!("motor file '{spec}' does not exist (nor is it a preset name; valid presets are: {names})")
             }
-            bail!("unknown preset '{spec}' (and no file of that name exists); valid presets are: {names}")
+            let hint = crate::suggest::preset_hint(spec);
+            bail!("unknown preset '{spec}' (and no file of that name exists); valid presets are: {names}{hint}")
         }
     }
 }
@@ -52,4 +53,14 @@ pub fn load_tolerances(spec: &str) -> Result<std::collections::BTreeMap<String, 
     }
     let text = std::fs::read_to_string(path).with_context(|| format!("cannot read motor file '{spec}'"))?;
     trum_core::params::tolerances_from_toml_str(&text, spec).map_err(|e| anyhow!("{e}"))
+}
+
+/// `"; did you mean 'radial_friction'?"` when the effect named in `spec` is not known.
+pub fn effect_hint(spec: &str) -> String {
+    let name = spec.split([':', '=']).next().unwrap_or("").trim();
+    let known = trum_core::effects::EFFECTS.iter().map(|e| e.name);
+    if name.is_empty() || name == "none" || known.clone().any(|n| n == name) {
+        return String::new();
+    }
+    crate::suggest::hint(name, crate::suggest::names(known))
 }

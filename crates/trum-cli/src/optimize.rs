@@ -45,6 +45,9 @@ pub struct OptimizeArgs {
     /// No progress bar.
     #[arg(short, long)]
     quiet: bool,
+    /// Print the result as JSON (settings, optimum, region, notes, every row) instead of the table.
+    #[arg(long)]
+    json: bool,
 }
 
 /// Columns of the criterion table.
@@ -98,7 +101,7 @@ fn row_cells(r: &CriterionRow, fmt: &dyn Fn(f64) -> String) -> Vec<String> {
 
 /// The drive a motor's source figures were taken at: a file's `[drive]` (or its preset's),
 /// or a preset's.
-fn motor_drive(spec: &str) -> Result<Option<Drive>> {
+pub fn motor_drive(spec: &str) -> Result<Option<Drive>> {
     let path = std::path::Path::new(spec);
     if path.is_file() {
         let text = std::fs::read_to_string(path).with_context(|| format!("cannot read motor file '{spec}'"))?;
@@ -127,6 +130,9 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     let res = res.map_err(|e| anyhow!("{e}"))?;
 
     let to_stdout = matches!(target, Some(OutputTarget::Stdout));
+    if to_stdout && a.json {
+        bail!("-o - and --json cannot both go to stdout");
+    }
     if let Some(t) = target {
         let rows: Vec<Vec<String>> = res.rows.iter().map(|r| row_cells(r, &csv_number)).collect();
         let write = |w: &mut dyn Write| -> std::io::Result<()> {
@@ -145,7 +151,7 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
         }
         t.finish()?;
     }
-    if !to_stdout {
+    if !to_stdout && !a.json {
         let rows: Vec<Vec<String>> = res.rows.iter().map(|r| row_cells(r, &|v| fmt_sig(v, 5))).collect();
         let header: Vec<String> = COLUMNS
             .iter()
@@ -218,7 +224,43 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
             fmt_sig(mid(res.region_n) - mid(*paper), 4),
         ));
     }
-    if to_stdout {
+    if a.json {
+        let num = crate::data::num;
+        let rows: Vec<_> = res
+            .rows
+            .iter()
+            .map(|r| {
+                let cells = row_cells(r, &|v| v.to_string());
+                let mut m = serde_json::Map::new();
+                for (c, v) in COLUMNS.iter().zip(cells) {
+                    let value = match *c {
+                        "status" => serde_json::json!(v),
+                        "in_region" => serde_json::json!(r.in_region),
+                        _ => num(v.parse::<f64>().unwrap_or(f64::NAN)),
+                    };
+                    m.insert((*c).to_string(), value);
+                }
+                serde_json::Value::Object(m)
+            })
+            .collect();
+        let notes: Vec<&str> = summary.lines().skip(1).collect();
+        let doc = serde_json::json!({
+            "motor": { "name": motor.name, "source": a.motor.motor, "effects": motor.effects.to_string() },
+            "voltage_v": cfg.voltage_v,
+            "frequency_hz": cfg.frequency_hz,
+            "drive_from_motor": drive.is_some() && (a.voltage_v.is_none() || a.frequency_hz.is_none()),
+            "weights": { "stall_torque": cfg.weights[0], "efficiency": cfg.weights[1],
+                         "temperature_rise": cfg.weights[2], "speed_fluctuation": cfg.weights[3] },
+            "run_time_s": cfg.run_time_s,
+            "runout_m": cfg.runout_m,
+            "region_tolerance": cfg.region_tolerance,
+            "optimum_preload_n": num(res.optimum_preload_n),
+            "region_n": [num(res.region_n.0), num(res.region_n.1)],
+            "notes": notes,
+            "rows": rows,
+        });
+        writeln!(out, "{}", serde_json::to_string_pretty(&doc)?)?;
+    } else if to_stdout {
         writeln!(err, "{summary}")?;
     } else {
         writeln!(out, "{summary}")?;

@@ -123,7 +123,10 @@ impl Data {
     fn col(&self, name: &str, what: &str) -> Result<&[f64]> {
         match self.names.iter().position(|n| n == name) {
             Some(i) => Ok(&self.cols[i]),
-            None => bail!("{what} column '{name}' does not exist; available columns are: {}", self.names.join(", ")),
+            None => {
+                let hint = crate::suggest::hint(name, crate::suggest::names(self.names.iter().map(String::as_str)));
+                bail!("{what} column '{name}' does not exist{hint}; available columns are: {}", self.names.join(", "))
+            }
         }
     }
 }
@@ -134,6 +137,11 @@ struct Spec {
     group: Option<String>,
     z: Option<String>,
     title: String,
+    /// Fixed conditions and effects, under the title.
+    subtitle: String,
+    /// Draw `z` over the (load torque, speed) plane of a torque × preload map, with
+    /// contours and the stall boundary, instead of a heat map over the grid.
+    speed_torque_plane: bool,
 }
 
 pub fn run(a: &PlotArgs, err: &mut dyn Write) -> Result<i32> {
@@ -153,36 +161,102 @@ pub fn run(a: &PlotArgs, err: &mut dyn Write) -> Result<i32> {
         (dg.map(String::from), dz.map(String::from))
     };
 
-    let (data, source) = match (&a.motor, &a.map) {
+    let plane = a.kind == Some(Kind::EfficiencyMap) && a.x.is_none() && a.y.is_none();
+    let (data, source, effects) = match (&a.motor, &a.map) {
         (Some(m), _) => {
             let ma = MotorArgs { motor: m.clone(), effects: a.effects.clone() };
             let (motor, sweep) = ma.load()?;
             let grid = plot_grid(&motor, a, &sweep, &x)?;
-            (solve_grid(&motor, &grid), motor.name.clone())
+            (solve_grid(&motor, &grid), motor.name.clone(), Some(motor.effects.to_string()))
         }
         (None, Some(path)) => {
             let mut needed = vec![x.as_str(), y.as_str()];
             needed.extend(group.as_deref());
             needed.extend(z.as_deref());
-            (read_csv(path, &needed)?, path.display().to_string())
+            if plane {
+                needed.push("speed_rpm");
+            }
+            // the operating-point columns a map always has: for the fixed conditions
+            let header = std::fs::read_to_string(path).ok().and_then(|t| t.lines().next().map(str::to_string));
+            for c in ["preload_n", "torque_nm", "voltage_v", "frequency_hz"] {
+                if !needed.contains(&c) && header.as_deref().is_some_and(|h| h.split(',').any(|n| n.trim() == c)) {
+                    needed.push(c);
+                }
+            }
+            needed.dedup();
+            (read_csv(path, &needed)?, path.display().to_string(), None)
         }
         (None, None) => bail!("give --motor or --map"),
     };
-    let what = match (&group, &z) {
-        (_, Some(z)) => format!("{z} over {x} × {y}"),
-        (Some(g), None) => format!("{y} vs {x} by {g}"),
-        (None, None) => format!("{y} vs {x}"),
+    let words = |c: &str| {
+        let w = display(c).0;
+        w[..1].to_string() + &w[1..]
     };
-    let spec = Spec { title: a.title.clone().unwrap_or_else(|| format!("{source}: {what}")), x, y, group, z };
+    let what = match (&group, &z) {
+        (_, Some(z)) if plane => format!("{} over load torque and speed", words(z)),
+        (_, Some(z)) => format!("{} over {} and {}", words(z), words(&x).to_lowercase(), words(&y).to_lowercase()),
+        (Some(g), None) => {
+            format!("{} against {}, by {}", words(&y), words(&x).to_lowercase(), words(g).to_lowercase())
+        }
+        (None, None) => format!("{} against {}", words(&y), words(&x).to_lowercase()),
+    };
+    // conditions that do not vary in the data and are not on an axis, and the effects
+    let mut fixed = Vec::new();
+    for c in ["preload_n", "torque_nm", "voltage_v", "frequency_hz"] {
+        if [Some(x.as_str()), Some(y.as_str()), group.as_deref()].contains(&Some(c)) {
+            continue;
+        }
+        if let Ok(v) = data.col(c, "") {
+            let d = distinct_sorted(v);
+            if d.len() == 1 {
+                fixed.push(condition(c, d[0]));
+            }
+        }
+    }
+    let mut subtitle = fixed.join(", ");
+    if let Some(e) = effects {
+        let e = if e == "none" { "nominal model (no effects)".to_string() } else { format!("effects: {e}") };
+        subtitle = if subtitle.is_empty() { e } else { format!("{subtitle}\n{e}") };
+    }
+    let spec = Spec {
+        title: a.title.clone().unwrap_or_else(|| format!("{source}: {what}")),
+        subtitle,
+        x,
+        y,
+        group,
+        z,
+        speed_torque_plane: plane,
+    };
 
     write_figure(&a.output, &SpecFigure { spec: &spec, data: &data }, err)?;
     Ok(0)
 }
 
+/// How a figure is drawn: with or without text (no font found), and the scale of the
+/// drawing surface over the final image (fonts, strokes and margins grow with it).
+#[derive(Clone, Copy, Debug)]
+pub struct Look {
+    /// False when no font is available: the plot is drawn without text.
+    pub labels: bool,
+    /// Drawing-surface pixels per image pixel.
+    pub k: f64,
+}
+
+impl Look {
+    /// `v` image pixels in drawing-surface pixels.
+    pub fn px(&self, v: f64) -> u32 {
+        (v * self.k).round().max(1.0) as u32
+    }
+    /// A font of `size` image pixels.
+    pub fn font(&self, size: f64) -> (&'static str, f64) {
+        ("sans-serif", size * self.k)
+    }
+}
+
 /// Something `write_figure` can draw on either backend.
 pub trait Figure {
-    /// Draws on `root`; `labels` is false when no font is available.
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, labels: bool, err: &mut dyn Write) -> Result<()>;
+    /// Draws on `root`.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, look: Look, err: &mut dyn Write) -> Result<()>;
 }
 
 /// Checks that `output` is a plot file name (.png or .svg, the format follows it).
@@ -194,6 +268,14 @@ pub fn check_plot_path(output: &Path) -> Result<String> {
     Ok(ext)
 }
 
+/// Supersampling of PNG output: drawn at this many times the size and averaged down, so
+/// lines and text are anti-aliased (plotters' bitmap backend draws hard pixel edges).
+const PNG_SUPERSAMPLE: u32 = 3;
+/// SVG output is drawn on a surface this many times the image size and shown at the image
+/// size through its `viewBox`: plotters' SVG backend writes whole units, which become
+/// quarter pixels.
+const SVG_SUBPIXEL: u32 = 4;
+
 /// Draws `fig` into `output` (.png or .svg) through an atomically renamed temporary file.
 pub fn write_figure(output: &Path, fig: &impl Figure, err: &mut dyn Write) -> Result<()> {
     let ext = check_plot_path(output)?;
@@ -203,18 +285,63 @@ pub fn write_figure(output: &Path, fig: &impl Figure, err: &mut dyn Write) -> Re
     }
     let target = OutputTarget::create(output, &format!(".{ext}"))?;
     let Some(draw_path) = target.draw_path() else { bail!("a plot cannot be written to stdout; give a file name") };
+    let (w, h) = SIZE_PX;
     if ext == "svg" {
-        let root = SVGBackend::new(draw_path, SIZE_PX).into_drawing_area();
-        root.fill(&WHITE).map_err(de)?;
-        fig.draw(&root, labels, err)?;
-        root.present().map_err(de)?;
+        let k = SVG_SUBPIXEL;
+        let mut text = String::new();
+        {
+            let root = SVGBackend::with_string(&mut text, (w * k, h * k)).into_drawing_area();
+            root.fill(&WHITE).map_err(de)?;
+            fig.draw(&root, Look { labels, k: f64::from(k) }, err)?;
+            root.present().map_err(de)?;
+        }
+        // shown at the image size; the drawing keeps its finer coordinates in the viewBox
+        let text = text.replacen(
+            &format!("width=\"{}\" height=\"{}\"", w * k, h * k),
+            &format!("width=\"{w}\" height=\"{h}\""),
+            1,
+        );
+        std::fs::write(draw_path, text).with_context(|| format!("writing '{}'", output.display()))?;
     } else {
-        let root = BitMapBackend::new(draw_path, SIZE_PX).into_drawing_area();
-        root.fill(&WHITE).map_err(de)?;
-        fig.draw(&root, labels, err)?;
-        root.present().map_err(de)?;
+        let k = PNG_SUPERSAMPLE;
+        let mut big = vec![0u8; (w * k * h * k * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut big, (w * k, h * k)).into_drawing_area();
+            root.fill(&WHITE).map_err(de)?;
+            fig.draw(&root, Look { labels, k: f64::from(k) }, err)?;
+            root.present().map_err(de)?;
+        }
+        let small = downsample(&big, (w, h), k);
+        let mut out = BitMapBackend::new(draw_path, (w, h));
+        out.blit_bitmap((0, 0), (w, h), &small).map_err(de)?;
+        out.present().map_err(de)?;
     }
     target.finish()
+}
+
+/// Averages `k` × `k` blocks of an RGB image of `k` times `size`.
+fn downsample(big: &[u8], (w, h): (u32, u32), k: u32) -> Vec<u8> {
+    let (w, h, k) = (w as usize, h as usize, k as usize);
+    let bw = w * k;
+    let mut out = vec![0u8; w * h * 3];
+    for y in 0..h {
+        for x in 0..w {
+            let mut acc = [0u32; 3];
+            for dy in 0..k {
+                let row = ((y * k + dy) * bw + x * k) * 3;
+                for dx in 0..k {
+                    for (c, a) in acc.iter_mut().enumerate() {
+                        *a += u32::from(big[row + dx * 3 + c]);
+                    }
+                }
+            }
+            let n = (k * k) as u32;
+            for (c, a) in acc.iter().enumerate() {
+                out[(y * w + x) * 3 + c] = ((a + n / 2) / n) as u8;
+            }
+        }
+    }
+    out
 }
 
 struct SpecFigure<'a> {
@@ -223,9 +350,22 @@ struct SpecFigure<'a> {
 }
 
 impl Figure for SpecFigure<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, labels: bool, err: &mut dyn Write) -> Result<()> {
-        draw(root, self.spec, self.data, labels, err)
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, look: Look, err: &mut dyn Write) -> Result<()> {
+        draw(root, self.spec, self.data, look, err)
     }
+}
+
+/// How a [`Line`] is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stroke {
+    /// A solid line.
+    Solid,
+    /// A dashed line (unstable branches, limits).
+    Dashed,
+    /// A thin dotted line (backbones, references).
+    Dotted,
+    /// Open circles at the points, no line (jumps, saddle nodes).
+    Circles,
 }
 
 /// One polyline of a [`LinePlot`]; non-finite points break it.
@@ -236,14 +376,16 @@ pub struct Line {
     pub color: RGBColor,
     /// Points in drawing order.
     pub points: Vec<(f64, f64)>,
-    /// Dashed instead of solid (unstable branches, backbones, limits).
-    pub dashed: bool,
+    /// How it is drawn.
+    pub stroke: Stroke,
 }
 
 /// Explicit lines against named (unit-suffixed) axes.
 pub struct LinePlot {
     /// Title.
     pub title: String,
+    /// Second title line: the fixed conditions and the effects switched on (may be empty).
+    pub subtitle: String,
     /// Horizontal axis column name (its unit is looked up for the label).
     pub x: String,
     /// Vertical axis column name.
@@ -253,8 +395,8 @@ pub struct LinePlot {
 }
 
 impl Figure for LinePlot {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, labels: bool, _: &mut dyn Write) -> Result<()> {
-        draw_lines(root, self, labels)
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, look: Look, _: &mut dyn Write) -> Result<()> {
+        draw_lines(root, self, look)
     }
 }
 
@@ -263,13 +405,13 @@ fn de<E: std::fmt::Display>(e: E) -> anyhow::Error {
 }
 
 fn fonts_available() -> bool {
-    ("sans-serif", 16).into_font().box_size("0.5 N m").is_ok()
+    ("sans-serif", 16).into_font().box_size("0.5 N·m").is_ok()
 }
 
 /// The grid for `--motor`: command line, then `[sweep]`, then the kind's defaults. An unset
 /// torque axis runs from zero to 5 % above the largest no-load stall torque.
 fn plot_grid(motor: &Motor, a: &PlotArgs, sweep: &trum_core::params::SweepTable, x: &str) -> Result<Grid> {
-    let (p, t, v, f) = match a.kind {
+    let (p, t, mut v, mut f) = match a.kind {
         Some(k) => k.default_axes(),
         None => {
             let d = crate::grid::default_grid();
@@ -277,6 +419,15 @@ fn plot_grid(motor: &Motor, a: &PlotArgs, sweep: &trum_core::params::SweepTable,
             (d.preload_n, t, d.voltage_v, d.frequency_hz)
         }
     };
+    // a fixed drive defaults to the motor's own (its [drive], as `trum map` and `trum optimize`)
+    if let Some(d) = a.motor.as_deref().map(crate::optimize::motor_drive).transpose()?.flatten() {
+        if v.n == 1 {
+            v = Axis::fixed(d.voltage_v);
+        }
+        if f.n == 1 {
+            f = Axis::fixed(d.frequency_hz);
+        }
+    }
     let mut grid =
         a.grid.resolve(sweep, &Grid { preload_n: p, torque_nm: Axis::fixed(0.0), voltage_v: v, frequency_hz: f });
     if a.grid.torque_nm.is_none() && sweep.torque_nm.is_none() {
@@ -347,7 +498,10 @@ fn read_csv(path: &Path, needed: &[&str]) -> Result<Data> {
     for n in needed {
         match all.iter().position(|h| h == n) {
             Some(i) => idx.push(i),
-            None => bail!("{shown}: column '{n}' does not exist; the columns are: {}", all.join(", ")),
+            None => {
+                let hint = crate::suggest::hint(n, crate::suggest::names(all.iter().map(String::as_str)));
+                bail!("{shown}: column '{n}' does not exist{hint}; the columns are: {}", all.join(", "))
+            }
         }
     }
     let mut cols = vec![Vec::new(); needed.len()];
@@ -372,12 +526,64 @@ fn read_csv(path: &Path, needed: &[&str]) -> Result<Data> {
     Ok(Data { names: needed.iter().map(|s| s.to_string()).collect(), cols })
 }
 
-/// `name [unit]`, with `N m` printed as `N·m`.
-fn axis_label(name: &str) -> String {
-    match unit_of(name) {
-        Some(u) => format!("{name} [{}]", u.replace(' ', "·")),
-        None => name.to_string(),
+/// How a column is shown on an axis: words, the unit shown and the factor from the
+/// column's SI unit to it (amplitudes in µm, efficiencies in %, frequencies in kHz).
+pub fn display(name: &str) -> (String, String, f64) {
+    let known: Option<(&str, &str, f64)> = match name {
+        "preload_n" => Some(("Preload", "N", 1.0)),
+        "torque_nm" => Some(("Load torque", "N·m", 1.0)),
+        "voltage_v" => Some(("Drive voltage", "V", 1.0)),
+        "frequency_hz" => Some(("Drive frequency", "kHz", 1e-3)),
+        "elapsed_s" => Some(("Time since switch-on", "s", 1.0)),
+        "speed_rpm" => Some(("Speed", "rpm", 1.0)),
+        "speed_rad_s" => Some(("Angular speed", "rad/s", 1.0)),
+        "efficiency" => Some(("Efficiency", "%", 100.0)),
+        "output_power_w" => Some(("Output power", "W", 1.0)),
+        "input_power_w" => Some(("Input power", "W", 1.0)),
+        "stall_torque_nm" => Some(("Stall torque", "N·m", 1.0)),
+        "amplitude_m" => Some(("Vibration amplitude", "µm", 1e6)),
+        "contact_angle_deg" => Some(("Contact angle", "°", 1.0)),
+        "driving_angle_deg" => Some(("Driving angle", "°", 1.0)),
+        "temperature_rise_k" => Some(("Temperature rise", "K", 1.0)),
+        "speed_std_rpm" => Some(("Speed fluctuation (std)", "rpm", 1.0)),
+        "current_a" => Some(("Drive current", "A", 1.0)),
+        "feedback_v" => Some(("Feedback voltage", "V", 1.0)),
+        "time_s" => Some(("Time", "ms", 1e3)),
+        "position_m" => Some(("Position along the wavelength", "mm", 1e3)),
+        "tangential_force_n_per_m" => Some(("Tangential force per length", "N/m", 1.0)),
+        _ => None,
+    };
+    if let Some((w, u, f)) = known {
+        return (w.to_string(), u.to_string(), f);
     }
+    // other quantities: their meaning from the registry, their unit as the CLI writes it
+    let words = QUANTITIES
+        .iter()
+        .find(|q| q.name == name)
+        .map(|q| {
+            let d = q.doc.split(',').next().unwrap_or(q.doc);
+            let mut c = d.chars();
+            c.next().map(|f| f.to_uppercase().collect::<String>() + c.as_str()).unwrap_or_default()
+        })
+        .unwrap_or_else(|| name.replace('_', " "));
+    let unit = unit_of(name).filter(|u| *u != "-").map(|u| u.replace("N m", "N·m")).unwrap_or_default();
+    (words, unit, 1.0)
+}
+
+/// `"Speed [rpm]"`: words and unit, for an axis.
+pub fn axis_label(name: &str) -> String {
+    let (w, u, _) = display(name);
+    if u.is_empty() {
+        w
+    } else {
+        format!("{w} [{u}]")
+    }
+}
+
+/// `"preload 250 N"`: a fixed condition in words.
+pub fn condition(name: &str, v: f64) -> String {
+    let (w, u, f) = display(name);
+    format!("{} {} {u}", w.to_lowercase(), crate::format::fmt_sig(v * f, 6)).trim_end().to_string()
 }
 
 fn padded(lo: f64, hi: f64, from_zero: bool) -> (f64, f64) {
@@ -408,22 +614,26 @@ fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     spec: &Spec,
     data: &Data,
-    labels: bool,
+    look: Look,
     err: &mut dyn Write,
 ) -> Result<()> {
     let xs = data.col(&spec.x, "--x")?;
     let ys = data.col(&spec.y, "--y")?;
+    if spec.speed_torque_plane {
+        let z = spec.z.as_deref().unwrap_or("efficiency");
+        return efficiency_plane(root, spec, data, z, look);
+    }
     match &spec.z {
         Some(z) => {
             let zs = data.col(z, "--z")?;
-            heat_map(root, spec, xs, ys, zs, labels, err)
+            heat_map(root, spec, xs, ys, zs, look, err)
         }
         None => {
             let gs = match &spec.group {
                 Some(g) => Some(data.col(g, "--group")?),
                 None => None,
             };
-            curves(root, spec, xs, ys, gs, labels)
+            curves(root, spec, xs, ys, gs, look)
         }
     }
 }
@@ -434,7 +644,7 @@ fn curves<DB: DrawingBackend>(
     xs: &[f64],
     ys: &[f64],
     gs: Option<&[f64]>,
-    labels: bool,
+    look: Look,
 ) -> Result<()> {
     // group value (as bits, so it can be a key; ordered by value below) → points
     let mut groups: BTreeMap<u64, (f64, Vec<(f64, f64)>)> = BTreeMap::new();
@@ -453,39 +663,65 @@ fn curves<DB: DrawingBackend>(
         .enumerate()
         .map(|(gi, (g, mut points))| {
             points.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let label = spec.group.as_deref().map(|gname| {
-                let unit = unit_of(gname).map(|u| format!(" {}", u.replace(' ', "·"))).unwrap_or_default();
-                format!("{gname} = {}{unit}", crate::format::fmt_sig(g, 6))
-            });
-            Line { label, color: series_color(gi, n), points, dashed: false }
+            let label = spec.group.as_deref().map(|gname| condition(gname, g));
+            Line { label, color: series_color(gi, n), points, stroke: Stroke::Solid }
         })
         .collect();
-    let plot = LinePlot { title: spec.title.clone(), x: spec.x.clone(), y: spec.y.clone(), lines };
-    draw_lines(root, &plot, labels)
+    let plot = LinePlot {
+        title: spec.title.clone(),
+        subtitle: spec.subtitle.clone(),
+        x: spec.x.clone(),
+        y: spec.y.clone(),
+        lines,
+    };
+    draw_lines(root, &plot, look)
 }
 
-fn draw_lines<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, plot: &LinePlot, labels: bool) -> Result<()> {
-    let pts = || plot.lines.iter().flat_map(|l| l.points.iter());
+/// The title area: `title` in bold-ish large type, `subtitle` (conditions, effects) below
+/// in smaller type; returns the area left for the chart.
+fn titled<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    subtitle: &str,
+    look: Look,
+) -> Result<DrawingArea<DB, Shift>> {
+    if !look.labels {
+        return Ok(root.clone());
+    }
+    let mut area = root.titled(title, look.font(22.0)).map_err(de)?;
+    for line in subtitle.lines().filter(|l| !l.trim().is_empty()) {
+        area = area.titled(line, look.font(15.0)).map_err(de)?;
+    }
+    Ok(area)
+}
+
+fn draw_lines<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, plot: &LinePlot, look: Look) -> Result<()> {
+    let (_, _, fx) = display(&plot.x);
+    let (_, _, fy) = display(&plot.y);
+    let pts = || plot.lines.iter().flat_map(|l| l.points.iter()).map(move |p| (p.0 * fx, p.1 * fy));
     let xr = finite_range(pts().map(|p| p.0)).ok_or_else(|| anyhow!("no finite values in column '{}'", plot.x))?;
     let yr = finite_range(pts().map(|p| p.1))
         .ok_or_else(|| anyhow!("no valid values of '{}' to plot (every point is invalid)", plot.y))?;
     let (x0, x1) = padded(xr.0, xr.1, false);
     let (y0, y1) = padded(yr.0, yr.1, true);
 
-    let mut cb = ChartBuilder::on(root);
-    cb.margin(20);
-    if labels {
-        cb.caption(&plot.title, ("sans-serif", 22)).x_label_area_size(55).y_label_area_size(80);
+    let area = titled(root, &plot.title, &plot.subtitle, look)?;
+    let mut cb = ChartBuilder::on(&area);
+    cb.margin(look.px(20.0));
+    if look.labels {
+        cb.x_label_area_size(look.px(55.0)).y_label_area_size(look.px(80.0));
     }
     let mut chart = cb.build_cartesian_2d(x0..x1, y0..y1).map_err(de)?;
     let mut mesh = chart.configure_mesh();
-    if labels {
+    let grid_line = RGBColor(225, 225, 225).stroke_width(look.px(1.0));
+    mesh.light_line_style(WHITE.mix(0.0)).bold_line_style(grid_line).axis_style(BLACK.stroke_width(look.px(1.0)));
+    if look.labels {
         mesh.x_desc(axis_label(&plot.x))
             .y_desc(axis_label(&plot.y))
             .x_label_formatter(&tick)
             .y_label_formatter(&tick)
-            .label_style(("sans-serif", 15))
-            .axis_desc_style(("sans-serif", 17));
+            .label_style(look.font(15.0))
+            .axis_desc_style(look.font(17.0));
     } else {
         mesh.x_labels(0).y_labels(0);
     }
@@ -493,20 +729,61 @@ fn draw_lines<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, plot: &LinePlot
     let mut legend = false;
     for line in &plot.lines {
         let color = line.color;
-        let style = color.stroke_width(2);
+        let width = if line.stroke == Stroke::Dotted { 1.2 } else { 2.0 };
+        let style = color.stroke_width(look.px(width));
+        let points: Vec<(f64, f64)> = line.points.iter().map(|p| (p.0 * fx, p.1 * fy)).collect();
+        let (dash, gap) = match line.stroke {
+            Stroke::Dotted => (look.px(2.0), look.px(4.0)),
+            _ => (look.px(9.0), look.px(5.0)),
+        };
+        let (k, stroke) = (look.k, line.stroke);
+        // one element type for every stroke: the parts a stroke does not use are transparent
+        let swatch = move |(x, y): (i32, i32)| {
+            let px = |v: f64| (v * k).round() as i32;
+            let on = |b: bool| ShapeStyle {
+                color: if b { color.to_rgba() } else { TRANSPARENT },
+                filled: false,
+                stroke_width: (2.0 * k).round().max(1.0) as u32,
+            };
+            let ((a0, a1), (b0, b1)) = match stroke {
+                Stroke::Solid => ((0.0, 22.0), (22.0, 22.0)),
+                Stroke::Dashed => ((0.0, 8.0), (14.0, 22.0)),
+                Stroke::Dotted => ((0.0, 3.0), (19.0, 22.0)),
+                Stroke::Circles => ((0.0, 0.0), (0.0, 0.0)),
+            };
+            let line = stroke != Stroke::Circles;
+            EmptyElement::at((x, y))
+                + Circle::new((px(11.0), 0), px(4.0), on(!line))
+                + PathElement::new(vec![(px(a0), 0), (px(a1), 0)], on(line))
+                + PathElement::new(vec![(px(b0), 0), (px(b1), 0)], on(line))
+        };
+        // a legend-only entry (no points) still gets its swatch
+        if points.is_empty() {
+            if let (true, Some(label)) = (look.labels, &line.label) {
+                chart
+                    .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                    .map_err(de)?
+                    .label(label.clone())
+                    .legend(swatch);
+                legend = true;
+            }
+            continue;
+        }
         // invalid points (NaN) break the line instead of being joined across
         let mut labelled = false;
-        for seg in line.points.split(|p| !p.0.is_finite() || !p.1.is_finite()).filter(|s| !s.is_empty()) {
+        for seg in points.split(|p| !p.0.is_finite() || !p.1.is_finite()).filter(|s| !s.is_empty()) {
             let pts = seg.iter().copied();
-            let series = if line.dashed {
-                chart.draw_series(DashedLineSeries::new(pts, 8, 5, style)).map_err(de)?
-            } else {
-                chart.draw_series(LineSeries::new(pts, style)).map_err(de)?
+            let series = match line.stroke {
+                Stroke::Solid => chart.draw_series(LineSeries::new(pts, style)).map_err(de)?,
+                Stroke::Dashed | Stroke::Dotted => {
+                    chart.draw_series(DashedLineSeries::new(pts, dash, gap, style)).map_err(de)?
+                }
+                Stroke::Circles => chart
+                    .draw_series(pts.map(|p| Circle::new(p, look.px(5.0), color.stroke_width(look.px(1.8)))))
+                    .map_err(de)?,
             };
-            if let (false, true, Some(label)) = (labelled, labels, &line.label) {
-                series
-                    .label(label.clone())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3)));
+            if let (false, true, Some(label)) = (labelled, look.labels, &line.label) {
+                series.label(label.clone()).legend(swatch);
                 labelled = true;
                 legend = true;
             }
@@ -516,9 +793,11 @@ fn draw_lines<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, plot: &LinePlot
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)
-            .label_font(("sans-serif", 15))
+            .label_font(look.font(15.0))
+            .legend_area_size(look.px(30.0))
+            .margin(look.px(8.0))
             .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
+            .border_style(BLACK.stroke_width(look.px(1.0)))
             .draw()
             .map_err(de)?;
     }
@@ -582,7 +861,7 @@ fn heat_map<DB: DrawingBackend>(
     xs: &[f64],
     ys: &[f64],
     zs: &[f64],
-    labels: bool,
+    look: Look,
     err: &mut dyn Write,
 ) -> Result<()> {
     let z_name = spec.z.as_deref().unwrap_or("");
@@ -619,23 +898,28 @@ fn heat_map<DB: DrawingBackend>(
     let ex = edges(&ux);
     let ey = edges(&uy);
 
-    let (w, _) = root.dim_in_pixel();
-    let (main, bar) = root.split_horizontally(w.saturating_sub(130));
+    let (_, _, fz) = display(z_name);
+    let (fx, fy) = (display(&spec.x).2, display(&spec.y).2);
+    let ex: Vec<f64> = ex.iter().map(|v| v * fx).collect();
+    let ey: Vec<f64> = ey.iter().map(|v| v * fy).collect();
+    let area = titled(root, &spec.title, &spec.subtitle, look)?;
+    let (w, _) = area.dim_in_pixel();
+    let (main, bar) = area.split_horizontally(w.saturating_sub(look.px(130.0)));
     let mut cb = ChartBuilder::on(&main);
-    cb.margin(20);
-    if labels {
-        cb.caption(&spec.title, ("sans-serif", 22)).x_label_area_size(55).y_label_area_size(80);
+    cb.margin(look.px(20.0));
+    if look.labels {
+        cb.x_label_area_size(look.px(55.0)).y_label_area_size(look.px(80.0));
     }
     let mut chart = cb.build_cartesian_2d(ex[0]..ex[ex.len() - 1], ey[0]..ey[ey.len() - 1]).map_err(de)?;
     let mut mesh = chart.configure_mesh();
     mesh.disable_mesh();
-    if labels {
+    if look.labels {
         mesh.x_desc(axis_label(&spec.x))
             .y_desc(axis_label(&spec.y))
             .x_label_formatter(&tick)
             .y_label_formatter(&tick)
-            .label_style(("sans-serif", 15))
-            .axis_desc_style(("sans-serif", 17));
+            .label_style(look.font(15.0))
+            .axis_desc_style(look.font(17.0));
     } else {
         mesh.x_labels(0).y_labels(0);
     }
@@ -652,21 +936,36 @@ fn heat_map<DB: DrawingBackend>(
         }))
         .map_err(de)?;
 
-    // colour bar
-    let mut cb = ChartBuilder::on(&bar);
-    cb.margin_top(if labels { 60 } else { 20 }).margin_bottom(if labels { 75 } else { 20 }).margin_right(10);
-    if labels {
-        cb.y_label_area_size(75);
+    colour_bar(&bar, z_name, (z0, z1), fz, look)
+}
+
+/// A vertical colour bar for `z` values in `z0..z1` (shown times `fz`, in the unit of
+/// [`display`]).
+fn colour_bar<DB: DrawingBackend>(
+    bar: &DrawingArea<DB, Shift>,
+    z_name: &str,
+    (z0, z1): (f64, f64),
+    fz: f64,
+    look: Look,
+) -> Result<()> {
+    let zspan = if z1 > z0 { z1 - z0 } else { 1.0 };
+    let mut cb = ChartBuilder::on(bar);
+    cb.margin_top(look.px(20.0))
+        .margin_bottom(look.px(if look.labels { 75.0 } else { 20.0 }))
+        .margin_right(look.px(10.0));
+    if look.labels {
+        cb.y_label_area_size(look.px(75.0));
     }
-    let (b0, b1) = if z1 > z0 { (z0, z1) } else { (z0 - 0.5, z0 + 0.5) };
+    let (b0, b1) = if z1 > z0 { (z0 * fz, z1 * fz) } else { (z0 * fz - 0.5, z0 * fz + 0.5) };
+    let (z0, zspan) = (z0 * fz, zspan * fz);
     let mut bc = cb.build_cartesian_2d(0.0..1.0, b0..b1).map_err(de)?;
     let mut bm = bc.configure_mesh();
     bm.disable_mesh().disable_x_axis();
-    if labels {
+    if look.labels {
         bm.y_desc(axis_label(z_name))
             .y_label_formatter(&tick)
-            .label_style(("sans-serif", 14))
-            .axis_desc_style(("sans-serif", 16));
+            .label_style(look.font(14.0))
+            .axis_desc_style(look.font(16.0));
     } else {
         bm.y_labels(0);
     }
@@ -679,4 +978,174 @@ fn heat_map<DB: DrawingBackend>(
     }))
     .map_err(de)?;
     Ok(())
+}
+
+/// `z` (efficiency) over the (load torque, speed) plane of a torque × preload grid, as
+/// motor makers draw efficiency maps: each quadrilateral between two neighbouring preload
+/// curves and two neighbouring torques is filled with its mean `z`, iso-`z` contours are
+/// drawn through it, and the stall boundary (the last running torque of each preload,
+/// before the rotor stalls or friction clamps the stator) is a dashed line. Cells with a stalled or invalid corner are left blank, not drawn as 0.
+fn efficiency_plane<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    spec: &Spec,
+    data: &Data,
+    z_name: &str,
+    look: Look,
+) -> Result<()> {
+    let (t, p, v, z) = (
+        data.col("torque_nm", "--x")?,
+        data.col("preload_n", "--y")?,
+        data.col("speed_rpm", "speed")?,
+        data.col(z_name, "--z")?,
+    );
+    let ut = distinct_sorted(t);
+    let up = distinct_sorted(p);
+    if ut.len() < 2 || up.len() < 2 {
+        bail!(
+            "an efficiency map needs at least 2 load torques and 2 preloads (this grid has {} and {})",
+            ut.len(),
+            up.len()
+        );
+    }
+    // grid[ip][it] = (torque, speed, z), NaN where the motor does not run
+    let nan = (f64::NAN, f64::NAN, f64::NAN);
+    let mut g = vec![vec![nan; ut.len()]; up.len()];
+    for i in 0..t.len() {
+        let (Ok(it), Ok(ip)) =
+            (ut.binary_search_by(|x| x.total_cmp(&t[i])), up.binary_search_by(|x| x.total_cmp(&p[i])))
+        else {
+            continue;
+        };
+        let running = v[i].is_finite() && v[i] > 0.0 && z[i].is_finite();
+        g[ip][it] = if running { (t[i], v[i], z[i]) } else { (t[i], f64::NAN, f64::NAN) };
+    }
+    let (fz, fx, fy) = (display(z_name).2, display("torque_nm").2, display("speed_rpm").2);
+    let zr = finite_range(g.iter().flatten().map(|c| c.2))
+        .ok_or_else(|| anyhow!("no running point to draw an efficiency map from"))?;
+    let xr = (ut[0] * fx, ut[ut.len() - 1] * fx);
+    let yr = finite_range(g.iter().flatten().map(|c| c.1 * fy)).unwrap_or((0.0, 1.0));
+    let (x0, x1) = padded(xr.0, xr.1, true);
+    let (y0, y1) = padded(yr.0, yr.1, true);
+
+    let area = titled(root, &spec.title, &spec.subtitle, look)?;
+    let (w, _) = area.dim_in_pixel();
+    let (main, bar) = area.split_horizontally(w.saturating_sub(look.px(130.0)));
+    let mut cb = ChartBuilder::on(&main);
+    cb.margin(look.px(20.0));
+    if look.labels {
+        cb.x_label_area_size(look.px(55.0)).y_label_area_size(look.px(80.0));
+    }
+    let mut chart = cb.build_cartesian_2d(x0..x1, y0..y1).map_err(de)?;
+    let mut mesh = chart.configure_mesh();
+    mesh.disable_mesh();
+    if look.labels {
+        mesh.x_desc(axis_label("torque_nm"))
+            .y_desc(axis_label("speed_rpm"))
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .label_style(look.font(15.0))
+            .axis_desc_style(look.font(17.0));
+    } else {
+        mesh.x_labels(0).y_labels(0);
+    }
+    mesh.draw().map_err(de)?;
+    let zspan = if zr.1 > zr.0 { zr.1 - zr.0 } else { 1.0 };
+    let xy = |c: (f64, f64, f64)| (c.0 * fx, c.1 * fy);
+    // filled cells (a thin outline of the same colour closes the seams between them)
+    let mut cells = Vec::new();
+    for ip in 0..up.len() - 1 {
+        for it in 0..ut.len() - 1 {
+            let q = [g[ip][it], g[ip][it + 1], g[ip + 1][it + 1], g[ip + 1][it]];
+            if q.iter().any(|c| !c.1.is_finite()) {
+                continue;
+            }
+            let zm = q.iter().map(|c| c.2).sum::<f64>() / 4.0;
+            let color = colormap((zm - zr.0) / zspan);
+            cells.push(Polygon::new(q.iter().map(|&c| xy(c)).collect::<Vec<_>>(), color.filled()));
+            cells.push(Polygon::new(q.iter().map(|&c| xy(c)).collect::<Vec<_>>(), color.stroke_width(look.px(1.0))));
+        }
+    }
+    chart.draw_series(cells).map_err(de)?;
+    // every fifth preload curve, thin, so the grid can be read off
+    let every = (up.len() / 8).max(1);
+    for row in g.iter().step_by(every) {
+        let pts: Vec<(f64, f64)> = row.iter().filter(|c| c.1.is_finite()).map(|&c| xy(c)).collect();
+        chart.draw_series(LineSeries::new(pts, WHITE.mix(0.35).stroke_width(look.px(1.0)))).map_err(de)?;
+    }
+    // contours: marching squares on the (preload, torque) grid, mapped into the plane
+    let step = crate::svg::nice_step(zspan * fz, 8.0);
+    let mut level = (zr.0 * fz / step).ceil() * step;
+    let mut labels = Vec::new();
+    while level <= zr.1 * fz {
+        let lz = level / fz;
+        let mut longest: Option<(f64, (f64, f64))> = None;
+        for ip in 0..up.len() - 1 {
+            for it in 0..ut.len() - 1 {
+                let q = [g[ip][it], g[ip][it + 1], g[ip + 1][it + 1], g[ip + 1][it]];
+                if q.iter().any(|c| !c.1.is_finite()) {
+                    continue;
+                }
+                let mut cross = Vec::new();
+                for e in 0..4 {
+                    let (a, b) = (q[e], q[(e + 1) % 4]);
+                    if (a.2 - lz) * (b.2 - lz) < 0.0 || (a.2 == lz && b.2 != lz) {
+                        let f = (lz - a.2) / (b.2 - a.2);
+                        cross.push(((a.0 + f * (b.0 - a.0)) * fx, (a.1 + f * (b.1 - a.1)) * fy));
+                    }
+                }
+                for pair in cross.chunks(2).filter(|c| c.len() == 2) {
+                    chart
+                        .draw_series(std::iter::once(PathElement::new(
+                            vec![pair[0], pair[1]],
+                            WHITE.stroke_width(look.px(1.4)),
+                        )))
+                        .map_err(de)?;
+                    let mid = ((pair[0].0 + pair[1].0) / 2.0, (pair[0].1 + pair[1].1) / 2.0);
+                    let len = (pair[0].0 - pair[1].0).hypot(pair[0].1 - pair[1].1);
+                    if longest.is_none_or(|(l, _)| len > l) {
+                        longest = Some((len, mid));
+                    }
+                }
+            }
+        }
+        if let Some((_, at)) = longest {
+            labels.push((at, format!("{} %", crate::format::fmt_sig(level, 3))));
+        }
+        level += step;
+    }
+    if look.labels {
+        let style = TextStyle::from(look.font(13.0)).color(&WHITE);
+        chart.draw_series(labels.into_iter().map(|(at, text)| Text::new(text, at, style.clone()))).map_err(de)?;
+    }
+    // edge of the running region: per preload, the last running torque before the rotor
+    // stops (stall) or the stator is clamped
+    let mut boundary = Vec::new();
+    for row in &g {
+        if let Some(last) = row.iter().rposition(|c| c.1.is_finite()) {
+            if row[last + 1..].iter().any(|c| c.0.is_finite() && !c.1.is_finite()) {
+                boundary.push(xy(row[last]));
+            }
+        }
+    }
+    let k = look.k;
+    if boundary.len() >= 2 {
+        chart
+            .draw_series(DashedLineSeries::new(boundary, look.px(9.0), look.px(5.0), BLACK.stroke_width(look.px(2.0))))
+            .map_err(de)?
+            .label("stall (or clamp) boundary")
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + (22.0 * k) as i32, y)], BLACK.stroke_width((2.0 * k) as u32))
+            });
+        if look.labels {
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperRight)
+                .label_font(look.font(15.0))
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK.stroke_width(look.px(1.0)))
+                .draw()
+                .map_err(de)?;
+        }
+    }
+    colour_bar(&bar, z_name, zr, fz, look)
 }

@@ -18,7 +18,7 @@ pub struct PointArgs {
     /// Axial preload [N].
     #[arg(long)]
     preload_n: f64,
-    /// Load torque [N m].
+    /// Load torque [N·m].
     #[arg(long, default_value_t = 0.0)]
     torque_nm: f64,
     /// Drive voltage amplitude per phase, zero-to-peak [V].
@@ -51,7 +51,7 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
     let valid = s.status.is_valid();
     let inputs: [(&str, f64, &str); 5] = [
         ("preload_n", op.preload_n, "N"),
-        ("torque_nm", op.torque_nm, "N m"),
+        ("torque_nm", op.torque_nm, "N·m"),
         ("voltage_v", op.voltage_v, "V"),
         ("frequency_hz", op.frequency_hz, "Hz"),
         ("elapsed_s", op.elapsed_s, "s"),

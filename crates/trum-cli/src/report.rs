@@ -17,11 +17,11 @@ use trum_core::Motor;
 /// resolution below which two values count as the same setting).
 type Coord = (&'static str, &'static str, fn(&ObservedRow) -> f64, f64);
 const COORDS: [Coord; 5] = [
-    ("preload_n", "preload [N]", |r| r.op.preload_n, 10.0),
-    ("torque_nm", "load torque [N·m]", |r| r.op.torque_nm, 0.01),
-    ("frequency_hz", "frequency [Hz]", |r| r.op.frequency_hz, 50.0),
-    ("elapsed_s", "elapsed time [s]", |r| r.op.elapsed_s, 1.0),
-    ("voltage_v", "voltage [V]", |r| r.op.voltage_v, 5.0),
+    ("preload_n", "Preload [N]", |r| r.op.preload_n, 10.0),
+    ("torque_nm", "Load torque [N·m]", |r| r.op.torque_nm, 0.01),
+    ("frequency_hz", "Drive frequency [Hz]", |r| r.op.frequency_hz, 50.0),
+    ("elapsed_s", "Time since switch-on [s]", |r| r.op.elapsed_s, 1.0),
+    ("voltage_v", "Drive voltage [V]", |r| r.op.voltage_v, 5.0),
 ];
 
 /// Distinct settings of a coordinate over some rows.
@@ -34,11 +34,33 @@ fn settings(rows: &[&ObservedRow], c: &Coord) -> usize {
 
 fn label_of(o: Observable) -> String {
     let u = unit(o.column());
+    let words = words_of(o);
     if u.is_empty() || u == "-" {
-        o.column().to_string()
+        words
     } else {
-        format!("{} [{u}]", o.column())
+        format!("{words} [{}]", u.replace("N m", "N·m"))
     }
+}
+
+/// The measured quantity in words (`Speed`, `Input power`).
+fn words_of(o: Observable) -> String {
+    match o.column() {
+        "speed_rpm" => "Speed".to_string(),
+        "speed_std_rpm" => "Speed fluctuation (std)".to_string(),
+        "efficiency" => "Efficiency".to_string(),
+        "input_power_w" => "Input power".to_string(),
+        "output_power_w" => "Output power".to_string(),
+        "current_a" => "Drive current".to_string(),
+        "feedback_v" => "Feedback voltage".to_string(),
+        "temperature_c" => "Temperature".to_string(),
+        other => other.replace('_', " "),
+    }
+}
+
+/// `"Speed against preload"`: a chart title in words.
+fn title_of(o: Observable, c: &Coord) -> String {
+    let x = c.1.split(" [").next().unwrap_or(c.0).to_lowercase();
+    format!("{} against {x}", words_of(o))
 }
 
 const CSS: &str =
@@ -161,7 +183,7 @@ fn ranking(h: &mut String, d: &Diagnosis) {
     let big = d.ranking.iter().any(|r| r.evidence.abs() > 60.0);
     let ev = Bars {
         title: "Evidence (½·ΔBIC)".into(),
-        x_label: if big { "evidence (signed log axis)".into() } else { "evidence".into() },
+        x_label: if big { "Evidence, ½·ΔBIC (signed log axis)".into() } else { "Evidence, ½·ΔBIC".into() },
         labels: labels.clone(),
         values: d.ranking.iter().map(|r| r.evidence).collect(),
         intervals: None,
@@ -173,7 +195,7 @@ fn ranking(h: &mut String, d: &Diagnosis) {
     };
     let sh = Bars {
         title: "Shrink of the held-out gap".into(),
-        x_label: "1 − NRMSE after / NRMSE baseline (bars clipped to [−1, 1])".into(),
+        x_label: "Shrink = 1 − NRMSE after / NRMSE baseline (clipped to [−1, 1])".into(),
         labels,
         values: d.ranking.iter().map(|r| r.shrink).collect(),
         intervals: Some(d.ranking.iter().map(|r| r.shrink_interval).collect()),
@@ -243,7 +265,7 @@ fn residual_maps(h: &mut String, d: &Diagnosis, bench: &BenchData) {
             let xy = |pick: fn(&trum_core::diagnose::HeldOut) -> f64| -> Vec<(f64, f64)> {
                 items.iter().map(|x| ((c.2)(&bench.rows[x.row]), x.measured - pick(x))).collect()
             };
-            let mut ch = Chart::new(&format!("{} vs {}", o.column(), c.0), c.1, &format!("residual {}", label_of(o)));
+            let mut ch = Chart::new(&title_of(o, c), c.1, &format!("Residual of {}", label_of(o).to_lowercase()));
             ch.width = 380.0;
             ch.height = 260.0;
             ch.hline = Some(0.0);
@@ -326,7 +348,7 @@ fn curves(h: &mut String, d: &Diagnosis, bench: &BenchData) {
             quantities.push(Observable::Efficiency);
         }
         for o in quantities {
-            let mut ch = Chart::new(&format!("{} vs {}", o.column(), c.0), c.1, &label_of(o));
+            let mut ch = Chart::new(&title_of(o, c), c.1, &label_of(o));
             ch.width = 620.0;
             ch.height = 360.0;
             for (ri, (name, idx)) in runs.iter().enumerate() {

@@ -7,10 +7,11 @@
 use crate::data::{num, write_atomic};
 use crate::format::{csv_number, fmt_sig};
 use crate::grid::parse_axis;
-use crate::plot::{series_color, write_figure, Line, LinePlot};
+use crate::plot::{series_color, write_figure, Line, LinePlot, Stroke};
 use crate::table::{write_table, Align};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, ValueEnum};
+use plotters::style::RGBColor;
 use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -146,9 +147,12 @@ pub struct ResonanceArgs {
     /// Response CSV (`-` for stdout; the summary then goes to stderr).
     #[arg(short = 'o', long = "output", value_name = "CSV")]
     output: Option<PathBuf>,
-    /// Plot of the curves (.png or .svg): stable branches solid, unstable and backbones dashed.
+    /// Plot of the curves (.png or .svg): stable branches solid, unstable dashed, backbones dotted, jumps circled.
     #[arg(long, value_name = "FILE")]
     plot: Option<PathBuf>,
+    /// Print the summary of every curve as JSON (resonance, peak, jumps, hysteresis) instead of the table.
+    #[arg(long)]
+    json: bool,
 }
 
 fn axis_values(ax: &Axis, name: &str) -> Result<Vec<f64>> {
@@ -160,8 +164,11 @@ fn axis_values(ax: &Axis, name: &str) -> Result<Vec<f64>> {
 }
 
 pub fn run(a: &ResonanceArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
-    if a.output.is_none() && a.plot.is_none() {
-        bail!("nothing to write: give -o CSV and/or --plot FILE");
+    if a.output.is_none() && a.plot.is_none() && !a.json {
+        bail!("nothing to write: give -o CSV, --plot FILE and/or --json");
+    }
+    if a.json && a.output.as_deref().is_some_and(|p| p.as_os_str() == "-") {
+        bail!("-o - and --json cannot both go to stdout");
     }
     if let Some(p) = &a.plot {
         crate::plot::check_plot_path(p)?;
@@ -201,9 +208,45 @@ pub fn run(a: &ResonanceArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         write_figure(path, &response_plot(&curves, voltages.len() > 1, preloads.len() > 1), err)?;
     }
     let summary_to_stderr = a.output.as_deref().is_some_and(|p| p.as_os_str() == "-");
+    if a.json {
+        writeln!(out, "{}", serde_json::to_string_pretty(&summary_json(&curves))?)?;
+        return Ok(0);
+    }
     let summary_out: &mut dyn Write = if summary_to_stderr { err } else { out };
     write_summary(&curves, summary_out)?;
     Ok(0)
+}
+
+/// The summary table as JSON: one object per curve, `null` for numbers a curve lacks.
+fn summary_json(curves: &[FamilyCurve]) -> serde_json::Value {
+    let num = crate::data::num;
+    let list: Vec<_> = curves
+        .iter()
+        .map(|c| {
+            let op = c.operating_point;
+            let mut o = json!({
+                "voltage_v": op.voltage_v,
+                "preload_n": op.preload_n,
+                "status": response_status(c),
+            });
+            if let Err(e) = &c.response {
+                o["reason"] = json!(e.to_string());
+            }
+            let m = c.response.is_ok().then(|| response_summary(c));
+            for (k, f) in [
+                ("linear_resonance_hz", m.as_ref().map(|m| m.linear_resonance_hz)),
+                ("equivalent_beta_n_per_m3", m.as_ref().map(|m| m.equivalent_beta_n_per_m3)),
+                ("peak_amplitude_m", m.as_ref().map(|m| m.peak_amplitude_m)),
+                ("jump_up_hz", m.as_ref().map(|m| m.jump_up_hz)),
+                ("jump_down_hz", m.as_ref().map(|m| m.jump_down_hz)),
+                ("hysteresis_hz", m.as_ref().map(|m| m.hysteresis_hz)),
+            ] {
+                o[k] = num(f.unwrap_or(f64::NAN));
+            }
+            o
+        })
+        .collect();
+    json!({ "curves": list })
 }
 
 /// The response table (`trum_core::layout::response_rows`, the layout Python's
@@ -262,19 +305,61 @@ fn response_plot(curves: &[FamilyCurve], by_voltage: bool, by_preload: bool) -> 
             v.sort_by(|a, b| a.0.total_cmp(&b.0));
             v
         };
-        let solid = |points, label| Line { label, color, points, dashed: false };
+        let solid = |points, label| Line { label, color, points, stroke: Stroke::Solid };
         // the legend entry goes on the first line that has points
         let label = Some(label.join(", "));
         let (single_label, lower_label) = if lower.is_empty() { (label, None) } else { (None, label) };
         lines.push(solid(sorted(single), single_label));
         lines.push(solid(sorted(lower), lower_label));
         lines.push(solid(sorted(upper), None));
-        lines.push(Line { label: None, color, points: sorted(middle), dashed: true });
+        lines.push(Line { label: None, color, points: sorted(middle), stroke: Stroke::Dashed });
         let backbone = c.backbone.iter().map(|b| (b.frequency_hz, b.amplitude_m)).collect();
-        lines.push(Line { label: None, color, points: backbone, dashed: true });
+        lines.push(Line { label: None, color, points: backbone, stroke: Stroke::Dotted });
+        if let Some(j) = &r.jumps {
+            // each jump: the saddle node (circle) and the drop or rise to the other stable
+            // branch at the same frequency (a thin vertical line)
+            for (f, a, up) in
+                [(j.jump_up_hz, j.jump_up_amplitude_m, true), (j.jump_down_hz, j.jump_down_amplitude_m, false)]
+            {
+                let other = r
+                    .points
+                    .iter()
+                    .filter(|p| p.stable && p.branch != Branch::Middle)
+                    .min_by(|p, q| (p.frequency_hz - f).abs().total_cmp(&(q.frequency_hz - f).abs()))
+                    .map(|near| {
+                        r.points
+                            .iter()
+                            .filter(|p| p.stable && p.frequency_hz == near.frequency_hz)
+                            .map(|p| p.amplitude_m)
+                            .fold(if up { f64::NEG_INFINITY } else { f64::INFINITY }, |m, v| {
+                                if up {
+                                    m.max(v)
+                                } else {
+                                    m.min(v)
+                                }
+                            })
+                    });
+                lines.push(Line { label: None, color, points: vec![(f, a)], stroke: Stroke::Circles });
+                if let Some(b) = other.filter(|b| b.is_finite()) {
+                    lines.push(Line { label: None, color, points: vec![(f, a), (f, b)], stroke: Stroke::Dotted });
+                }
+            }
+        }
+    }
+    if !lines.is_empty() {
+        let gray = RGBColor(90, 90, 90);
+        lines.push(Line { label: Some("unstable branch".into()), color: gray, points: vec![], stroke: Stroke::Dashed });
+        lines.push(Line { label: Some("backbone".into()), color: gray, points: vec![], stroke: Stroke::Dotted });
+        lines.push(Line {
+            label: Some("jump (saddle node)".into()),
+            color: gray,
+            points: vec![],
+            stroke: Stroke::Circles,
+        });
     }
     LinePlot {
-        title: "amplitude-frequency response (dashed: unstable branch, backbone)".into(),
+        title: "Amplitude-frequency response of the Hertzian oscillator".into(),
+        subtitle: "solid: stable branches; dashed: unstable branch; dotted: backbone; circles: jumps".into(),
         x: "frequency_hz".into(),
         y: "amplitude_m".into(),
         lines,

@@ -6,10 +6,11 @@ use crate::args::MotorArgs;
 use crate::data::write_atomic;
 use crate::format::{csv_number, fmt_sig};
 use crate::grid::parse_axis;
-use crate::plot::{series_color, write_figure, Line, LinePlot};
+use crate::plot::{series_color, write_figure, Line, LinePlot, Stroke};
 use crate::table::{write_table, Align};
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
+use plotters::style::RGBColor;
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::PathBuf;
@@ -35,7 +36,7 @@ pub struct StepArgs {
     /// Axial preload [N].
     #[arg(long, default_value_t = 260.0)]
     preload_n: f64,
-    /// Load torque [N m].
+    /// Load torque [N·m].
     #[arg(long, default_value_t = 0.0)]
     torque_nm: f64,
     /// Simulated time [s].
@@ -71,6 +72,12 @@ pub struct StepArgs {
     /// Plot of the friction-force distribution with the Coulomb limits ±μp (.png or .svg).
     #[arg(long, value_name = "FILE", requires = "snapshot_at_s")]
     snapshot_plot: Option<PathBuf>,
+    /// Print the result as JSON (one object per operating point: status and every quantity) instead of the table.
+    #[arg(long)]
+    json: bool,
+    /// No progress spinner.
+    #[arg(short, long)]
+    quiet: bool,
 }
 
 /// One operating point of the sweep and its outcome.
@@ -120,8 +127,8 @@ fn quantities(r: &Run) -> Vec<(&'static str, f64, &'static str, &'static str)> {
         ("final_speed_rpm", speed, "rpm", "mean speed over the last 20 % of the run"),
         ("steady_speed_rpm", r.steady.speed_rpm, "rpm", "steady-state solver at this point"),
         ("speed_difference", rel(speed, r.steady.speed_rpm), "-", "(final - steady) / steady"),
-        ("contact_torque_nm", torque, "N m", "mean contact torque over the last 20 %"),
-        ("steady_contact_torque_nm", r.steady.contact_torque_nm, "N m", "load + rotor viscous torque at steady speed"),
+        ("contact_torque_nm", torque, "N·m", "mean contact torque over the last 20 %"),
+        ("steady_contact_torque_nm", r.steady.contact_torque_nm, "N·m", "load + rotor viscous torque at steady speed"),
         ("torque_difference", rel(torque, r.steady.contact_torque_nm), "-", "(transient - steady) / steady"),
         ("amplitude_m", amp, "m", "mean wave amplitude over the last 20 %"),
         ("steady_amplitude_m", r.steady.amplitude_m, "m", "steady-state wave amplitude"),
@@ -182,6 +189,10 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
     for &(v, f, p) in &points {
         config(v, f, p).validate().map_err(|e| anyhow!("{}", flag_message(&e)))?;
     }
+    let spinner = crate::diagnose::spinner(
+        &format!("simulating {} operating point{}", points.len(), if single { "" } else { "s" }),
+        a.quiet,
+    );
     let runs: Vec<Run> = points
         .par_iter()
         .map(|&(v, f, p)| Run {
@@ -192,6 +203,7 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
             steady: steady_comparison(&motor, &config(v, f, p)),
         })
         .collect();
+    spinner.finish_and_clear();
     if single {
         if let Err(e) = &runs[0].result {
             bail!("{}", flag_message(e));
@@ -216,11 +228,38 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
             write_atomic(path, ".csv", &snapshots_csv(resp, motor.friction_layer.friction_coefficient), out)?;
         }
         if let Some(path) = &a.plot {
-            write_figure(path, &speed_plot(resp, &runs[0]), err)?;
+            write_figure(path, &speed_plot(resp, &runs[0], &motor, a), err)?;
         }
         if let Some(path) = &a.snapshot_plot {
             write_figure(path, &snapshot_plot(resp, motor.friction_layer.friction_coefficient), err)?;
         }
+    }
+    if a.json {
+        if to_stderr {
+            bail!("--json and an output to stdout (`-`) cannot both go to stdout");
+        }
+        let list: Vec<_> = runs
+            .iter()
+            .map(|r| {
+                let mut q = serde_json::Map::new();
+                for (n, v, _, _) in quantities(r) {
+                    q.insert(n.into(), crate::data::num(v));
+                }
+                serde_json::json!({
+                    "voltage_v": r.voltage_v,
+                    "frequency_hz": r.frequency_hz,
+                    "phase_difference_deg": r.phase_deg,
+                    "preload_n": a.preload_n,
+                    "torque_nm": a.torque_nm,
+                    "status": status(&r.result),
+                    "steady_status": r.steady.status.to_string(),
+                    "quantities": q,
+                })
+            })
+            .collect();
+        let doc = serde_json::json!({ "motor": motor.name, "runs": list });
+        writeln!(out, "{}", serde_json::to_string_pretty(&doc)?)?;
+        return Ok(0);
     }
     let summary: &mut dyn Write = if to_stderr { err } else { out };
     if single {
@@ -255,7 +294,7 @@ fn print_single(r: &Run, motor: &Motor, a: &StepArgs, out: &mut dyn Write) -> Re
     writeln!(out, "motor    {}{source}", motor.name)?;
     writeln!(
         out,
-        "drive    {} V, {} Hz, phase {} deg, preload {} N, load {} N m",
+        "drive    {} V, {} Hz, phase {} deg, preload {} N, load {} N·m",
         fmt_sig(r.voltage_v, 6),
         fmt_sig(r.frequency_hz, 6),
         fmt_sig(r.phase_deg, 6),
@@ -381,17 +420,17 @@ fn snapshots_csv(r: &StepResponse, mu: f64) -> String {
     s
 }
 
-fn speed_plot(resp: &StepResponse, r: &Run) -> LinePlot {
+fn speed_plot(resp: &StepResponse, r: &Run, motor: &Motor, a: &StepArgs) -> LinePlot {
     let t = &resp.series;
-    let line = |y: &[f64], color, label: &str, dashed| Line {
+    let line = |y: &[f64], color, label: &str, stroke| Line {
         label: Some(label.into()),
         color,
         points: t.time_s.iter().copied().zip(y.iter().copied()).collect(),
-        dashed,
+        stroke,
     };
     let mut lines = vec![
-        line(&t.speed_rpm, series_color(0, 3), "speed_rpm", false),
-        line(&t.speed_period_mean_rpm, series_color(1, 3), "period mean", false),
+        line(&t.speed_rpm, RGBColor(170, 170, 170), "rotor speed", Stroke::Solid),
+        line(&t.speed_period_mean_rpm, series_color(0, 3), "mean over a drive period", Stroke::Solid),
     ];
     if r.steady.speed_rpm.is_finite() {
         let (t0, t1) = (t.time_s.first().copied().unwrap_or(0.0), t.time_s.last().copied().unwrap_or(0.0));
@@ -400,15 +439,18 @@ fn speed_plot(resp: &StepResponse, r: &Run) -> LinePlot {
             label: Some("steady-state solver".into()),
             color: series_color(2, 3),
             points: vec![(t0, v), (t1, v)],
-            dashed: true,
+            stroke: Stroke::Dashed,
         });
     }
     LinePlot {
-        title: format!(
-            "step response: {} V, {} Hz, {} deg",
+        title: format!("{}: rotor speed after switch-on (stick-slip contact)", motor.name),
+        subtitle: format!(
+            "drive voltage {} V, drive frequency {} kHz, phase {}°, preload {} N, load torque {} N·m",
             fmt_sig(r.voltage_v, 6),
-            fmt_sig(r.frequency_hz, 6),
-            fmt_sig(r.phase_deg, 6)
+            fmt_sig(r.frequency_hz / 1e3, 6),
+            fmt_sig(r.phase_deg, 6),
+            fmt_sig(a.preload_n, 6),
+            fmt_sig(a.torque_nm, 6)
         ),
         x: "time_s".into(),
         y: "speed_rpm".into(),
@@ -429,14 +471,20 @@ fn snapshot_plot(resp: &StepResponse, mu: f64) -> LinePlot {
             label: Some(format!("t = {} s: {st} stick, {sl} slip, {nc} no contact", fmt_sig(sn.time_s, 4))),
             color,
             points: pts(&|x| x.tangential_force_n_per_m),
-            dashed: false,
+            stroke: Stroke::Solid,
         });
         for sign in [1.0, -1.0] {
-            lines.push(Line { label: None, color, points: pts(&|x| sign * mu * x.pressure_n_per_m), dashed: true });
+            lines.push(Line {
+                label: None,
+                color,
+                points: pts(&|x| sign * mu * x.pressure_n_per_m),
+                stroke: Stroke::Dashed,
+            });
         }
     }
     LinePlot {
-        title: "friction force over one wavelength (dashed: Coulomb limits ±μp)".into(),
+        title: "Friction force over one wavelength".into(),
+        subtitle: format!("dashed: Coulomb limits ±μp (μ = {})", fmt_sig(mu, 3)),
         x: "position_m".into(),
         y: "tangential_force_n_per_m".into(),
         lines,

@@ -52,7 +52,7 @@ pub fn esc(s: &str) -> String {
 }
 
 /// A round step of about `span / n`.
-fn nice_step(span: f64, n: f64) -> f64 {
+pub fn nice_step(span: f64, n: f64) -> f64 {
     let raw = (span / n).max(1e-300);
     let mag = 10f64.powf(raw.log10().floor());
     let f = raw / mag;
@@ -339,10 +339,19 @@ impl Bars {
             t
         };
         let st = nice_step(x1 - x0, 5.0);
+        // labels closer than their own width to the previous one are left out (a signed
+        // log axis crowds 1, 3, 10 near zero)
+        let mut last_x = f64::NEG_INFINITY;
+        let mut ticks = ticks;
+        ticks.sort_by(|a, b| tf(*a).total_cmp(&tf(*b)));
         for t in ticks {
             let x = sx(tf(t));
-            let _ = write!(s, r##"<line x1="{x:.1}" y1="{mt}" x2="{x:.1}" y2="{:.1}" stroke="#e4e4e4"/>"##, mt + ph);
             let lab = if self.symlog { format!("{t}") } else { tick_label(t, st) };
+            if x - last_x < 8.0 + 6.5 * lab.chars().count() as f64 {
+                continue;
+            }
+            last_x = x;
+            let _ = write!(s, r##"<line x1="{x:.1}" y1="{mt}" x2="{x:.1}" y2="{:.1}" stroke="#e4e4e4"/>"##, mt + ph);
             let _ = write!(s, r#"<text x="{x:.1}" y="{:.1}" text-anchor="middle">{lab}</text>"#, mt + ph + 14.0);
         }
         let zx = sx(0.0);
@@ -387,11 +396,34 @@ impl Bars {
                 }
             }
             let txt = crate::format::fmt_sig(v, 3);
-            let _ = write!(s, r#"<text x="{:.1}" y="{:.1}" font-size="10">{txt}</text>"#, b + 4.0, y + bh / 2.0 + 4.0);
+            // the value goes right of the bar and of its interval whisker, never over them
+            let whisker = self
+                .intervals
+                .as_ref()
+                .and_then(|iv| iv.get(i))
+                .filter(|iv| iv.0.is_finite() && iv.1.is_finite())
+                .map_or(b, |iv| b.max(sx(tf(cl(iv.0)))).max(sx(tf(cl(iv.1)))));
+            let _ = write!(
+                s,
+                r#"<text x="{:.1}" y="{:.1}" font-size="10">{txt}</text>"#,
+                whisker + 4.0,
+                y + bh / 2.0 + 4.0
+            );
         }
         let _ = write!(s, r##"<line x1="{zx:.1}" y1="{mt}" x2="{zx:.1}" y2="{:.1}" stroke="#333"/>"##, mt + ph);
-        for (v, lab) in &self.refs {
-            let x = sx(tf(*v));
+        // reference lines; two labels closer than their width go to either side of their lines
+        let xs: Vec<f64> = self.refs.iter().map(|(v, _)| sx(tf(*v))).collect();
+        let width = |lab: &str| 6.0 * lab.chars().count() as f64 + 6.0;
+        for (i, (_, lab)) in self.refs.iter().enumerate() {
+            let x = xs[i];
+            let near = |j: usize| (xs[j] - x).abs() < 0.5 * (width(lab) + width(&self.refs[j].1));
+            let (anchor, dx) = if i + 1 < xs.len() && near(i + 1) && xs[i + 1] >= x {
+                ("end", -2.0)
+            } else if i > 0 && near(i - 1) && xs[i - 1] <= x {
+                ("start", 2.0)
+            } else {
+                ("middle", 0.0)
+            };
             let _ = write!(
                 s,
                 r##"<line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#c00" stroke-dasharray="4,3"/>"##,
@@ -400,7 +432,8 @@ impl Bars {
             );
             let _ = write!(
                 s,
-                r##"<text x="{x:.1}" y="{:.1}" fill="#c00" font-size="10" text-anchor="middle">{}</text>"##,
+                r##"<text x="{:.1}" y="{:.1}" fill="#c00" font-size="10" text-anchor="{anchor}">{}</text>"##,
+                x + dx,
                 mt - 7.0,
                 esc(lab)
             );

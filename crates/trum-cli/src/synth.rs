@@ -18,7 +18,7 @@ pub enum CampaignArg {
     PreloadTorque,
     /// No-load frequency sweeps ±1.5 kHz at 0.75, 1 and 1.25 × the voltage, 250 N (45 rows).
     FrequencySweep,
-    /// A 10 min warm-up time series at 250 N, 0.3 N m, 20 s samples, with temperatures (31 rows).
+    /// A 10 min warm-up time series at 250 N, 0.3 N·m, 20 s samples, with temperatures (31 rows).
     WarmUp,
     /// Speed stability (speed_std_rpm) at no load, preloads 150-500 N (8 rows).
     Stability,

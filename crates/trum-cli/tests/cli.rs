@@ -140,11 +140,24 @@ fn map_columns_rows_and_defaults() {
     let speed: f64 = rows[0][5].parse().expect("number");
     assert_eq!(format!("{speed}"), rows[0][5]);
 
-    let sel = ok(&["map", "--motor", "generic60", "--columns", "speed_rpm,efficiency", "-o", "-"]);
+    // no axes anywhere: the motor's default map (9 preloads x 25 torques up to the stall
+    // torque at 500 N, at its drive; generic60 has none: 200 V, 43 kHz), not one point
+    let sel = ok(&["map", "--motor", "generic60", "--columns", "speed_rpm,efficiency,stall_torque_nm", "-o", "-"]);
     let (h, rows) = parse_csv(&sel);
-    assert_eq!(h, ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status", "speed_rpm", "efficiency"]);
-    assert_eq!(rows.len(), 1);
-    assert_eq!(&rows[0][..4], ["250", "0", "200", "43000"]);
+    assert_eq!(
+        h,
+        ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status", "speed_rpm", "efficiency", "stall_torque_nm"]
+    );
+    assert_eq!(rows.len(), 9 * 25);
+    assert_eq!(&rows[0][..4], ["100", "0", "200", "43000"]);
+    assert_eq!(rows[224][0], "500");
+    let top: f64 = rows[224][1].parse().expect("number");
+    let stall_500: f64 = rows[200][7].parse().expect("number");
+    assert!(top >= stall_500 && top <= 1.1 * stall_500, "torque axis ends at {top}, stall torque {stall_500}");
+    assert!(rows.iter().any(|r| r[4] == "stall"), "the default map reaches the stall torque");
+    // one axis given: the other axes take their defaults, as before
+    let one = ok(&["map", "--motor", "generic60", "--preload-n", "250", "--columns", "speed_rpm", "-o", "-"]);
+    assert_eq!(parse_csv(&one).1.len(), 1);
 }
 
 #[test]
@@ -408,6 +421,27 @@ fn plots_png_and_svg() {
     ]);
     let bytes = std::fs::read(&png).expect("png");
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    // anti-aliased: pixels of the 150 N curve (viridis' first colour) blended with the
+    // white background, against those of the full colour. Drawn without supersampling the
+    // ratio is 0.23 (plotters blends a little at line joins); anti-aliased, 0.73.
+    let (w, h, rgb) = decode_png(&bytes);
+    assert_eq!((w, h), (1024, 720));
+    let c = [68.0, 1.0, 84.0];
+    let (mut core, mut blended) = (0usize, 0usize);
+    for p in rgb.chunks(3) {
+        let a = (f64::from(p[1]) - c[1]) / (255.0 - c[1]);
+        if (0..3).all(|k| (f64::from(p[k]) - (c[k] + a * (255.0 - c[k]))).abs() <= 6.0) {
+            if a < 0.15 {
+                core += 1;
+            } else if a < 0.85 {
+                blended += 1;
+            }
+        }
+    }
+    assert!(
+        core > 500 && blended as f64 > 0.45 * core as f64,
+        "{blended} blended edge pixels, {core} full-colour pixels"
+    );
     let svg = d.join("em.svg");
     ok(&[
         "plot",
@@ -424,6 +458,16 @@ fn plots_png_and_svg() {
     ]);
     let text = std::fs::read_to_string(&svg).expect("svg");
     assert!(text.starts_with("<svg") && text.contains("<rect"), "{}", &text[..200.min(text.len())]);
+    // shown at 1024 x 720, drawn in quarter pixels: the lines are not stair-stepped
+    assert!(text.starts_with(r#"<svg width="1024" height="720" viewBox="0 0 4096 2880""#), "{}", &text[..120]);
+    if text.contains("<text") {
+        // the efficiency map over the speed-torque plane: words, units, conditions, effects
+        for words in
+            ["Load torque [N·m]", "Speed [rpm]", "Efficiency [%]", "drive voltage 200 V", "nominal model (no effects)"]
+        {
+            assert!(text.contains(words), "{words} missing from the efficiency map");
+        }
+    }
     // from a map CSV
     let map = d.join("m.csv");
     ok(&[
@@ -453,7 +497,7 @@ fn plots_png_and_svg() {
         from_csv.to_str().unwrap_or_default(),
     ]);
     let text = std::fs::read_to_string(&from_csv).expect("svg");
-    assert!(text.contains("torque_nm [N·m]") || !text.contains("<text"), "axis label with unit");
+    assert!(text.contains("Load torque [N·m]") || !text.contains("<text"), "axis label in words with unit");
     let e = fails(
         &["plot", "--map", m, "--x", "torque", "--y", "speed_rpm", "-o", from_csv.to_str().unwrap_or_default()],
         1,
@@ -468,4 +512,91 @@ fn motor_file_doc_lists_every_key() {
     for k in trum_core::Motor::all_keys() {
         assert!(doc.contains(&format!("| `[{}]` | `{}` |", k.section, k.key)), "{}.{} missing", k.section, k.key);
     }
+}
+
+#[test]
+fn completions_for_bash_zsh_and_fish_name_every_command() {
+    for shell in ["bash", "zsh", "fish"] {
+        let s = ok(&["completions", shell]);
+        for cmd in ["map", "diagnose", "resonance", "completions"] {
+            assert!(s.contains(cmd), "{shell} completions lack {cmd}");
+        }
+    }
+    assert!(fails(&["completions", "tcsh"], 2).contains("invalid value 'tcsh'"));
+}
+
+#[test]
+fn json_on_presets_effects_and_optimize() {
+    let p: serde_json::Value = serde_json::from_str(&ok(&["presets", "--json"])).expect("JSON");
+    let trum60a = p.as_array().and_then(|l| l.iter().find(|x| x["name"] == "trum60a")).expect("trum60a listed");
+    assert_eq!(trum60a["display_name"], "TRUM60A");
+    assert_eq!(trum60a["drive"]["frequency_hz"], 42000.0);
+    let e: serde_json::Value = serde_json::from_str(&ok(&["effects", "--json"])).expect("JSON");
+    let names: Vec<&str> = e.as_array().expect("list").iter().filter_map(|x| x["name"].as_str()).collect();
+    let want: Vec<&str> = trum_core::effects::EFFECTS.iter().map(|x| x.name).collect();
+    assert_eq!(names, want);
+    assert_eq!(e[0]["params"][0]["role"], "strength");
+    let o: serde_json::Value =
+        serde_json::from_str(&ok(&["optimize", "--motor", "generic60", "--preload-n", "150:450:7", "--json", "-q"]))
+            .expect("JSON");
+    let rows = o["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 7);
+    // the optimum is a candidate inside its region, and the in-region rows span it
+    let best = o["optimum_preload_n"].as_f64().expect("number");
+    assert!(rows.iter().any(|r| r["preload_n"].as_f64() == Some(best)));
+    let (lo, hi) = (o["region_n"][0].as_f64().expect("lo"), o["region_n"][1].as_f64().expect("hi"));
+    assert!(lo <= best && best <= hi);
+    for r in rows {
+        let p = r["preload_n"].as_f64().expect("preload");
+        assert_eq!(r["in_region"].as_bool(), Some(lo <= p && p <= hi), "{r}");
+    }
+}
+
+#[test]
+fn did_you_mean_for_presets_effects_and_columns() {
+    let e = fails(&["point", "--motor", "TRUM60A", "--preload-n", "250"], 1);
+    assert!(e.contains("did you mean 'trum60a'?"), "{e}");
+    let e = fails(&["presets", "show", "generc60"], 1);
+    assert!(e.contains("did you mean 'generic60'?"), "{e}");
+    let e = fails(&["point", "--motor", "trum60a", "--effect", "radial_frction=1", "--preload-n", "250"], 1);
+    assert!(e.contains("did you mean 'radial_friction'?"), "{e}");
+    let e = fails(&["map", "--motor", "trum60a", "--preload-n", "250", "--columns", "speed_rmp", "-o", "-"], 1);
+    assert!(e.contains("did you mean 'speed_rpm'?"), "{e}");
+    // nothing close: no guess
+    let e = fails(&["point", "--motor", "shinsei", "--preload-n", "250"], 1);
+    assert!(!e.contains("did you mean"), "{e}");
+}
+
+#[test]
+fn csv_numbers_are_readable_and_round_trip() {
+    let s = ok(&[
+        "map",
+        "--motor",
+        "trum60a",
+        "--preload-n",
+        "250",
+        "--columns",
+        "amplitude_m,modal_stiffness_n_per_m",
+        "-o",
+        "-",
+    ]);
+    let (h, rows) = parse_csv(&s);
+    let amp = &rows[0][h.iter().position(|c| c == "amplitude_m").expect("column")];
+    // micrometre amplitudes in exponent form, not 0.00000441...
+    assert!(amp.contains("e-6") && !amp.starts_with("0.0"), "{amp}");
+    let v: f64 = amp.parse().expect("number");
+    assert_eq!(format!("{v:e}"), *amp);
+    for r in &rows {
+        assert!(r.iter().all(|c| c.len() < 26), "{r:?}");
+    }
+}
+
+/// Width, height and RGB bytes of an 8-bit RGB PNG.
+fn decode_png(bytes: &[u8]) -> (u32, u32, Vec<u8>) {
+    let mut reader = png::Decoder::new(bytes).read_info().expect("png header");
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).expect("png frame");
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    buf.truncate(info.buffer_size());
+    (info.width, info.height, buf)
 }

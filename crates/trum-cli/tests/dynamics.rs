@@ -141,7 +141,13 @@ fn resonance_plots_and_preload_family() {
     let e = fails(&["resonance", "--plot", p(&dir.path().join("r.jpg"))]);
     assert!(e.contains(".png or .svg"), "{e}");
     let e = fails(&["resonance"]);
-    assert!(e.contains("-o CSV and/or --plot"), "{e}");
+    assert!(e.contains("-o CSV, --plot FILE and/or --json"), "{e}");
+    // --json: the summary per curve, the jumps of the multiple-scales solution
+    let j: serde_json::Value = serde_json::from_str(&ok(&["resonance", "--voltage-v", "200", "--json"])).expect("JSON");
+    let c = &j["curves"][0];
+    assert_eq!(c["status"], "ok");
+    let (up, down) = (c["jump_up_hz"].as_f64().unwrap_or(0.0), c["jump_down_hz"].as_f64().unwrap_or(0.0));
+    assert!((c["hysteresis_hz"].as_f64().unwrap_or(0.0) - (up - down).abs()).abs() < 1e-9 * up, "{c}");
 }
 
 /// A feedback-voltage record of the oscillator at 200 V, 400 N on its upper branch at
@@ -338,6 +344,20 @@ fn step_sweep_over_phase_table() {
     ]
     .concat());
     assert!(out.contains("not_moving"), "{out}");
+    // --json: one run per phase, the standing wave (0 deg) does not move
+    let j: serde_json::Value = serde_json::from_str(&ok(&[
+        &["step", "--motor", FROZEN_TRUM60A, "--phase-difference-deg", "-90:90:3", "--json", "-q"][..],
+        &FAST[..],
+    ]
+    .concat()))
+    .expect("JSON");
+    let runs = j["runs"].as_array().expect("runs");
+    assert_eq!(runs.len(), 3);
+    assert_eq!(runs[1]["phase_difference_deg"], 0.0);
+    assert_eq!(runs[1]["status"], "not_moving");
+    let fwd = runs[2]["quantities"]["final_speed_rpm"].as_f64().expect("speed");
+    let rev = runs[0]["quantities"]["final_speed_rpm"].as_f64().expect("speed");
+    assert!(fwd > 0.0 && rev < 0.0 && (fwd + rev).abs() < 0.05 * fwd, "{fwd} {rev}");
     let (h, rows) = csv_rows(&std::fs::read_to_string(&table).expect("table"));
     assert_eq!(&h[..4], ["voltage_v", "frequency_hz", "phase_difference_deg", "status"]);
     let col = |name: &str| h.iter().position(|c| c == name).expect("column");

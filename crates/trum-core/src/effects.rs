@@ -302,7 +302,7 @@ pub struct Effects {
 /// effect of the motor. Zero by default; not part of a motor file.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Instrument {
-    /// Noise floor of the speed-stability reading [rev/min]: the instrument reads
+    /// Noise floor of the speed-stability reading [rpm]: the instrument reads
     /// √(true² + floor²) of a speed standard deviation.
     pub speed_std_floor_rpm: f64,
     /// Zero offset of the torque transducer [N·m]: a row's torque column reads the load

@@ -18,9 +18,9 @@ pub struct Fluctuation {
     pub status: Status,
     /// Preload ripple amplitude ΔF [N].
     pub preload_ripple_n: f64,
-    /// Time-averaged speed over a revolution [rev/min].
+    /// Time-averaged speed over a revolution [rpm].
     pub mean_speed_rpm: f64,
-    /// Time-weighted standard deviation of speed over a revolution [rev/min].
+    /// Time-weighted standard deviation of speed over a revolution [rpm].
     pub speed_std_rpm: f64,
     /// Smallest and largest contact angle over the revolution [deg] (Chen et al. 2020 Fig.
     /// 7).

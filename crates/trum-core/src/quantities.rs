@@ -43,7 +43,7 @@ quantities! {
     (efficiency, "-", "output power / electrical input power"),
     (output_power_w, "W", "mechanical output power"),
     (input_power_w, "W", "electrical input power, both phases"),
-    (stall_torque_nm, "N m", "stall (blocking) torque at this preload and drive"),
+    (stall_torque_nm, "N·m", "stall (blocking) torque at this preload and drive"),
     (amplitude_m, "m", "wave amplitude at the contact surface"),
     (contact_angle_deg, "deg", "contact angle Xc, full arc per wave"),
     (driving_angle_deg, "deg", "driving angle Xs, full arc per wave"),

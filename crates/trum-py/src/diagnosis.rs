@@ -4,7 +4,9 @@
 
 use crate::{detached, input_err, PyMotor};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use trum_core::bench::observations;
+use trum_core::calibrate::{baseline_params_with, calibrate_refitting_bounds, rescale_uncertainties, FitOptions};
 use trum_core::diagnose::json::{to_json, Provenance};
 use trum_core::diagnose::{diagnose, DiagnoseOptions};
 use trum_core::measurements::parse_measurements;
@@ -34,4 +36,52 @@ pub fn diagnose_csv(
         Ok((to_json(&d, &src).to_string(), meas.warnings.clone()))
     })?;
     out.map_err(|e| input_err(py, e))
+}
+
+/// Calibrates the uncertain baseline parameters of `motor` to the measurement CSV `data`
+/// (its bytes; `source` names it in messages), as `trum calibrate` does: a maximum a
+/// posteriori fit with each parameter's tolerance as its prior, bounds refitted once, and
+/// standard errors against relative parameter changes. Returns a dict: `motor` (the
+/// calibrated motor), `params` (rows of name, nominal, value, std_error, at_bound,
+/// identifiable), `chi2`, `chi2_per_reading`, `n_rows`, `n_readings`, `evaluations`,
+/// `warnings` (the fit's) and `notes` (the reader's). The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (motor, data, source))]
+pub fn calibrate_csv<'py>(
+    py: Python<'py>,
+    motor: &Bound<'py, PyMotor>,
+    data: Vec<u8>,
+    source: String,
+) -> PyResult<Bound<'py, PyDict>> {
+    let pm = motor.get().clone();
+    let m = pm.inner.clone();
+    let out = detached(py, move || -> Result<_, String> {
+        let meas = parse_measurements(&data, &source).map_err(|e| e.to_string())?;
+        let bench = observations(&meas, &m);
+        let params = baseline_params_with(&m, &bench.rows, &Default::default());
+        let mut cal = calibrate_refitting_bounds(&m, &bench.rows, &params, &FitOptions::default())
+            .map_err(|e| format!("{source}: {e}"))?;
+        rescale_uncertainties(&mut cal, &bench.rows);
+        Ok((cal, bench.rows.len(), meas.warnings.clone()))
+    })?;
+    let (cal, n_rows, notes) = out.map_err(|e| input_err(py, e))?;
+    let d = PyDict::new(py);
+    let rows: Vec<(String, f64, f64, f64, bool, bool)> = cal
+        .params
+        .iter()
+        .map(|p| {
+            let nominal = pm.inner.param(&p.name).unwrap_or(f64::NAN);
+            (p.name.clone(), nominal, p.value, p.std_error, p.at_bound, p.identifiable)
+        })
+        .collect();
+    d.set_item("params", rows)?;
+    d.set_item("chi2", cal.chi2)?;
+    d.set_item("chi2_per_reading", cal.chi2 / cal.n_readings.max(1) as f64)?;
+    d.set_item("n_rows", n_rows)?;
+    d.set_item("n_readings", cal.n_readings)?;
+    d.set_item("evaluations", cal.evaluations)?;
+    d.set_item("warnings", cal.warnings.clone())?;
+    d.set_item("notes", notes)?;
+    d.set_item("motor", Bound::new(py, PyMotor { inner: cal.motor, drive: pm.drive })?)?;
+    Ok(d)
 }

@@ -16,6 +16,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use trum_core::criterion::{self as core_criterion, CriterionConfig};
 use trum_core::effects::EFFECTS;
 use trum_core::layout::STATUS_NAMES;
+use trum_core::params::Drive;
 use trum_core::quantities::QUANTITIES;
 use trum_core::sweep::{Axis, Grid, AXES};
 use trum_core::{presets, Motor, ParamError, TrumError};
@@ -81,7 +82,15 @@ fn detached<T: Send, F: FnOnce() -> T + Send>(py: Python<'_>, f: F) -> PyResult<
 #[pyclass(frozen, eq, name = "Motor", module = "trum._trum")]
 #[derive(Clone, PartialEq)]
 pub struct PyMotor {
-    inner: Motor,
+    pub(crate) inner: Motor,
+    /// `(voltage_v, frequency_hz)` of the motor file's `[drive]` table, or of its preset's:
+    /// what `solve` uses when the caller gives no drive, as the CLI's commands do.
+    pub(crate) drive: Option<(f64, f64)>,
+}
+
+/// The `[drive]` of a preset, as `(voltage_v, frequency_hz)`.
+fn preset_drive(name: &str) -> Option<(f64, f64)> {
+    presets::find(name).ok().and_then(|p| p.drive()).map(|d| (d.voltage_v, d.frequency_hz))
 }
 
 fn dotted_keys() -> Vec<String> {
@@ -123,14 +132,18 @@ impl PyMotor {
     /// The motor of a preset (`trum60a`, `generic60`, ...).
     #[new]
     fn new(py: Python<'_>, preset: &str) -> PyResult<Self> {
-        presets::preset(preset).map(|inner| PyMotor { inner }).map_err(|e| param_err(py, &e))
+        presets::preset(preset)
+            .map(|inner| PyMotor { inner, drive: preset_drive(preset) })
+            .map_err(|e| param_err(py, &e))
     }
 
     /// Reads a TOML motor file's text; `source` names it in error messages.
     #[staticmethod]
     #[pyo3(signature = (text, source = "<string>"))]
     fn from_toml_str(py: Python<'_>, text: &str, source: &str) -> PyResult<Self> {
-        Motor::from_toml_str(text, source).map(|inner| PyMotor { inner }).map_err(|e| param_err(py, &e))
+        let inner = Motor::from_toml_str(text, source).map_err(|e| param_err(py, &e))?;
+        let drive = Drive::from_toml_str(text, source).map_err(|e| param_err(py, &e))?;
+        Ok(PyMotor { inner, drive: drive.map(|d| (d.voltage_v, d.frequency_hz)) })
     }
 
     /// Builds a motor from a preset (or, without one, from every key), numeric overrides
@@ -177,7 +190,7 @@ impl PyMotor {
             m.validate(source, None)?;
             Ok(m)
         };
-        build().map(|inner| PyMotor { inner }).map_err(|e| param_err(py, &e))
+        build().map(|inner| PyMotor { inner, drive: preset.and_then(preset_drive) }).map_err(|e| param_err(py, &e))
     }
 
     /// A copy with numeric parameters replaced.
@@ -186,7 +199,7 @@ impl PyMotor {
         let mut m = self.inner.clone();
         apply_params(&mut m, &params, source)
             .and_then(|_| m.validate(source, None))
-            .map(|_| PyMotor { inner: m })
+            .map(|_| PyMotor { inner: m, drive: self.drive })
             .map_err(|e| param_err(py, &e))
     }
 
@@ -196,7 +209,7 @@ impl PyMotor {
         let mut m = self.inner.clone();
         apply_effects(&mut m, &specs, source)
             .and_then(|_| m.validate(source, None))
-            .map(|_| PyMotor { inner: m })
+            .map(|_| PyMotor { inner: m, drive: self.drive })
             .map_err(|e| param_err(py, &e))
     }
 
@@ -259,9 +272,17 @@ impl PyMotor {
         self.inner.effects.to_string()
     }
 
-    /// A complete TOML motor file that reads back to an identical motor.
+    /// The drive `(voltage_v, frequency_hz)` of the motor file's `[drive]` table or of its
+    /// preset; `None` when neither gives one.
+    #[getter]
+    fn drive(&self) -> Option<(f64, f64)> {
+        self.drive
+    }
+
+    /// A complete TOML motor file that reads back to an identical motor (its `[drive]`
+    /// included).
     fn to_toml(&self) -> String {
-        self.inner.to_toml()
+        self.toml_text()
     }
 
     fn __repr__(&self) -> String {
@@ -272,7 +293,18 @@ impl PyMotor {
     }
 
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
-        Ok((py.import("trum._trum")?.getattr("_motor_from_toml")?, (self.inner.to_toml(),)))
+        Ok((py.import("trum._trum")?.getattr("_motor_from_toml")?, (self.toml_text(),)))
+    }
+}
+
+impl PyMotor {
+    fn toml_text(&self) -> String {
+        let mut s = self.inner.to_toml();
+        if let Some((v, f)) = self.drive {
+            // `{:?}` is the shortest text that reads back to the same f64
+            s.push_str(&format!("\n[drive]\nvoltage_v = {v:?}\nfrequency_hz = {f:?}\n"));
+        }
+        s
     }
 }
 
@@ -546,6 +578,7 @@ fn _trum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dynamics::hertz_identify, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::step, m)?)?;
     m.add_function(wrap_pyfunction!(diagnosis::diagnose_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnosis::calibrate_csv, m)?)?;
     m.add("STATUS_NAMES", STATUS_NAMES.to_vec())?;
     m.add("INPUTS", vector::INPUTS.to_vec())?;
     m.add("AXES", AXES.to_vec())?;

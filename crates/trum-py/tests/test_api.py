@@ -128,7 +128,7 @@ def test_registries():
 
 
 def test_map_columns_and_values(motor):
-    d = trum.map(motor, preload_n=(150, 300, 4), voltage_v=200, frequency_hz=43e3, torque_nm=(0.0, 0.3, 7))
+    d = trum.map(motor, preload_n=trum.linspace(150, 300, 4), voltage_v=200, frequency_hz=43e3, torque_nm=trum.linspace(0.0, 0.3, 7))
     assert list(d)[:5] == ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status"]
     assert list(d)[5:] == list(trum.QUANTITY_NAMES)
     assert all(len(v) == 28 for v in d.values())
@@ -137,7 +137,7 @@ def test_map_columns_and_values(motor):
     assert d["status"].tolist() == res.status.tolist()
     # warm starts from point to point: equal to the cold solve within the solver tolerance
     np.testing.assert_allclose(d["speed_rpm"], res.speed_rpm, rtol=1e-8, atol=1e-9)
-    par = trum.map(motor, preload_n=(150, 300, 4), voltage_v=200, frequency_hz=43e3, torque_nm=(0.0, 0.3, 7), parallel=True)
+    par = trum.map(motor, preload_n=trum.linspace(150, 300, 4), voltage_v=200, frequency_hz=43e3, torque_nm=trum.linspace(0.0, 0.3, 7), parallel=True)
     for k in trum.QUANTITY_NAMES:
         np.testing.assert_array_equal(par[k], d[k])
     pd = pytest.importorskip("pandas")
@@ -152,7 +152,7 @@ def test_map_is_the_clis_map_bit_for_bit(motor):
                           "--torque-nm", "0:1.4:700", "--columns", "speed_rpm,efficiency,amplitude_m", "-o", "-"],
                          check=True, capture_output=True, text=True).stdout
     rows = list(csv.DictReader(io.StringIO(out)))
-    d = trum.map(motor, preload_n=(100, 400, 3), voltage_v=(180, 220, 2), frequency_hz=43e3, torque_nm=(0, 1.4, 700))
+    d = trum.map(motor, preload_n=trum.linspace(100, 400, 3), voltage_v=trum.linspace(180, 220, 2), frequency_hz=43e3, torque_nm=trum.linspace(0, 1.4, 700))
     assert len(rows) == d["speed_rpm"].size == 4200
     for i, row in enumerate(rows):
         assert row["status"] == d["status"][i], i
@@ -164,27 +164,105 @@ def test_map_is_the_clis_map_bit_for_bit(motor):
 
 def test_map_errors(motor):
     with pytest.raises(trum.InputError, match=r"^preload_n: 0 must be > 0$"):
-        trum.map(motor, preload_n=(0, 100, 3), voltage_v=200, frequency_hz=43e3)
+        trum.map(motor, preload_n=trum.linspace(0, 100, 3), voltage_v=200, frequency_hz=43e3)
     # the same words as `trum map` for a negative torque
     with pytest.raises(trum.InputError, match=r"^torque_nm: -0.5 must be >= 0$"):
-        trum.map(motor, preload_n=100, voltage_v=200, frequency_hz=43e3, torque_nm=(-0.5, 0.5, 3))
-    with pytest.raises(trum.InputError, match="must be a positive whole number"):
-        trum.map(motor, preload_n=(100, 200, 2.5), voltage_v=200, frequency_hz=43e3)
-    with pytest.raises(trum.InputError, match="at least one point"):
-        trum.map(motor, preload_n=(100, 200, 0), voltage_v=200, frequency_hz=43e3)
+        trum.map(motor, preload_n=100, voltage_v=200, frequency_hz=43e3, torque_nm=trum.linspace(-0.5, 0.5, 3))
+    with pytest.raises(trum.InputError, match="must be a whole number"):
+        trum.linspace(100, 200, 2.5)
+    with pytest.raises(trum.InputError, match="must be >= 1"):
+        trum.linspace(100, 200, 0)
+    with pytest.raises(trum.InputError, match="non-empty 1-D"):
+        trum.map(motor, preload_n=[], voltage_v=200, frequency_hz=43e3)
     with pytest.raises(trum.InputError, match="max_points"):
-        trum.map(motor, preload_n=(100, 200, 10**5), voltage_v=200, frequency_hz=43e3, torque_nm=(0, 1, 10**4))
-    with pytest.raises(trum.InputError, match="expected a value or"):
-        trum.map(motor, preload_n=(100, 200), voltage_v=200, frequency_hz=43e3)
+        trum.map(motor, preload_n=trum.linspace(100, 200, 10**5), voltage_v=200, frequency_hz=43e3, torque_nm=trum.linspace(0, 1, 10**4))
+    # a tuple is neither read as a range nor as values: the error says how to write both
+    with pytest.raises(trum.InputError, match=r"trum.linspace\(150, 400, 6\).*\[150, 400, 6\]"):
+        trum.map(motor, preload_n=(150, 400, 6), voltage_v=200, frequency_hz=43e3)
+    with pytest.raises(trum.InputError, match="tuple"):
+        trum.resonance(voltage_v=(100, 300, 3))
+    with pytest.raises(trum.InputError, match="evenly spaced"):
+        trum.optimize(motor, preload_n=[150, 200, 400])
+
+
+def test_lists_and_arrays_are_values_everywhere(motor):
+    # three preloads, whether a list, an array or a Series: not a range 150..250 of 350 points
+    for spec in ([150, 250, 350], np.array([150.0, 250.0, 350.0])):
+        d = trum.map(motor, preload_n=spec, voltage_v=200, frequency_hz=43e3)
+        assert d["preload_n"].tolist() == [150.0, 250.0, 350.0]
+        r = trum.resonance(voltage_v=spec, preload_n=400.0, frequency_hz=41000.0)
+        assert [c.voltage_v for c in r.curves] == [150.0, 250.0, 350.0]
+    # unevenly spaced values are solved point by point: equal to Motor.solve bit for bit
+    d = trum.map(motor, preload_n=[150, 200, 400], torque_nm=[0.0, 0.1], voltage_v=200, frequency_hz=43e3)
+    assert d["preload_n"].tolist() == [150, 150, 200, 200, 400, 400]
+    assert d["torque_nm"].tolist() == [0.0, 0.1] * 3
+    res = motor.solve(preload_n=d["preload_n"], torque_nm=d["torque_nm"], voltage_v=200, frequency_hz=43e3)
+    assert d["speed_rpm"].tobytes() == res.speed_rpm.tobytes()
+    # np.linspace and trum.linspace give the same grid (the CLI's START:STOP:N)
+    a = trum.map(motor, preload_n=np.linspace(150, 300, 4), torque_nm=np.linspace(0, 0.3, 7))
+    b = trum.map(motor, preload_n=trum.linspace(150, 300, 4), torque_nm=trum.linspace(0, 0.3, 7))
+    assert a["speed_rpm"].tobytes() == b["speed_rpm"].tobytes()
+    assert trum.linspace(0, 0.3, 7).tolist() == [0.3 * i / 6 for i in range(7)]
+
+
+def test_drive_defaults_are_the_motors(motor):
+    # trum60a's [drive] is 200 V, 42 kHz (the preset's source figures); generic60 has none
+    assert motor.drive == (200.0, 42000.0)
+    assert trum.Motor("generic60").drive is None
+    a = motor.solve(preload_n=260.0, torque_nm=0.1)
+    b = motor.solve(preload_n=260.0, torque_nm=0.1, voltage_v=200.0, frequency_hz=42e3)
+    assert a.speed_rpm.tobytes() == b.speed_rpm.tobytes()
+    assert a.inputs["frequency_hz"].tolist() == 42e3
+    g = trum.Motor("generic60").solve(preload_n=260.0)
+    assert (g.inputs["voltage_v"].item(), g.inputs["frequency_hz"].item()) == (200.0, 43e3)
+    # the drive travels with the motor: TOML text and pickle
+    import pickle
+
+    assert pickle.loads(pickle.dumps(motor)).drive == motor.drive
+    assert trum.Motor.from_toml_str(motor.to_toml()).drive == motor.drive
+    d = trum.map(motor, preload_n=260.0)
+    assert (d["voltage_v"][0], d["frequency_hz"][0]) == (200.0, 42e3)
+
+
+def test_tables_and_reprs(motor):
+    pd = pytest.importorskip("pandas")
+    d = trum.map(motor, preload_n=[150, 250, 350], torque_nm=trum.linspace(0, 0.6, 7), voltage_v=200, frequency_hz=43e3)
+    df = d.to_pandas()
+    assert df.shape == (21, 5 + len(trum.QUANTITY_NAMES)) and str(df["status"].dtype) == "category"
+    assert d.shape == (3, 1, 1, 7) and d.swept == ["preload_n", "torque_nm"]
+    assert d.fixed == {"voltage_v": 200.0, "frequency_hz": 43e3}
+    text = repr(d)
+    assert len(text) < 400 and "preload_n[3]" in text and "torque_nm[7]" in text
+    # a Series' index survives solve().to_pandas()
+    s = pd.Series([200.0, 260.0, 320.0], index=pd.Index(["a", "b", "c"], name="run"))
+    out = motor.solve(preload_n=s, voltage_v=200, frequency_hz=43e3).to_pandas()
+    assert out.index.tolist() == ["a", "b", "c"] and out.index.name == "run"
+    assert out.loc["b", "preload_n"] == 260.0
+    o = trum.optimize(motor, preload_n=trum.linspace(150, 500, 8), torque_samples=8)
+    assert len(repr(o)) < 500 and "optimum_preload_n" in repr(o)
+    assert len(repr(motor.solve(preload_n=np.linspace(100, 400, 1000)))) < 300
+
+
+def test_map_to_xarray(motor):
+    xr = pytest.importorskip("xarray")
+    d = trum.map(motor, preload_n=[150, 250, 350], torque_nm=trum.linspace(0, 0.6, 7), voltage_v=200, frequency_hz=43e3)
+    ds = d.to_xarray()
+    assert isinstance(ds, xr.Dataset)
+    assert dict(ds.sizes) == {"preload_n": 3, "torque_nm": 7}
+    assert ds["speed_rpm"].attrs["units"] == "rpm" and ds["preload_n"].attrs["units"] == "N"
+    assert float(ds["voltage_v"]) == 200.0
+    # the grid cell is the flat row: preload 250 N, torque 0.2 N·m is row 1 * 7 + 2
+    assert float(ds["speed_rpm"].isel(preload_n=1, torque_nm=2)) == d["speed_rpm"][9]
+    assert ds["status"].sel(preload_n=350).values.tolist() == d["status"][14:21].tolist()
 
 
 def test_optimize(motor):
-    o = trum.optimize(motor, preload_n=(150, 500, 8), torque_samples=8)
+    o = trum.optimize(motor, preload_n=trum.linspace(150, 500, 8), torque_samples=8)
     t = o.table
     assert len(t["preload_n"]) == 8 and o.optimum_preload_n in t["preload_n"]
     assert o.region_n[0] <= o.optimum_preload_n <= o.region_n[1]
     assert o.config["weights"] == {"stall_torque": 1.0, "efficiency": 1.0, "temperature_rise": 2.0, "speed_fluctuation": 2.0}
-    o2 = trum.optimize(motor, preload_n=(150, 500, 8), torque_samples=8, weights={"stall_torque": 5})
+    o2 = trum.optimize(motor, preload_n=trum.linspace(150, 500, 8), torque_samples=8, weights={"stall_torque": 5})
     assert o2.config["weights"]["stall_torque"] == 5.0
     with pytest.raises(trum.InputError, match="weights must be finite"):
         trum.optimize(motor, weights=[0, 0, 0, 0])

@@ -49,6 +49,27 @@ def test_bytes_give_the_same_document():
         assert a[k] == b[k]
 
 
+def test_dataframes_and_open_files_give_the_same_document():
+    pd = pytest.importorskip("pandas")
+    a = trum.diagnose(RING, DATA)
+    with open(DATA, "rb") as f:
+        b = trum.diagnose(RING, f)
+    c = trum.diagnose(RING, pd.read_csv(DATA))
+    assert b["data"] == str(DATA) and c["data"] == "<DataFrame>"
+    for k in ("verdict", "gap"):
+        assert a[k] == b[k]
+    # a DataFrame goes back to CSV at full precision: the same readings, the same verdict
+    assert c["verdict"] == a["verdict"]
+    assert c["gap"]["baseline_heldout_nrmse"] == pytest.approx(a["gap"]["baseline_heldout_nrmse"], rel=1e-9)
+    # tables: the held-out readings with residuals, the ranking, the regions
+    h = a.to_pandas()
+    assert len(h) == len(a["heldout"]) and "speed_rpm" in set(h["quantity"])
+    assert (h["residual_baseline"] == h["measured"] - h["baseline"]).all()
+    r = a.to_pandas("ranking")
+    assert r["effect"].iloc[0] == "eccentricity" and "evidence" in r
+    assert len(repr(a)) < 400 and "eccentricity" in repr(a)
+
+
 @pytest.mark.skipif(not os.environ.get("TRUM_BIN"), reason="set TRUM_BIN to a trum CLI binary to compare with it")
 def test_matches_trum_diagnose_json():
     exe = shutil.which(os.environ["TRUM_BIN"]) or os.environ["TRUM_BIN"]
@@ -72,7 +93,7 @@ def test_bad_input_is_a_clear_error(tmp_path):
         trum.diagnose(RING, tmp_path / "missing.csv")
     with pytest.raises(trum.InputError, match="is a directory"):
         trum.diagnose(RING, tmp_path)
-    with pytest.raises(TypeError, match="path or bytes"):
+    with pytest.raises(TypeError, match="a path, bytes, an open file or a pandas DataFrame"):
         trum.diagnose(RING, 42)
     bad = tmp_path / "bad.csv"
     bad.write_text("preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n100,150,42000,0,106\n200,150,42000,0,nan\n")
@@ -94,3 +115,37 @@ def test_ignored_columns_are_warned_about(tmp_path):
     with pytest.warns(UserWarning, match="operator"):
         d = trum.diagnose(RING, extra)
     assert d["verdict"] == "eccentricity"
+
+
+def test_calibrate_fits_the_baseline_and_reads_every_data_form():
+    c = trum.calibrate(RING, DATA)
+    # the eccentric bench is fitted about as well as its noise allows by the baseline alone
+    assert 0.2 < c.chi2_per_reading < 2.0 and c.n_rows == 8
+    byname = {p["name"]: p for p in c.params}
+    mu = byname["friction_layer.friction_coefficient"]
+    assert mu["identifiable"] and abs(mu["value"] / mu["nominal"] - 1) < 0.3
+    # the calibrated motor carries the fitted values
+    for p in c.params:
+        if not p["name"].startswith("bench."):
+            assert c.motor[p["name"]] == p["value"], p["name"]
+    assert len(repr(c)) < 200
+    pd = pytest.importorskip("pandas")
+    df = c.to_pandas()
+    assert list(df.columns) == ["name", "nominal", "value", "std_error", "change", "at_bound", "identifiable"]
+    c2 = trum.calibrate(RING, pd.read_csv(DATA))
+    # the DataFrame goes back to CSV at full precision: the same fit
+    for a, b in zip(c.params, c2.params):
+        assert a["name"] == b["name"] and a["value"] == pytest.approx(b["value"], rel=1e-9)
+
+
+@pytest.mark.skipif(not os.environ.get("TRUM_BIN"), reason="set TRUM_BIN to a trum CLI binary to compare with it")
+def test_calibrate_matches_trum_calibrate_json():
+    exe = shutil.which(os.environ["TRUM_BIN"]) or os.environ["TRUM_BIN"]
+    out = subprocess.run([exe, "calibrate", "--motor", str(RING_FILE), "--data", str(DATA), "--json", "-", "-q"],
+                         check=True, capture_output=True, text=True).stdout
+    cli = json.loads(out)
+    py = trum.calibrate(RING, str(DATA))
+    assert py.chi2 == pytest.approx(cli["chi2"], rel=1e-12)
+    for a, b in zip(py.params, cli["params"]):
+        assert a["name"] == b["name"] and a["value"] == pytest.approx(b["value"], rel=1e-12)
+        assert a["std_error"] == pytest.approx(b["std_error"], rel=1e-9)

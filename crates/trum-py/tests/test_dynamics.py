@@ -21,7 +21,7 @@ FAST = dict(duration_s=0.004, nodes_per_wavelength=64)
 
 
 def test_resonance_branches_jumps_and_trends():
-    r = trum.resonance(voltage_v=(100, 300, 3), preload_n=400.0, frequency_hz=(40800, 41050, 251))
+    r = trum.resonance(voltage_v=trum.linspace(100, 300, 3), preload_n=400.0, frequency_hz=trum.linspace(40800, 41050, 251))
     assert [c.voltage_v for c in r.curves] == [100.0, 200.0, 300.0]
     assert r.frequency_hz.shape == (251,)
     c = r.curves[1]
@@ -158,7 +158,7 @@ def test_matches_cli_resonance_and_step():
                           "--frequency-hz", "40850:41000:31", "-o", "-"],
                          check=True, capture_output=True, text=True).stdout
     rows = list(csv.DictReader(io.StringIO(out)))
-    d = trum.resonance(voltage_v=(100, 300, 3), preload_n=(300, 400, 2), frequency_hz=(40850, 41000, 31)).to_dict()
+    d = trum.resonance(voltage_v=trum.linspace(100, 300, 3), preload_n=trum.linspace(300, 400, 2), frequency_hz=trum.linspace(40850, 41000, 31)).to_dict()
     assert len(rows) == d["frequency_hz"].size
     for i, row in enumerate(rows):
         assert row["branch"] == d["branch"][i] and row["status"] == d["status"][i]

@@ -65,15 +65,19 @@ pub(super) fn locate_gap(rows: &[ObservedRow], preds: &[Vec<f64>]) -> Vec<GapReg
                     .map(|&v| -> Bin { (format!("{name} = {}", fmt_num(v)), Box::new(move |x| x == v)) })
                     .collect()
             } else {
-                let cut1 = vals[vals.len() / 3];
-                let cut2 = vals[(2 * vals.len()) / 3];
+                let (i1, i2) = (vals.len() / 3, (2 * vals.len()) / 3);
+                let (cut1, cut2) = (vals[i1], vals[i2]);
+                // the label's bound: the roundest number between the value below the cut
+                // and the cut, which splits the data the same way (no value lies between)
+                let round1 = roundest_between(vals[i1.saturating_sub(1)], cut1);
+                let round2 = roundest_between(vals[i2.saturating_sub(1)], cut2);
                 vec![
-                    (format!("{name} < {}", fmt_num(cut1)), Box::new(move |x| x < cut1)),
+                    (format!("{name} < {}", fmt_num(round1)), Box::new(move |x| x < cut1)),
                     (
-                        format!("{} <= {name} < {}", fmt_num(cut1), fmt_num(cut2)),
+                        format!("{} <= {name} < {}", fmt_num(round1), fmt_num(round2)),
                         Box::new(move |x| x >= cut1 && x < cut2),
                     ),
-                    (format!("{name} >= {}", fmt_num(cut2)), Box::new(move |x| x >= cut2)),
+                    (format!("{name} >= {}", fmt_num(round2)), Box::new(move |x| x >= cut2)),
                 ]
             };
             for (label, inside) in bins.iter() {
@@ -108,6 +112,48 @@ pub(super) fn locate_gap(rows: &[ObservedRow], preds: &[Vec<f64>]) -> Vec<GapReg
     out.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
     out.truncate(10);
     out
+}
+
+/// The number in (`lo`, `hi`] with the fewest significant digits (steps of 1, 2 or 5 times
+/// a power of ten), `hi` itself when `lo >= hi`. Region bounds of measured operating
+/// points (read back with noise: 249.8731 N) are labelled with it (245 N): any bound in
+/// that interval splits the data the same way.
+fn roundest_between(lo: f64, hi: f64) -> f64 {
+    if !hi.is_finite() || !lo.is_finite() || lo >= hi {
+        return hi;
+    }
+    let top = hi.abs().max(lo.abs()).log10().floor() as i32 + 1;
+    for k in (top - 16..=top).rev() {
+        for m in [5.0, 2.0, 1.0] {
+            let step = m * 10f64.powi(k);
+            let n = (lo / step).floor() + 1.0;
+            // n·m / 10^-k rather than n·step: 3 · 0.1 is 0.30000000000000004, 3 / 10 is 0.3
+            let c = if k < 0 { n * m / 10f64.powi(-k) } else { n * step };
+            if c > lo && c <= hi {
+                return c;
+            }
+        }
+    }
+    hi
+}
+
+#[cfg(test)]
+mod region_bound_tests {
+    use super::roundest_between;
+
+    #[test]
+    fn region_bounds_are_the_roundest_number_that_splits_the_data_the_same_way() {
+        assert_eq!(roundest_between(240.1, 249.8731), 245.0);
+        assert_eq!(roundest_between(0.2, 0.3000000004), 0.3);
+        assert_eq!(roundest_between(199.0, 200.0), 200.0);
+        assert_eq!(roundest_between(41_990.0, 42_010.0), 42_000.0);
+        assert_eq!(roundest_between(3.0, 3.0), 3.0);
+        // the bound stays inside (lo, hi]: every value <= lo is below it, hi is not
+        for (lo, hi) in [(0.123, 0.1234), (1e-7, 1.1e-7), (-5.0, -4.9), (99.99, 100.01)] {
+            let c = roundest_between(lo, hi);
+            assert!(c > lo && c <= hi, "{lo} {hi} -> {c}");
+        }
+    }
 }
 
 fn fmt_num(x: f64) -> String {

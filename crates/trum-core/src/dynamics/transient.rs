@@ -163,9 +163,9 @@ pub enum TransientError {
 pub struct TimeSeries {
     /// Time [s].
     pub time_s: Vec<f64>,
-    /// Instantaneous rotor speed [rev/min].
+    /// Instantaneous rotor speed [rpm].
     pub speed_rpm: Vec<f64>,
-    /// Rotor speed averaged over the last drive period [rev/min] (zero before t = 0).
+    /// Rotor speed averaged over the last drive period [rpm] (zero before t = 0).
     pub speed_period_mean_rpm: Vec<f64>,
     /// Wave amplitude √(q_A² + q_B²) [m].
     pub amplitude_m: Vec<f64>,
@@ -221,7 +221,7 @@ pub struct Snapshot {
     pub requested_time_s: f64,
     /// Time of the step the snapshot was taken at (the step nearest the request) [s].
     pub time_s: f64,
-    /// Rotor speed at that instant [rev/min].
+    /// Rotor speed at that instant [rpm].
     pub speed_rpm: f64,
     /// The nodes, in order of position.
     pub nodes: Vec<NodeSample>,
@@ -238,9 +238,9 @@ impl Snapshot {
 /// Step-response figures of the period-averaged speed (control-textbook definitions).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepMetrics {
-    /// Final speed: mean over the averaging window at the end of the run [rev/min].
+    /// Final speed: mean over the averaging window at the end of the run [rpm].
     pub final_speed_rpm: f64,
-    /// Largest period-averaged speed [rev/min].
+    /// Largest period-averaged speed [rpm].
     pub peak_speed_rpm: f64,
     /// Delay time: first time the speed reaches 50 % of the final speed [s].
     pub delay_s: Option<f64>,
@@ -273,7 +273,7 @@ impl StepMetrics {
 pub struct SteadyAverages {
     /// Length of the averaging window [s].
     pub window_s: f64,
-    /// Mean rotor speed [rev/min].
+    /// Mean rotor speed [rpm].
     pub speed_rpm: f64,
     /// Mean contact torque on the rotor [N·m].
     pub contact_torque_nm: f64,
@@ -368,7 +368,7 @@ pub fn step_response(motor: &Motor, cfg: &TransientConfig) -> Result<StepRespons
 pub struct SteadyComparison {
     /// Status of the steady solution; the numbers are NaN unless it is valid.
     pub status: Status,
-    /// Steady rotor speed [rev/min].
+    /// Steady rotor speed [rpm].
     pub speed_rpm: f64,
     /// Contact torque at steady state: the load plus the rotor's viscous torque d_r·Ω [N·m].
     pub contact_torque_nm: f64,

@@ -115,7 +115,9 @@ fn builder_checks_ranges() {
         .err();
     assert_eq!(
         e.map(|e| e.to_string()).as_deref(),
-        Some("synthetic data: line 3, column 'speed_rpm': \"NaN\" is not a finite number; rotor speed must be >= 0 rev/min")
+        Some(
+            "synthetic data: line 3, column 'speed_rpm': \"NaN\" is not a finite number; rotor speed must be >= 0 rpm"
+        )
     );
     let e = Measurements::builder().row(Row::new(1.0, 1.0, 1.0, 0.0, 0.0).with_run_id("a\nb")).build().err();
     assert_eq!(e.map(|e| e.kind), Some(MeasurementErrorKind::LineBreakInText));

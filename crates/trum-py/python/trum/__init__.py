@@ -25,8 +25,9 @@ from ._registry import (
 )
 from ._result import Result
 from ._motor import Motor
-from ._api import Optimum, map, optimize
-from ._diagnosis import diagnose
+from ._axes import linspace
+from ._api import MapResult, Optimum, map, optimize
+from ._diagnosis import Calibration, Diagnosis, calibrate, diagnose
 from ._dynamics import (
     HertzIdentification,
     Resonance,
@@ -44,12 +45,17 @@ __all__ = [
     "Motor",
     "Result",
     "Optimum",
+    "MapResult",
+    "Diagnosis",
+    "linspace",
     # `map` is left out of __all__ so `from trum import *` does not shadow the builtin.
     "optimize",
     "resonance",
     "identify_hertz",
     "step",
     "diagnose",
+    "calibrate",
+    "Calibration",
     "hertz_defaults",
     "Resonance",
     "ResonanceCurve",

@@ -4,49 +4,195 @@ from __future__ import annotations
 import json
 import os
 import warnings
-from typing import Any, Dict, Union
+from typing import Any, Dict, List, Tuple, Union
+
+import numpy as np
 
 from . import _trum
 from ._api import _motor
 from ._errors import InputError
 from ._motor import Motor
+from ._result import _require_pandas
 
 
-def diagnose(
-    motor: Union[Motor, str],
-    data: Union[str, "os.PathLike[str]", bytes],
-    *,
-    exact_cv: bool = False,
-) -> Dict[str, Any]:
-    """Where the calibrated baseline misses the measurements, which unmodelled effect
-    causes it, and how far the held-out gap shrinks once it is added.
+DataLike = Union[str, "os.PathLike[str]", bytes, Any]
 
-    ``motor`` is the nominal motor (a ``trum.Motor`` or a preset name); ``data`` a
-    measurement CSV in the layout of docs/MEASUREMENTS.md, as a path or as the
-    file's bytes. Returns the JSON document of ``trum diagnose --json`` as a dict
-    (``verdict``, ``confounded_with``, ``partial``, ``gap``, ``ranking``, ``notes``, ...;
-    every field in docs/DIAGNOSIS_JSON.md, the method in docs/DIAGNOSIS.md). Columns the reader ignores are reported with
-    ``warnings.warn``. A bad file, or data that cannot support a held-out test, raises
-    ``trum.InputError`` naming the file, line and column. The GIL is released while it runs.
-    """
-    m = _motor(motor)
+
+def _read_data(data: DataLike) -> Tuple[bytes, str]:
+    """The bytes of a measurement CSV and the name messages give it: a path, the file's
+    bytes, an open file (text or binary) or a pandas DataFrame (its columns as the CSV's)."""
     if isinstance(data, (bytes, bytearray)):
-        raw, source = bytes(data), "<bytes>"
-    elif isinstance(data, (str, os.PathLike)):
+        return bytes(data), "<bytes>"
+    if isinstance(data, (str, os.PathLike)):
         source = os.fspath(data)
         if os.path.isdir(source):
             raise InputError(f"measurement file '{source}' is a directory")
         try:
             with open(source, "rb") as f:
-                raw = f.read()
+                return f.read(), source
         except FileNotFoundError:
             raise InputError(f"measurement file '{source}' does not exist") from None
         except OSError as e:
             raise InputError(f"cannot read measurement file '{source}': {e.strerror}") from None
-    else:
-        raise TypeError(f"data: expected a path or bytes, got {type(data).__name__}")
+    if hasattr(data, "to_csv") and hasattr(data, "columns"):
+        # a DataFrame: the index is not a measurement column; numbers at full precision
+        text = data.to_csv(index=False, float_format="%.17g", na_rep="")
+        return text.encode("utf-8"), "<DataFrame>"
+    if hasattr(data, "read"):
+        raw = data.read()
+        name = getattr(data, "name", None)
+        source = name if isinstance(name, str) else "<file>"
+        return (raw.encode("utf-8") if isinstance(raw, str) else bytes(raw)), source
+    raise TypeError(f"data: expected a path, bytes, an open file or a pandas DataFrame, got {type(data).__name__}")
+
+
+class Diagnosis(dict):
+    """The diagnosis document (docs/DIAGNOSIS_JSON.md) as a dict, with tables and a plot:
+    ``to_pandas()`` (the held-out readings with their predictions), ``to_pandas("ranking")``
+    (every candidate effect), ``to_pandas("where")`` (where the baseline misses), and
+    ``plot()`` (the held-out residuals per quantity, before and after the verdict)."""
+
+    def to_pandas(self, table: str = "heldout") -> Any:
+        """``'heldout'``: one row per held-out reading (``row``, ``line``, ``quantity``,
+        ``measured``, ``baseline``, ``after``, and the residuals ``residual_baseline`` and
+        ``residual_after`` = measured − predicted, in the quantity's unit); ``'ranking'``:
+        one row per candidate (``effect``, ``evidence``, ``heldout_nrmse_after``, ``shrink``,
+        ...); ``'where'``: the regions of ``gap.where``."""
+        pd = _require_pandas()
+        if table == "heldout":
+            df = pd.DataFrame(self.get("heldout", []), columns=["row", "line", "quantity", "measured", "baseline", "after"])
+            df = df.astype({"measured": float, "baseline": float, "after": float})
+            df["residual_baseline"] = df["measured"] - df["baseline"]
+            df["residual_after"] = df["measured"] - df["after"]
+            df["quantity"] = df["quantity"].astype("category")
+            return df
+        if table == "ranking":
+            rows = [{k: v for k, v in r.items() if k not in ("params", "shrink_interval")} for r in self.get("ranking", [])]
+            return pd.DataFrame(rows)
+        if table == "where":
+            return pd.DataFrame(self.get("gap", {}).get("where", []))
+        raise ValueError(f"table: expected 'heldout', 'ranking' or 'where', got {table!r}")
+
+    def plot(self, *, ax: Any = None) -> Any:
+        """Held-out residual (measured − predicted) per reading, one panel per measured
+        quantity: the calibrated baseline's and, with the verdict's effect(s) added, what is
+        left. Returns the Axes (one per quantity)."""
+        from . import _plot
+
+        plt = _plot._require_matplotlib()
+        held = self.get("heldout", [])
+        qs = list(dict.fromkeys(h["quantity"] for h in held))
+        if not qs:
+            raise InputError("this diagnosis has no held-out readings to plot")
+        if ax is None:
+            _, ax = plt.subplots(len(qs), 1, figsize=(6.4, 1.2 + 2.0 * len(qs)), constrained_layout=True, squeeze=False)
+            ax = ax[:, 0]
+        axs = np.atleast_1d(ax)
+        after_name = self.get("verdict", "")
+        for a, q in zip(axs, qs):
+            h = [x for x in held if x["quantity"] == q]
+            i = np.arange(len(h))
+            meas = np.array([np.nan if x["measured"] is None else x["measured"] for x in h], dtype=float)
+            base = np.array([np.nan if x["baseline"] is None else x["baseline"] for x in h], dtype=float)
+            aft = np.array([np.nan if x["after"] is None else x["after"] for x in h], dtype=float)
+            f = _plot.factor(q)
+            a.axhline(0, color="k", lw=0.6)
+            a.plot(i, (meas - base) * f, "o", ms=3, color="C3", label="calibrated baseline")
+            if after_name not in ("none", "unexplained"):
+                a.plot(i, (meas - aft) * f, "s", ms=3, mfc="none", color="C0", label=f"with {after_name}")
+            words = _plot.label(q)
+            a.set_ylabel("Residual of\n" + words[:1].lower() + words[1:], fontsize="small")
+            a.grid(True, alpha=0.3)
+        axs[0].legend(fontsize="small")
+        axs[-1].set_xlabel("Held-out reading (in file order)")
+        axs[0].set_title(f"Diagnosis of {self.get('motor', {}).get('name', 'the motor')}: verdict {after_name}",
+                         fontsize="medium")
+        return ax
+
+    def __repr__(self) -> str:
+        g = self.get("gap", {})
+        return (f"<trum.Diagnosis verdict={self.get('verdict')!r} complete={self.get('complete')} "
+                f"confounded_with={self.get('confounded_with')}; held-out NRMSE {g.get('baseline_heldout_nrmse', float('nan')):.3g} "
+                f"-> {g.get('remaining_heldout_nrmse', float('nan')) or float('nan'):.3g} (noise {g.get('noise_nrmse', float('nan')):.3g}); "
+                f"{len(self.get('ranking', []))} candidates; {self.get('n_rows')} rows>")
+
+    __str__ = __repr__
+
+
+def diagnose(
+    motor: Union[Motor, str],
+    data: DataLike,
+    *,
+    exact_cv: bool = False,
+) -> Diagnosis:
+    """Where the calibrated baseline misses the measurements, which unmodelled effect
+    causes it, and how far the held-out gap shrinks once it is added.
+
+    ``motor`` is the nominal motor (a ``trum.Motor`` or a preset name); ``data`` a
+    measurement table in the layout of docs/MEASUREMENTS.md: a path, the file's bytes, an
+    open file or a pandas DataFrame with those columns. Returns the JSON document of
+    ``trum diagnose --json`` as a :class:`Diagnosis` (a dict: ``verdict``,
+    ``confounded_with``, ``partial``, ``gap``, ``ranking``, ``notes``, ...; every field in
+    docs/DIAGNOSIS_JSON.md, the method in docs/DIAGNOSIS.md), with ``to_pandas()`` and
+    ``plot()``. Columns the reader ignores are reported with ``warnings.warn``. A bad file,
+    or data that cannot support a held-out test, raises ``trum.InputError`` naming the
+    file, line and column. The GIL is released while it runs.
+    """
+    m = _motor(motor)
+    raw, source = _read_data(data)
     motor_source = motor if isinstance(motor, str) else (m.preset or m.name)
     text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv))
     for w in notes:
         warnings.warn(w, stacklevel=2)
-    return json.loads(text)
+    return Diagnosis(json.loads(text))
+
+
+class Calibration:
+    """Result of :func:`calibrate`: the calibrated motor and the fit, parameter by parameter.
+
+    ``motor`` (a ``trum.Motor``), ``params`` (list of dicts: ``name``, ``nominal``,
+    ``value``, ``std_error``, ``at_bound``, ``identifiable``), ``chi2``,
+    ``chi2_per_reading`` (1 = fits to within the assumed noise), ``n_rows``,
+    ``n_readings``, ``evaluations``, ``warnings``."""
+
+    def __init__(self, d: Dict[str, Any]) -> None:
+        self.motor: Motor = Motor._wrap(d["motor"])
+        keys = ("name", "nominal", "value", "std_error", "at_bound", "identifiable")
+        self.params = [dict(zip(keys, row)) for row in d["params"]]
+        self.chi2: float = d["chi2"]
+        self.chi2_per_reading: float = d["chi2_per_reading"]
+        self.n_rows: int = d["n_rows"]
+        self.n_readings: int = d["n_readings"]
+        self.evaluations: int = d["evaluations"]
+        self.warnings: List[str] = list(d["warnings"])
+
+    def to_pandas(self) -> Any:
+        """One row per fitted parameter: ``name``, ``nominal``, ``value``, ``std_error``,
+        ``change`` (value / nominal − 1), ``at_bound``, ``identifiable``."""
+        pd = _require_pandas()
+        df = pd.DataFrame(self.params, columns=["name", "nominal", "value", "std_error", "at_bound", "identifiable"])
+        df.insert(4, "change", df["value"] / df["nominal"] - 1.0)
+        return df
+
+    def __repr__(self) -> str:
+        ident = sum(1 for p in self.params if p["identifiable"])
+        return (f"<trum.Calibration {len(self.params)} parameters ({ident} identifiable), chi2/reading "
+                f"{self.chi2_per_reading:.3g} over {self.n_readings} readings; {len(self.warnings)} warnings>")
+
+
+def calibrate(motor: Union[Motor, str], data: DataLike) -> Calibration:
+    """Calibrates the uncertain baseline parameters of ``motor`` to measurements, as
+    ``trum calibrate`` does (a maximum a posteriori fit, each parameter's tolerance as its
+    prior; docs/DIAGNOSIS.md). ``data`` is a measurement table in the layout of
+    docs/MEASUREMENTS.md: a path, the file's bytes, an open file or a pandas DataFrame.
+    Returns a :class:`Calibration` (``.motor`` is the calibrated motor,
+    ``.to_pandas()`` the parameter table). The reader's notes (ignored columns) come as
+    ``warnings.warn``; a bad file raises ``trum.InputError`` naming the file, line and
+    column. A motor file's ``[tolerances]`` table is not read here: the default tolerances
+    apply. The GIL is released while it runs."""
+    m = _motor(motor)
+    raw, source = _read_data(data)
+    d = _trum.calibrate_csv(m, raw, source)
+    for w in d["notes"]:
+        warnings.warn(w, stacklevel=2)
+    return Calibration(d)

@@ -12,7 +12,9 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _trum
-from ._api import _axis, _motor
+from . import _axes, _plot
+from ._api import _motor
+from ._result import _require_pandas
 from ._errors import InputError
 from ._motor import Motor, _number
 
@@ -33,21 +35,8 @@ def _params(oscillator: Optional[Mapping[str, Any]]) -> List[tuple]:
 
 
 def _values(name: str, v: Values) -> List[float]:
-    """A number, a 1-D array or list of numbers, or a ``(start, stop, n)`` tuple."""
-    if isinstance(v, tuple) and len(v) == 3:
-        a, b, n = _axis(name, v)
-        if n < 1:
-            raise InputError(f"{name}: the point count {n} must be >= 1")
-        return np.linspace(a, b, n).tolist()
-    if isinstance(v, numbers.Real) and not isinstance(v, bool):
-        return [float(v)]
-    try:
-        arr = np.asarray(v, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InputError(f"{name}: expected numbers, got {v!r}") from None
-    if arr.ndim != 1 or arr.size == 0:
-        raise InputError(f"{name}: expected a number or a non-empty 1-D array, got shape {arr.shape}")
-    return arr.tolist()
+    """A number, or explicit values (list, array, Series); a range is ``trum.linspace``."""
+    return _axes.values(name, v).tolist()
 
 
 @dataclass(frozen=True)
@@ -80,6 +69,13 @@ class ResonanceCurve:
             return None
         return abs(self.jump_up_hz - self.jump_down_hz)
 
+    def __repr__(self) -> str:
+        jumps = ("single valued" if self.hysteresis_hz is None else
+                 f"jump up {self.jump_up_hz:.6g} Hz, jump down {self.jump_down_hz:.6g} Hz")
+        return (f"<trum.ResonanceCurve {self.voltage_v:g} V, {self.preload_n:g} N: {self.status}; "
+                f"{self.frequency_hz.size} response points ({int(np.count_nonzero(~self.stable.astype(bool)))} "
+                f"unstable); {jumps}>")
+
 
 @dataclass(frozen=True)
 class Resonance:
@@ -107,10 +103,80 @@ class Resonance:
         out["stable"] = np.array(t["stable"], dtype=object)
         return {k: out[k] for k in self.columns}
 
+    def to_pandas(self) -> Any:
+        """:meth:`to_dict` as a tidy DataFrame (``branch`` and ``status`` categorical,
+        ``stable`` a nullable boolean)."""
+        pd = _require_pandas()
+        df = pd.DataFrame(self.to_dict())
+        for c in ("branch", "status"):
+            if c in df:
+                df[c] = df[c].astype("category")
+        if "stable" in df:
+            df["stable"] = df["stable"].astype("boolean")
+        return df
+
+    def plot(self, *, ax: Any = None) -> Any:
+        """Amplitude [µm] against frequency per curve: stable branches solid, the unstable
+        branch dashed, the backbone dotted, each jump inside the band marked at its saddle
+        node with an arrow to where the amplitude lands. Returns the Axes."""
+        ax = _plot.axes(ax)
+        fa, aa = _plot.factor("frequency_hz"), _plot.factor("amplitude_m")
+        f_lo, f_hi = (float(self.frequency_hz.min()), float(self.frequency_hz.max())) if self.frequency_hz.size else (0, 0)
+        for i, c in enumerate(self.curves):
+            if c.status != "ok" or c.frequency_hz.size == 0:
+                continue
+            color = f"C{i % 10}"
+            stable = c.stable.astype(bool)
+            first = True
+            for br in ("single", "lower", "middle", "upper"):
+                m = c.branch == br
+                if not m.any():
+                    continue
+                # one point per grid frequency and branch: NaN where the branch does not
+                # exist, so that a branch of two separate pieces is not joined across the gap
+                grid = np.unique(c.frequency_hz)
+                y = np.full(grid.size, np.nan)
+                y[np.searchsorted(grid, c.frequency_hz[m])] = c.amplitude_m[m]
+                ax.plot(grid * fa, y * aa, color=color,
+                        ls="--" if br == "middle" else "-", lw=0.9 if br == "middle" else 1.4,
+                        label=f"{c.voltage_v:g} V, {c.preload_n:g} N" if first and br != "middle" else None)
+                first = first and br == "middle"
+            inside = (c.backbone_frequency_hz >= f_lo) & (c.backbone_frequency_hz <= f_hi)
+            ax.plot(c.backbone_frequency_hz[inside] * fa, c.backbone_amplitude_m[inside] * aa, ":", lw=0.8, color=color)
+            for f, a_jump, tag in ((c.jump_up_hz, c.jump_up_amplitude_m, "up"), (c.jump_down_hz, c.jump_down_amplitude_m, "down")):
+                if f is None or a_jump is None or not (f_lo <= f <= f_hi):
+                    continue
+                # the jump lands on the stable branch nearest in frequency, on the other side
+                on = stable & (np.abs(c.frequency_hz - f) <= np.min(np.abs(c.frequency_hz[stable] - f)) + 1e-9 * f)
+                land = c.amplitude_m[on]
+                target = land.max() if tag == "up" else land.min()
+                if abs(target - a_jump) > 1e-3 * max(target, a_jump):
+                    ax.annotate("", xy=(f * fa, target * aa), xytext=(f * fa, a_jump * aa),
+                                arrowprops=dict(arrowstyle="->", color=color, lw=0.9))
+                ax.plot([f * fa], [a_jump * aa], "o", mfc="none", color=color, ms=5)
+        ax.plot([], [], "k--", lw=0.9, label="unstable branch")
+        ax.plot([], [], "k:", lw=0.8, label="backbone")
+        ax.plot([], [], "ko", mfc="none", ms=5, label="jump (saddle node), arrow: where it lands")
+        ax.set_xlabel(_plot.label("frequency_hz"))
+        ax.set_ylabel(_plot.label("amplitude_m"))
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="small")
+        ax.set_title("Hertzian oscillator: response by drive voltage and preload", fontsize="medium")
+        return ax
+
+    def __repr__(self) -> str:
+        st = [c.status for c in self.curves]
+        counts = ", ".join(f"{k}={st.count(k)}" for k in sorted(set(st)))
+        n = len(self.table.get("frequency_hz", ())) if self.table else 0
+        f = self.frequency_hz
+        band = f"{f[0]:.6g}..{f[-1]:.6g} Hz ({f.size})" if f.size else "no frequencies"
+        return (f"<trum.Resonance {len(self.curves)} curves ({counts}); frequency {band}; table {n} rows x "
+                f"{len(self.columns)} columns: {', '.join(self.columns)}>")
+
 
 def resonance(
     *,
-    voltage_v: Values = (100.0, 300.0, 3),
+    voltage_v: Optional[Values] = None,
     preload_n: Values = 400.0,
     frequency_hz: Optional[Values] = None,
     method: str = "multiple_scales",
@@ -119,10 +185,13 @@ def resonance(
     """Amplitude–frequency response of the Hertzian oscillator ([Hertz2022] eq. 10-12) for
     every voltage × preload: all branches incl. the unstable one, backbone, jump-up and
     jump-down frequencies. Each of ``voltage_v``, ``preload_n``, ``frequency_hz`` is a
-    number, a 1-D array or ``(start, stop, n)``; ``frequency_hz=None`` picks 401 points
+    number or explicit values (a list, a 1-D array); a range is ``trum.linspace(start,
+    stop, n)``; ``voltage_v=None`` is 100, 200 and 300 V; ``frequency_hz=None`` picks 401 points
     over a band holding every peak and jump. ``method``: ``'multiple_scales'`` or
     ``'harmonic_balance'``. ``oscillator``: parameters overriding :func:`hertz_defaults`.
     A point the softening spring cannot carry has status ``'no_static_equilibrium'``."""
+    if voltage_v is None:
+        voltage_v = [100.0, 200.0, 300.0]
     freqs = None if frequency_hz is None else np.ascontiguousarray(_values("frequency_hz", frequency_hz))
     d = _trum.hertz_response(
         _params(oscillator), _values("voltage_v", voltage_v), _values("preload_n", preload_n), freqs, method
@@ -196,6 +265,19 @@ class Snapshot:
     slip_speed_m_s: np.ndarray
     state: np.ndarray  # 'no_contact', 'stick' or 'slip' per node
 
+    def to_pandas(self) -> Any:
+        """One row per node: position and the contact state there."""
+        pd = _require_pandas()
+        df = pd.DataFrame({k: getattr(self, k) for k in ("position_m", "pressure_n_per_m", "tangential_force_n_per_m",
+                                                          "friction_limit_n_per_m", "slip_speed_m_s", "state")})
+        df["state"] = df["state"].astype("category")
+        return df
+
+    def __repr__(self) -> str:
+        st = self.state
+        counts = ", ".join(f"{k}={int(np.count_nonzero(st == k))}" for k in ("stick", "slip", "no_contact"))
+        return f"<trum.Snapshot t={self.time_s:.6g} s, {self.speed_rpm:.5g} rpm; {st.size} nodes ({counts})>"
+
 
 @dataclass(frozen=True)
 class StepResult:
@@ -209,10 +291,48 @@ class StepResult:
     snapshots: List[Snapshot] = field(default_factory=list)
     time_step_s: float = 0.0
     steps: int = 0
+    #: the fixed drive and load, for titles: voltage_v, frequency_hz, preload_n, torque_nm
+    conditions: Dict[str, float] = field(default_factory=dict)
+    motor: str = ""
 
     def speed_difference(self) -> float:
         """(settled transient speed − steady-solver speed) / steady-solver speed."""
         return (self.averages["speed_rpm"] - self.steady["speed_rpm"]) / self.steady["speed_rpm"]
+
+    def to_pandas(self) -> Any:
+        """The time series as a tidy DataFrame, one row per recorded step (``time_s`` first)."""
+        pd = _require_pandas()
+        return pd.DataFrame(self.series)
+
+    def plot(self, y: str = "speed_rpm", *, ax: Any = None) -> Any:
+        """``y`` (default the rotor speed) against time [ms], with the period mean, the
+        steady solver's speed and the metrics (delay, rise, settling) marked."""
+        ax = _plot.axes(ax)
+        t = np.asarray(self.series["time_s"])
+        ft = _plot.factor("time_s")
+        ax.plot(t * ft, self.series[y], lw=0.6, color="0.6", label="rotor speed")
+        if y == "speed_rpm" and "speed_period_mean_rpm" in self.series:
+            ax.plot(t * ft, self.series["speed_period_mean_rpm"], lw=1.4, color="C0", label="mean over a drive period")
+        if y == "speed_rpm" and self.steady.get("speed_rpm") is not None:
+            ax.axhline(self.steady["speed_rpm"], color="C3", ls="--", lw=1, label="steady-state solver")
+        for key, words in (("delay_s", "delay"), ("settling_time_s", "settled")):
+            v = self.metrics.get(key)
+            if v is not None:
+                ax.axvline(v * ft, color="k", lw=0.6, ls=":")
+                ax.annotate(words, (v * ft, 1.0), xycoords=("data", "axes fraction"), va="top", fontsize="x-small")
+        ax.set_xlabel(_plot.label("time_s"))
+        ax.set_ylabel(_plot.label(y))
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="small", loc="lower right")
+        if self.conditions:
+            ax.set_title(_plot.caption(self.conditions, self.motor or None, "none"), fontsize="medium")
+        return ax
+
+    def __repr__(self) -> str:
+        n = len(next(iter(self.series.values()))) if self.series else 0
+        m = ", ".join(f"{k}={v:.4g}" for k, v in self.metrics.items() if v is not None)
+        return (f"<trum.StepResult {self.status}; {n} samples x {len(self.series)} series "
+                f"({', '.join(self.series)}); metrics: {m or 'none'}; {len(self.snapshots)} snapshots>")
 
 
 def _require_name(motor: Any) -> str:
@@ -266,5 +386,7 @@ def step(
         s = dict(s)
         s["state"] = np.array(s["state"], dtype=object)
         snaps.append(Snapshot(**s))
+    cond = {"voltage_v": float(voltage_v), "frequency_hz": float(frequency_hz), "preload_n": float(preload_n),
+            "torque_nm": float(torque_nm)}
     return StepResult(dict(d["series"]), dict(d["metrics"]), d["status"], dict(d["averages"]), dict(d["steady"]),
-                      snaps, d["time_step_s"], d["steps"])
+                      snaps, d["time_step_s"], d["steps"], cond, m.name)

@@ -179,6 +179,13 @@ class Motor:
         return self._m.preset
 
     @property
+    def drive(self) -> Optional[Tuple[float, float]]:
+        """``(voltage_v, frequency_hz)`` of the motor file's ``[drive]`` table or its preset's
+        (the drive its source figures were taken at); ``None`` when neither gives one.
+        ``solve``, ``trum.map`` and ``trum.optimize`` use it when no drive is given."""
+        return self._m.drive
+
+    @property
     def effects(self) -> str:
         """Active effects in the core's display form (``none`` for the baseline model)."""
         return self._m.effects
@@ -240,8 +247,8 @@ class Motor:
         self,
         *,
         preload_n: ArrayLike,
-        voltage_v: ArrayLike,
-        frequency_hz: ArrayLike,
+        voltage_v: Optional[ArrayLike] = None,
+        frequency_hz: Optional[ArrayLike] = None,
         torque_nm: ArrayLike = 0.0,
         elapsed_s: ArrayLike = 0.0,
         parallel: Optional[bool] = None,
@@ -254,7 +261,20 @@ class Motor:
         (e.g. a negative preload) do not raise: they get NaN and status
         ``invalid_input`` with ``Result.reason``. ``parallel=None`` uses all cores from
         4096 points on. The GIL is released while solving.
+
+        Without ``voltage_v``/``frequency_hz`` the motor's drive is used (``Motor.drive``:
+        its ``[drive]`` table or its preset's, else 200 V and 43 kHz), as the CLI does. A
+        pandas Series input lends its index to ``Result.to_pandas()`` when the result is
+        1-D and of its length.
         """
+        v0, f0 = self.drive or (200.0, 43e3)
+        voltage_v = v0 if voltage_v is None else voltage_v
+        frequency_hz = f0 if frequency_hz is None else frequency_hz
+        index = None
+        for x in (preload_n, torque_nm, voltage_v, frequency_hz, elapsed_s):
+            if hasattr(x, "index") and hasattr(x, "to_numpy") and getattr(x, "ndim", 0) == 1:
+                index = x.index
+                break
         ins = {
             "preload_n": _as_f64("preload_n", preload_n),
             "torque_nm": _as_f64("torque_nm", torque_nm),
@@ -263,7 +283,11 @@ class Motor:
             "elapsed_s": _as_f64("elapsed_s", elapsed_s),
         }
         data = _trum.solve_arrays(self._m, *ins.values(), parallel=parallel)
-        return Result(data, ins)
+        res = Result(data, ins)
+        if index is not None and len(res.shape) == 1 and res.shape[0] == len(index):
+            res._index = index
+        res.motor, res.effects = self.name, self.effects
+        return res
 
 
 def _from_toml(text: str) -> Motor:

@@ -66,6 +66,9 @@ class Result:
         self._q: Dict[str, np.ndarray] = {n: data[n] for n in QUANTITY_NAMES}
         #: The inputs, broadcast to ``shape`` (read-only views).
         self.inputs: Dict[str, np.ndarray] = {k: np.broadcast_to(v, self.shape) for k, v in inputs.items()}
+        self._index: Any = None
+        self.motor: str = ""
+        self.effects: str = ""
 
     def __getattr__(self, name: str) -> np.ndarray:
         if not name.startswith("_"):
@@ -133,13 +136,30 @@ class Result:
         return d
 
     def to_pandas(self) -> Any:
-        """A DataFrame with one row per point (C order); ``status`` is categorical."""
+        """A DataFrame with one row per point (C order); ``status`` is categorical. The
+        index is that of a pandas Series given to ``solve`` (1-D results), else 0..n-1."""
         pd = _require_pandas()
         cols: Dict[str, Any] = {k: np.ravel(v) for k, v in self.inputs.items()}
         cols["status"] = pd.Categorical.from_codes(self.status_code.reshape(-1), categories=list(STATUS_NAMES))
         cols.update({k: v.reshape(-1) for k, v in self._q.items()})
-        return pd.DataFrame(cols)
+        return pd.DataFrame(cols, index=self._index)
+
+    def plot(self, x: str = "torque_nm", y: str = "speed_rpm", *, ax: Any = None) -> Any:
+        """``y`` against ``x`` for a 1-D result (e.g. a speed-torque curve); points without
+        a running steady state (stall, no convergence) leave a gap. Returns the Axes."""
+        from . import _plot
+
+        if len(self.shape) != 1:
+            raise ValueError(f"plot() draws a 1-D result; this one has shape {self.shape} (use trum.map for grids)")
+        ax = _plot.axes(ax)
+        xs = np.asarray(self[x], dtype=np.float64)
+        ys = np.where(self.status == "ok", np.asarray(self[y], dtype=np.float64), np.nan)
+        _plot.lines(ax, xs, ys, x, y, [("", np.ones(xs.size, dtype=bool))], marker=".")
+        fixed = {k: float(np.ravel(v)[0]) for k, v in self.inputs.items()
+                 if k != x and np.ravel(v).size and np.all(np.ravel(v) == np.ravel(v)[0]) and not (k == "elapsed_s" and np.ravel(v)[0] == 0)}
+        ax.set_title(_plot.caption(fixed, self.motor or None, self.effects or None), fontsize="medium")
+        return ax
 
     def __repr__(self) -> str:
         counts = ", ".join(f"{k}={v}" for k, v in self.counts().items() if v)
-        return f"<trum.Result shape={self.shape} {counts or 'empty'}>"
+        return f"<trum.Result shape={self.shape} {counts or 'empty'}; {len(self.keys())} columns: {', '.join(self.keys()[:7])}, ...>"
