@@ -36,6 +36,10 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     let (motor, _) = a.motor.load()?;
     let (_, bench) = read_data(&a.data, &motor, err)?;
     let tolerances = crate::motor::load_tolerances(&a.motor.motor)?;
+    // Check the output paths before the fit, so a typo or an input named as output fails at once.
+    for p in [&a.output, &a.json].into_iter().flatten() {
+        drop(crate::output::OutputTarget::create(p, ".tmp")?);
+    }
     let params = baseline_params_with(&motor, &bench.rows, &tolerances);
     let mut cal = calibrate_refitting_bounds(&motor, &bench.rows, &params, &FitOptions::default())
         .map_err(|e| anyhow!("{}: {e}", a.data))?;

@@ -19,6 +19,7 @@ pub fn read_data(path: &str, motor: &Motor, err: &mut dyn Write) -> Result<(Meas
     if !p.exists() {
         bail!("measurement file '{path}' does not exist");
     }
+    crate::output::note_input(p, &format!("--data '{path}'"));
     let bytes = std::fs::read(p).with_context(|| format!("cannot read measurement file '{path}'"))?;
     // MeasurementError's message names the file, line and column; show it unchanged.
     let m = parse_measurements(&bytes, path).map_err(|e| anyhow!("{e}"))?;

@@ -23,6 +23,7 @@ impl MotorArgs {
 pub fn load_motor(spec: &str) -> Result<(Motor, SweepTable)> {
     let path = Path::new(spec);
     if path.is_file() {
+        crate::output::note_input(path, &format!("--motor '{spec}'"));
         let text = std::fs::read_to_string(path).with_context(|| format!("cannot read motor file '{spec}'"))?;
         // ParamError's message names the file, line and key; show it unchanged.
         return Motor::from_toml_str_with_sweep(&text, spec).map_err(|e| anyhow!("{e}"));
