@@ -6,12 +6,44 @@ use anyhow::{anyhow, bail, Context, Result};
 use std::io::Write;
 use std::path::Path;
 use trum_core::bench::{observations, BenchData};
-use trum_core::measurements::{parse_measurements, Measurements};
+use trum_core::measurements::{parse_measurements_with, Measurements, PlausibleRanges};
 use trum_core::Motor;
 
-/// Reads and checks a measurement file (layout: docs/MEASUREMENTS.md); warnings (ignored
-/// columns, ...) are printed to `err`.
-pub fn read_data(path: &str, motor: &Motor, err: &mut dyn Write) -> Result<(Measurements, BenchData)> {
+/// `--plausible COLUMN=LOW:HIGH`, shared by the commands that read a measurement file.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct PlausibleArgs {
+    /// Plausible range of a measured column, replacing its default (docs/MEASUREMENTS.md,
+    /// "Plausible ranges"): COLUMN=LOW:HIGH, an end left empty for no bound, or COLUMN=any (repeatable).
+    #[arg(long = "plausible", value_name = "COLUMN=LOW:HIGH")]
+    pub plausible: Vec<String>,
+}
+
+impl PlausibleArgs {
+    /// The ranges in force: the defaults with every `--plausible` applied; a column given
+    /// twice is an error (which one was meant?).
+    pub fn ranges(&self) -> Result<PlausibleRanges> {
+        let mut r = PlausibleRanges::default();
+        let mut seen: Vec<&str> = Vec::new();
+        for spec in &self.plausible {
+            let name = spec.split_once('=').map_or(spec.as_str(), |(n, _)| n.trim());
+            if seen.contains(&name) {
+                bail!("--plausible: '{name}' is given twice");
+            }
+            seen.push(name);
+            r.parse_assignment(spec).map_err(|m| anyhow!("--plausible '{spec}': {m}"))?;
+        }
+        Ok(r)
+    }
+}
+
+/// Reads and checks a measurement file (layout: docs/MEASUREMENTS.md), values within
+/// `plausible`; warnings (ignored columns, ...) are printed to `err`.
+pub fn read_data(
+    path: &str,
+    motor: &Motor,
+    plausible: &PlausibleRanges,
+    err: &mut dyn Write,
+) -> Result<(Measurements, BenchData)> {
     let p = Path::new(path);
     if p.is_dir() {
         bail!("--data '{path}' is a directory, not a measurement file");
@@ -22,7 +54,7 @@ pub fn read_data(path: &str, motor: &Motor, err: &mut dyn Write) -> Result<(Meas
     crate::output::note_input(p, &format!("--data '{path}'"));
     let bytes = std::fs::read(p).with_context(|| format!("cannot read measurement file '{path}'"))?;
     // MeasurementError's message names the file, line and column; show it unchanged.
-    let m = parse_measurements(&bytes, path).map_err(|e| anyhow!("{e}"))?;
+    let m = parse_measurements_with(&bytes, path, plausible).map_err(|e| anyhow!("{e}"))?;
     for w in &m.warnings {
         writeln!(err, "warning: {w}")?;
     }

@@ -1614,7 +1614,8 @@ pub fn diagnose(
             });
         }
     }
-    Ok(Diagnosis {
+    // (no verdict from figures that overflowed: json::guard_non_finite)
+    Ok(json::guard_non_finite(Diagnosis {
         verdict,
         complete,
         confounded_with: confounded,
@@ -1632,7 +1633,7 @@ pub fn diagnose(
         folds: k,
         baseline_params: base_cal.params.iter().map(|p| (p.name.clone(), p.value)).collect(),
         heldout,
-    })
+    }))
 }
 
 /// Two effect lists (`a+b`) name the same set.

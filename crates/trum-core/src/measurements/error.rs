@@ -156,6 +156,26 @@ pub enum MeasurementErrorKind {
         /// The parsed value.
         value: f64,
     },
+    /// A number inside the column's range but outside its plausible range.
+    #[error(
+        "\"{text}\" is outside the plausible range of {} for a traveling-wave ultrasonic motor, {} \
+         (a typo, a unit slip or a bench fault?); if the value is real, give the column another \
+         plausible range (docs/MEASUREMENTS.md, \"Plausible ranges\")",
+        .column.spec().quantity,
+        super::plausible::describe(*.column, (*.low, *.high))
+    )]
+    Implausible {
+        /// The column.
+        column: Column,
+        /// The cell text as written.
+        text: String,
+        /// The parsed value.
+        value: f64,
+        /// Low end of the plausible range in force.
+        low: f64,
+        /// High end of the plausible range in force.
+        high: f64,
+    },
     /// A `run_id` given to the builder that contains a line break.
     #[error("contains a line break; run ids must be one line")]
     LineBreakInText,

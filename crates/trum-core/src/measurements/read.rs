@@ -2,7 +2,7 @@
 
 use super::{
     Column, ColumnSpec, ExtraColumn, MeasurementError, MeasurementErrorKind, Measurements, MisnameReason, NumberIssue,
-    COLUMNS,
+    PlausibleRanges, COLUMNS,
 };
 
 /// One cell as tokenized: text (trimmed unless quoted) and whether it was quoted.
@@ -310,8 +310,20 @@ fn unit_suffix(spec: &ColumnSpec) -> &'static str {
 /// spelling (unless the right column is present too), a ragged row, an unterminated
 /// quote, an empty required cell, a numeric cell that is not a plain decimal (`nan`,
 /// `inf`, hex, text), and a value outside its column's range. The first problem in file
-/// order is reported. Never panics.
+/// order is reported. Never panics. Values must also lie in their column's default
+/// plausible range ([`super::ColumnSpec::plausible`]); [`parse_measurements_with`] takes
+/// other ranges.
 pub fn parse_measurements(bytes: &[u8], source: &str) -> Result<Measurements, MeasurementError> {
+    parse_measurements_with(bytes, source, &PlausibleRanges::default())
+}
+
+/// [`parse_measurements`] with the given plausible ranges (a value outside its column's
+/// range is an error naming its line and column).
+pub fn parse_measurements_with(
+    bytes: &[u8],
+    source: &str,
+    plausible: &PlausibleRanges,
+) -> Result<Measurements, MeasurementError> {
     let err = |line: Option<usize>, column: Option<String>, kind| MeasurementError {
         source_name: source.to_string(),
         line,
@@ -431,6 +443,16 @@ pub fn parse_measurements(bytes: &[u8], source: &str) -> Result<Measurements, Me
             })?;
             if c.check(value).is_err() {
                 return Err(cell_err(MeasurementErrorKind::OutOfRange { column: c, text: text.to_string(), value }));
+            }
+            if !plausible.contains(c, value) {
+                let (low, high) = plausible.get(c);
+                return Err(cell_err(MeasurementErrorKind::Implausible {
+                    column: c,
+                    text: text.to_string(),
+                    value,
+                    low,
+                    high,
+                }));
             }
             m.push_value(c, Some(value));
         }
