@@ -127,3 +127,36 @@ fn calibrate_refuses_a_preload_of_1e308_n() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("--plausible 'preload=0:1': 'preload' is not a numeric measurement column"));
 }
+
+#[test]
+fn control_characters_in_a_motor_name_are_refused_naming_the_key() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    for (escaped, code) in
+        [("a\\u0000b", "U+0000"), ("a\\rb", "U+000D"), ("\\u001B[31mred", "U+001B"), ("x\\u007F", "U+007F")]
+    {
+        std::fs::write(d.join("m.toml"), format!("preset = \"trum60a\"\nname = \"{escaped}\"\n")).expect("write");
+        let o = trum(d, &["point", "--motor", "m.toml", "--preload-n", "250"]);
+        assert_eq!(o.status.code(), Some(1), "{escaped}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("line 2") && e.contains("key 'name'") && e.contains(code), "{escaped}: {e}");
+        assert!(!o.stdout.contains(&0x1b) && !e.as_bytes().contains(&0x1b), "a raw ESC reached the terminal");
+    }
+}
+
+#[test]
+fn a_calibrated_motor_file_reads_back_whatever_the_names_in_it() {
+    // A printable name with TOML's special characters, and a data file whose name holds an
+    // ESC and a carriage return (written into the file's header comment).
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    std::fs::write(d.join("m.toml"), "preset = \"trum60a\"\nname = \"Motör \\\"q\\\" \\\\ # [x]\"\n").expect("write");
+    write(d, "d\u{1b}[2J\r.csv", None, &[]);
+    let o = trum(d, &["calibrate", "--motor", "m.toml", "--data", "d\u{1b}[2J\r.csv", "-o", "cal.toml"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = std::fs::read_to_string(d.join("cal.toml")).expect("read");
+    assert!(!text.chars().any(|c| c.is_control() && c != '\n'), "a raw control character in the file");
+    let o = trum(d, &["point", "--motor", "cal.toml", "--preload-n", "250"]);
+    assert_eq!(o.status.code(), Some(0), "the calibrated file does not read back: {}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("Motör \"q\" \\ # [x]"));
+}

@@ -508,6 +508,19 @@ impl Motor {
     /// Checks every value (finite, sign, integrality, and the physical consistency checks
     /// the model needs). `text` lets errors point at a line of the TOML source.
     pub fn validate(&self, source_name: &str, text: Option<&str>) -> Result<(), ParamError> {
+        // A control character in the name would be written raw into motor files' comments,
+        // tables and terminals (an ESC changes the terminal's state); no use for one.
+        if let Some((i, c)) = self.name.char_indices().find(|(_, c)| c.is_control()) {
+            return Err(ParamError {
+                source_name: source_name.into(),
+                line: text.and_then(|t| line_of_key(t, "", "name")),
+                key: "name".into(),
+                reason: format!(
+                    "contains the control character U+{:04X} at byte {i}; a motor name must be printable text",
+                    c as u32
+                ),
+            });
+        }
         for (info, v) in Self::all_keys().iter().zip(self.values()) {
             if let Some(reason) = info.check.reason(v) {
                 return Err(ParamError {
@@ -655,6 +668,7 @@ impl Motor {
     /// key to its provenance (paper value, assumed, calibrated) and is written as comments.
     pub fn to_toml_annotated(&self, header: &str, notes: &dyn Fn(&str) -> Option<String>) -> String {
         let mut s = String::new();
+        let header = printable(header);
         for l in header.lines() {
             let _ = writeln!(s, "# {l}").map(|_| ());
             if l.is_empty() {
@@ -675,7 +689,7 @@ impl Motor {
             }
             let dotted = format!("{}.{}", info.section, info.key);
             let val = fmt_toml_number(v, info.check == Check::PositiveInteger);
-            let note = notes(&dotted).map(|n| format!(" ({n})")).unwrap_or_default();
+            let note = notes(&dotted).map(|n| format!(" ({})", printable(&n).replace('\n', " "))).unwrap_or_default();
             let _ = writeln!(s, "{} = {}  # {}{}", info.key, val, info.doc, note);
         }
         s.push_str(&self.effects.to_toml());
@@ -702,6 +716,23 @@ pub(crate) fn fmt_toml_number(v: f64, integer: bool) -> String {
     }
 }
 
+/// `s` with every control character but the line feed written as `\u{1b}`: a TOML
+/// comment may hold no control character but the tab, and the header of a written motor
+/// file carries text from outside (a data file's name).
+fn printable(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        if c.is_control() && c != '\n' {
+            out.push_str(&format!("\\u{{{:x}}}", c as u32));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// A TOML basic string: quotes, backslashes and every control character escaped (TOML
+/// allows none of them raw, DEL included).
 pub(crate) fn toml_string(s: &str) -> String {
     let mut out = String::from("\"");
     for c in s.chars() {
@@ -709,7 +740,7 @@ pub(crate) fn toml_string(s: &str) -> String {
             '"' => out.push_str("\\\""),
             '\\' => out.push_str("\\\\"),
             '\n' => out.push_str("\\n"),
-            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04X}", c as u32)),
+            c if c.is_control() => out.push_str(&format!("\\u{:04X}", c as u32)),
             c => out.push(c),
         }
     }
