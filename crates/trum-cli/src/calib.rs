@@ -22,6 +22,10 @@ pub struct CalibrateArgs {
     data: String,
     #[command(flatten)]
     plausible: crate::data::PlausibleArgs,
+    /// Most measurement rows to calibrate to (docs/CLI.md, "Limits"): more are refused
+    /// before the fit with the estimated time and memory; raise this to run anyway.
+    #[arg(long, value_name = "N", default_value_t = 200_000)]
+    max_rows: usize,
     /// Write the calibrated motor file here (TOML; `-` for stdout instead of the table).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Option<PathBuf>,
@@ -42,11 +46,22 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     for p in [&a.output, &a.json].into_iter().flatten() {
         drop(crate::output::OutputTarget::create(p, ".tmp")?);
     }
+    crate::data::check_rows(&a.data, bench.rows.len(), a.max_rows, &crate::data::CALIBRATE_ROW)?;
     refuse_unsolvable(&motor, &bench, &a.data)?;
     let params = baseline_params_with(&motor, &bench.rows, &tolerances);
-    let mut cal = calibrate_refitting_bounds(&motor, &bench.rows, &params, &FitOptions::default())
-        .map_err(|e| anyhow!("{}: {e}", a.data))?;
-    rescale_uncertainties(&mut cal, &bench.rows);
+    let spinner = crate::diagnose::spinner_with(&format!(
+        "calibrating {} parameters to {} rows (about {})",
+        params.len(),
+        bench.rows.len(),
+        crate::output::human_seconds(bench.rows.len() as f64 * crate::data::CALIBRATE_ROW.seconds)
+    ));
+    let cal = calibrate_refitting_bounds(&motor, &bench.rows, &params, &FitOptions::default());
+    let mut cal = cal.map_err(|e| anyhow!("{}: {e}", a.data));
+    if let Ok(cal) = &mut cal {
+        rescale_uncertainties(cal, &bench.rows);
+    }
+    spinner.finish_and_clear();
+    let cal = cal?;
     let chi2_per = cal.chi2 / cal.n_readings.max(1) as f64;
     if let Some(path) = &a.json {
         let doc = json!({

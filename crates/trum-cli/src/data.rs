@@ -36,6 +36,38 @@ impl PlausibleArgs {
     }
 }
 
+/// The size model of `calibrate` and `diagnose`: time and memory a measurement row costs
+/// (docs/CLI.md, "Limits"). Calibration: 10^6 rows took 417 s and 5.4 GB; a diagnosis
+/// about 6 ms a row on clean data (1120 rows in 6.9 s, docs/PERFORMANCE.md) and up to
+/// 40 ms a row on erratic data, memory as calibration's several times over.
+pub struct RowCost {
+    /// Seconds a row, on the reference machine.
+    pub seconds: f64,
+    /// Bytes of memory a row.
+    pub bytes: f64,
+    /// What the work is called in the message (`calibrate`).
+    pub what: &'static str,
+}
+
+/// Calibration's row cost.
+pub const CALIBRATE_ROW: RowCost = RowCost { seconds: 4.2e-4, bytes: 5.4e3, what: "calibrate" };
+/// The diagnosis's row cost (clean data; erratic data up to 7 times the time).
+pub const DIAGNOSE_ROW: RowCost = RowCost { seconds: 6e-3, bytes: 2e4, what: "diagnose" };
+
+/// Refuses more than `max_rows` rows before any work, with the estimate and the flag.
+pub fn check_rows(data: &str, rows: usize, max_rows: usize, cost: &RowCost) -> Result<()> {
+    if rows > max_rows {
+        bail!(
+            "{data} has {rows} rows: an estimated {} and {} of memory to {} them; that is more than --max-rows \
+             {max_rows} (docs/CLI.md, \"Limits\"); give --max-rows {rows} to run it anyway, or thin the data",
+            crate::output::human_seconds(rows as f64 * cost.seconds),
+            crate::output::human_bytes(rows as f64 * cost.bytes),
+            cost.what
+        );
+    }
+    Ok(())
+}
+
 /// Reads and checks a measurement file (layout: docs/MEASUREMENTS.md), values within
 /// `plausible`; warnings (ignored columns, ...) are printed to `err`.
 pub fn read_data(

@@ -30,6 +30,10 @@ pub struct DiagnoseArgs {
     data: String,
     #[command(flatten)]
     plausible: crate::data::PlausibleArgs,
+    /// Most measurement rows to diagnose (docs/CLI.md, "Limits"): more are refused before
+    /// the run with the estimated time and memory; raise this to run anyway.
+    #[arg(long, value_name = "N", default_value_t = 10_000)]
+    max_rows: usize,
     /// Write the diagnosis as JSON here (`-`: JSON to stdout instead of the summary).
     #[arg(long, value_name = "OUT.json")]
     json: Option<PathBuf>,
@@ -45,6 +49,7 @@ pub struct DiagnoseArgs {
 pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
     let (motor, _) = load_motor(&a.motor)?;
     let (_, bench) = read_data(&a.data, &motor, &a.plausible.ranges()?, err)?;
+    crate::data::check_rows(&a.data, bench.rows.len(), a.max_rows, &crate::data::DIAGNOSE_ROW)?;
     // Check the output paths before the long run, so a typo fails at once.
     for p in [&a.json, &a.report].into_iter().flatten() {
         drop(crate::output::OutputTarget::create(p, ".tmp")?);
@@ -76,11 +81,19 @@ pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
 
 /// A spinner on stderr while the diagnosis runs (only on a terminal).
 fn spinner() -> ProgressBar {
+    spinner_with("diagnosing: calibrating the baseline and every candidate effect on held-out regions")
+}
+
+/// A spinner on stderr with the elapsed time while a long step runs (only on a terminal).
+pub fn spinner_with(message: &str) -> ProgressBar {
     if !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
     let b = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
-    b.set_message("diagnosing: calibrating the baseline and every candidate effect on held-out regions");
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {elapsed} {msg}") {
+        b.set_style(style);
+    }
+    b.set_message(message.to_string());
     b.enable_steady_tick(Duration::from_millis(120));
     b
 }

@@ -356,6 +356,56 @@ impl Drop for WritebackFile {
     }
 }
 
+/// The number of worker threads for `requested` (`None` or 0: RAYON_NUM_THREADS, else
+/// every core), never more than the machine's cores: more threads than cores only add
+/// switching and memory (100 000 threads drove the load above 600). A flag above the
+/// cores is capped with a note on `err` (`flag` names the option); the environment
+/// variable is capped silently.
+pub fn worker_threads(requested: Option<usize>, flag: &str, err: &mut dyn std::io::Write) -> Result<usize> {
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
+    match requested {
+        Some(n) if n > cores => {
+            writeln!(err, "note: {flag} {n} capped at {cores}, the number of cores of this machine")?;
+            Ok(cores)
+        }
+        Some(n) if n > 0 => Ok(n),
+        _ => Ok(std::env::var("RAYON_NUM_THREADS")
+            .ok()
+            .and_then(|v| v.trim().parse::<usize>().ok())
+            .filter(|&n| n > 0)
+            .map_or(cores, |n| n.min(cores))),
+    }
+}
+
+/// `3.1 GB`, `310 GB`, `12 MB` (decimal units).
+pub fn human_bytes(b: f64) -> String {
+    let units = ["B", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut v = b;
+    let mut i = 0;
+    while v >= 1000.0 && i + 1 < units.len() {
+        v /= 1000.0;
+        i += 1;
+    }
+    if v < 10.0 && i > 0 {
+        format!("{v:.1} {}", units[i])
+    } else {
+        format!("{v:.0} {}", units[i])
+    }
+}
+
+/// `45 s`, `17 min`, `3.2 h`, `41 days`.
+pub fn human_seconds(s: f64) -> String {
+    if s < 90.0 {
+        format!("{s:.0} s")
+    } else if s < 5400.0 {
+        format!("{:.0} min", s / 60.0)
+    } else if s < 3.0 * 86400.0 {
+        format!("{:.1} h", s / 3600.0)
+    } else {
+        format!("{:.0} days", s / 86400.0)
+    }
+}
+
 /// A progress bar on stderr that appears only once a run has taken more than a second,
 /// and never when stderr is not a terminal or with `--quiet`.
 pub struct Progress {
