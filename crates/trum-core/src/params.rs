@@ -599,7 +599,7 @@ impl Motor {
                     _ => token,
                 }
             } else {
-                String::new()
+                line.map(|l| key_on_line(text, l)).unwrap_or_default()
             };
             ParamError { source_name: source_name.into(), line, key, reason: msg }
         })?;
@@ -699,6 +699,29 @@ impl Motor {
     /// Plain TOML (no provenance notes).
     pub fn to_toml(&self) -> String {
         self.to_toml_annotated(&format!("trum motor file: {}", self.name), &|_| None)
+    }
+}
+
+/// The dotted key a TOML error's line holds: `stator.modal_mass_kg` for a key under
+/// `[stator]`, `stator` for a table header, empty when the line is neither (the toml
+/// crate's messages, `duplicate key` or `invalid type: integer `1``, do not name it).
+fn key_on_line(text: &str, line: usize) -> String {
+    let Some(l) = text.lines().nth(line.saturating_sub(1)).map(str::trim) else { return String::new() };
+    if let Some(h) = l.strip_prefix('[') {
+        return h.trim_start_matches('[').split(']').next().unwrap_or("").trim().to_string();
+    }
+    let Some((k, _)) = l.split_once('=') else { return String::new() };
+    let k = k.trim().trim_matches('"');
+    if k.is_empty() || k.contains('#') {
+        return String::new();
+    }
+    let section =
+        text.lines().take(line.saturating_sub(1)).collect::<Vec<_>>().into_iter().rev().find_map(|l| {
+            l.trim().strip_prefix('[').map(|h| h.trim_matches(|c| c == '[' || c == ']').trim().to_string())
+        });
+    match section {
+        Some(sec) if !sec.is_empty() => format!("{sec}.{k}"),
+        _ => k.to_string(),
     }
 }
 

@@ -68,6 +68,18 @@ pub enum MeasurementErrorKind {
         /// The invalid byte.
         byte: u8,
     },
+    /// The bytes are UTF-16 (a byte-order mark, or a zero byte beside every ASCII one).
+    #[error("the file is UTF-16{}, not UTF-8; save it as UTF-8 (in a spreadsheet: CSV UTF-8)", if *.little_endian { " (little-endian)" } else { " (big-endian)" })]
+    Utf16 {
+        /// Byte order.
+        little_endian: bool,
+    },
+    /// The header is one field holding another separator.
+    #[error("the header is one column holding '{separator}': the file looks separated by '{separator}' (a spreadsheet's regional setting?); measurement files are comma-separated, with '.' as the decimal point")]
+    WrongDelimiter {
+        /// The separator found (`;`, a tab, `|`).
+        separator: char,
+    },
     /// Nothing but blank lines (or nothing at all).
     #[error("no data rows: the file is empty; expected a header row and at least one measurement row")]
     EmptyFile,

@@ -9,7 +9,7 @@ import numpy as np
 
 from . import _trum
 from ._errors import InputError
-from ._motor import Motor
+from ._motor import Motor, _max_points
 from ._registry import QUANTITY_NAMES, STATUS_NAMES
 from ._result import _require_pandas
 
@@ -63,7 +63,7 @@ def map(  # noqa: A001 - the CLI's name for it
         torque_nm=_axis("torque_nm", torque_nm),
         voltage_v=_axis("voltage_v", voltage_v),
         frequency_hz=_axis("frequency_hz", frequency_hz),
-        max_points=int(max_points),
+        max_points=_max_points(max_points),
         parallel=parallel,
     )
     out: Dict[str, np.ndarray] = {k: d[k] for k in _trum.AXES}

@@ -22,16 +22,22 @@ def diagnose(
     causes it, and how far the held-out gap shrinks once it is added.
 
     ``motor`` is the nominal motor (a ``trum.Motor`` or a preset name); ``data`` a
-    measurement CSV in the layout of docs/MEASUREMENTS.md, as a path or as the
-    file's bytes. Returns the JSON document of ``trum diagnose --json`` as a dict
+    measurement CSV in the layout of docs/MEASUREMENTS.md, as a path, the file's bytes,
+    its text (a string with a line break), or a pandas DataFrame with those columns. Returns the JSON document of ``trum diagnose --json`` as a dict
     (``verdict``, ``confounded_with``, ``partial``, ``gap``, ``ranking``, ``notes``, ...;
     every field in docs/DIAGNOSIS_JSON.md, the method in docs/DIAGNOSIS.md). Columns the reader ignores are reported with
     ``warnings.warn``. A bad file, or data that cannot support a held-out test, raises
     ``trum.InputError`` naming the file, line and column. The GIL is released while it runs.
     """
     m = _motor(motor)
-    if isinstance(data, (bytes, bytearray)):
+    if hasattr(data, "to_csv") and hasattr(data, "columns"):
+        # a pandas DataFrame: its columns are the file's (docs/MEASUREMENTS.md)
+        raw, source = data.to_csv(index=False).encode("utf-8"), "<DataFrame>"
+    elif isinstance(data, (bytes, bytearray)):
         raw, source = bytes(data), "<bytes>"
+    elif isinstance(data, str) and ("\n" in data or "\r" in data):
+        # CSV text rather than a path (no file name has a line break)
+        raw, source = data.encode("utf-8"), "<text>"
     elif isinstance(data, (str, os.PathLike)):
         source = os.fspath(data)
         if os.path.isdir(source):
@@ -44,7 +50,10 @@ def diagnose(
         except OSError as e:
             raise InputError(f"cannot read measurement file '{source}': {e.strerror}") from None
     else:
-        raise TypeError(f"data: expected a path or bytes, got {type(data).__name__}")
+        raise TypeError(
+            f"data: expected a measurement file's path or bytes, its text, or a pandas DataFrame, "
+            f"got {type(data).__name__}"
+        )
     motor_source = motor if isinstance(motor, str) else (m.preset or m.name)
     text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv))
     for w in notes:
