@@ -78,3 +78,27 @@ fn too_many_rows_are_refused_before_calibrating_or_diagnosing() {
         assert!(e.contains("more than --max-rows 20") && e.contains("give --max-rows 30"), "{cmd}: {e}");
     }
 }
+
+#[test]
+fn dev_null_is_read_as_a_motor_file_and_an_effect_given_twice_is_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = trum(dir.path(), &["point", "--motor", "/dev/null", "--preload-n", "250"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("/dev/null, key 'geometry': missing section"), "{}", stderr(&o));
+    let o = trum(
+        dir.path(),
+        &[
+            "point",
+            "--motor",
+            "trum60a",
+            "--preload-n",
+            "250",
+            "--effect",
+            "radial_friction=0.1",
+            "--effect",
+            "radial_friction=0.3",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("radial_friction is given twice"), "{}", stderr(&o));
+}

@@ -484,3 +484,39 @@ fn implausible_values_are_refused_with_line_and_column() {
         assert!(c.column.check(hi).is_ok(), "{}", c.name);
     }
 }
+
+#[test]
+fn another_delimiter_and_utf16_are_named() {
+    let e = message(b"preload_n;voltage_v;frequency_hz;torque_nm;speed_rpm\n250;150;42000;0;120\n");
+    assert!(e.contains("line 1") && e.contains("separated by ';'") && e.contains("comma-separated"), "{e}");
+    let e = message(b"preload_n\tvoltage_v\tfrequency_hz\ttorque_nm\tspeed_rpm\n250\t150\t42000\t0\t120\n");
+    assert!(e.contains("separated by '\t'"), "{e}");
+    let text = "preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n250,150,42000,0,120\n";
+    let le: Vec<u8> = text.encode_utf16().flat_map(u16::to_le_bytes).collect();
+    let be: Vec<u8> = text.encode_utf16().flat_map(u16::to_be_bytes).collect();
+    let with_bom: Vec<u8> = [0xFF, 0xFE].into_iter().chain(le.iter().copied()).collect();
+    for (bytes, endian) in [(&le, "little"), (&be, "big"), (&with_bom, "little")] {
+        let e = message(bytes);
+        assert!(e.contains(&format!("UTF-16 ({endian}-endian), not UTF-8")), "{e}");
+    }
+}
+
+#[test]
+fn ten_thousand_unknown_columns_give_one_short_warning_in_linear_time() {
+    let n = 10_000;
+    let mut head = String::from("preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm");
+    let mut row = String::from("250,150,42000,0,120");
+    for i in 0..n {
+        head += &format!(",x{i}");
+        row += ",1";
+    }
+    let text = format!("{head}\n{row}\n{row}\n");
+    let t0 = std::time::Instant::now();
+    let m = parse_str(&text).unwrap_or_else(|e| panic!("{e}"));
+    // quadratic handling took seconds at this size; linear takes milliseconds
+    assert!(t0.elapsed() < std::time::Duration::from_secs(1), "{:?}", t0.elapsed());
+    assert_eq!(m.extra_columns.len(), n);
+    assert_eq!(m.extra_columns[n - 1].cells, ["1", "1"]);
+    assert_eq!(m.warnings.len(), 1);
+    assert!(m.warnings[0].len() < 300 && m.warnings[0].contains("and 9990 more"), "{}", m.warnings[0]);
+}
