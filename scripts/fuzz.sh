@@ -20,16 +20,21 @@ echo "fuzz seed: $SEED, ${SECONDS_PER_TARGET} s per target (replay a crash: carg
 for t in "${TARGETS[@]}"; do
   corpus=fuzz/coverage/corpus/$t
   mkdir -p "$corpus" "fuzz/coverage/artifacts/$t"
+  # inputs up to the length a target can use, from the start (-len_control=0)
   case $t in
-    motor_reader) seeds=fuzz/corpus/toml ;;
-    measurement_reader) seeds=fuzz/corpus/csv ;;
-    *) seeds= ;;
+    motor_reader) seeds=fuzz/corpus/toml; max_len=8192 ;;
+    measurement_reader) seeds=fuzz/corpus/csv; max_len=8192 ;;
+    solver) seeds=; max_len=128 ;;
+    writers_round_trip) seeds=; max_len=512 ;;
+    calibrate_diagnose) seeds=; max_len=64 ;;
+    *) seeds=; max_len=4096 ;;
   esac
   echo "== $t"
   log=$(mktemp)
   # -rss_limit_mb bounds memory; -timeout reports an input slower than 10 s as a hang
   if ! cargo +nightly fuzz run --fuzz-dir fuzz/coverage "$t" "$corpus" $seeds -- \
       -seed="$SEED" -max_total_time="$SECONDS_PER_TARGET" -rss_limit_mb=4096 -timeout=10 \
+      -max_len="$max_len" -len_control=0 \
       -print_final_stats=1 >"$log" 2>&1; then
     tail -40 "$log"
     echo "FAILED: $t (seed $SEED; the input is in fuzz/coverage/artifacts/$t/)"
