@@ -72,6 +72,15 @@ def test_diagnose_takes_a_dataframe_or_csv_text(motor):
     # an implausible value names its line and column, wherever the data come from
     with pytest.raises(trum.InputError, match=r"line 10, column 'speed_rpm'.*plausible range"):
         trum.diagnose("trum60a", ROWS + "250,150,42000,0,1e300\n")
+    # lifted: no confident verdict from an overflow, and every spec figure a number
+    d = trum.diagnose("trum60a", ROWS + "250,150,42000,0,1e300\n", plausible={"speed_rpm": None})
+    assert d["verdict"] == "unexplained" and d["complete"] is False
+    assert all(np.isfinite(d["gap"][k]) for k in ("baseline_heldout_nrmse", "noise_nrmse"))
+    assert all(np.isfinite(r[k]) for r in d["ranking"] for k in ("evidence", "heldout_nrmse_after", "shrink"))
+    # a wider range, one end open
+    trum.diagnose("trum60a", ROWS + "250,150,42000,0,2e4\n", plausible={"speed_rpm": (0, None)})
+    with pytest.raises(trum.InputError, match="plausible 'speedrpm=any'.*not a numeric measurement column"):
+        trum.diagnose("trum60a", ROWS, plausible={"speedrpm": None})
 
 
 try:

@@ -4,7 +4,7 @@ from __future__ import annotations
 import json
 import os
 import warnings
-from typing import Any, Dict, Union
+from typing import Any, Dict, Mapping, Optional, Union
 
 from . import _trum
 from ._api import _motor
@@ -17,6 +17,7 @@ def diagnose(
     data: Union[str, "os.PathLike[str]", bytes],
     *,
     exact_cv: bool = False,
+    plausible: Optional[Mapping[str, Any]] = None,
 ) -> Dict[str, Any]:
     """Where the calibrated baseline misses the measurements, which unmodelled effect
     causes it, and how far the held-out gap shrinks once it is added.
@@ -28,7 +29,19 @@ def diagnose(
     every field in docs/DIAGNOSIS_JSON.md, the method in docs/DIAGNOSIS.md). Columns the reader ignores are reported with
     ``warnings.warn``. A bad file, or data that cannot support a held-out test, raises
     ``trum.InputError`` naming the file, line and column. The GIL is released while it runs.
+
+    A value outside its column's plausible range (docs/MEASUREMENTS.md) is such an error;
+    ``plausible={"speed_rpm": (0, 2e4), "preload_n": None}`` replaces ranges when the
+    values are real (``None`` for no bound at all; ``None`` at either end of a pair for
+    no bound there).
     """
+    specs = []
+    for col, rng in (plausible or {}).items():
+        if rng is None:
+            specs.append(f"{col}=any")
+        else:
+            lo, hi = rng
+            specs.append(f"{col}={'' if lo is None else repr(float(lo))}:{'' if hi is None else repr(float(hi))}")
     m = _motor(motor)
     if hasattr(data, "to_csv") and hasattr(data, "columns"):
         # a pandas DataFrame: its columns are the file's (docs/MEASUREMENTS.md)
@@ -55,7 +68,7 @@ def diagnose(
             f"got {type(data).__name__}"
         )
     motor_source = motor if isinstance(motor, str) else (m.preset or m.name)
-    text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv))
+    text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv), specs)
     for w in notes:
         warnings.warn(w, stacklevel=2)
     return json.loads(text)

@@ -112,5 +112,10 @@ def step(
     snapshot_at_s: Sequence[float],
 ) -> Dict[str, Any]: ...
 def diagnose_csv(
-    motor: Motor, data: bytes, source: str, motor_source: str, exact_cv: bool = False
+    motor: Motor,
+    data: bytes,
+    source: str,
+    motor_source: str,
+    exact_cv: bool = False,
+    plausible: List[str] = ...,
 ) -> Tuple[str, List[str]]: ...
