@@ -14,7 +14,7 @@ fi
 PY="$VENV/bin/python"
 echo "== installing build and test dependencies"
 "$PY" -m pip install -q --disable-pip-version-check --upgrade pip
-"$PY" -m pip install -q --disable-pip-version-check maturin numpy pytest pandas xarray matplotlib "dask[distributed]"
+"$PY" -m pip install -q --disable-pip-version-check maturin numpy pytest pandas xarray matplotlib hypothesis "dask[distributed]"
 
 echo "== building trum (release) into $VENV"
 # maturin develop installs into the virtualenv named by VIRTUAL_ENV.

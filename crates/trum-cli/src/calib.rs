@@ -18,6 +18,12 @@ pub struct CalibrateArgs {
     /// Measurement CSV (shared/spec/measurements.md; `trum synth` writes one).
     #[arg(long, value_name = "FILE")]
     data: String,
+    #[command(flatten)]
+    plausible: crate::data::PlausibleArgs,
+    /// Most measurement rows to calibrate to (docs/CLI.md, "Limits"): more are refused
+    /// before the fit with the estimated time and memory; raise this to run anyway.
+    #[arg(long, value_name = "N", default_value_t = 200_000)]
+    max_rows: usize,
     /// Write the calibrated motor file here (TOML; `-` for stdout instead of the table).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Option<PathBuf>,
@@ -35,17 +41,33 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         anyhow::bail!("-o - and --json - cannot both go to stdout");
     }
     let (motor, _) = a.motor.load()?;
-    let (_, bench) = read_data(&a.data, &motor, err)?;
+    let (_, bench) = read_data(&a.data, &motor, &a.plausible.ranges()?, err)?;
     let tolerances = crate::motor::load_tolerances(&a.motor.motor)?;
-    let spinner = crate::diagnose::spinner("calibrating the baseline parameters", a.quiet);
+    // Check the output paths before the fit, so a typo or an input named as output fails at once.
+    for p in [&a.output, &a.json].into_iter().flatten() {
+        drop(crate::output::OutputTarget::create(p, ".tmp")?);
+    }
+    crate::data::check_rows(&a.data, bench.rows.len(), a.max_rows, &crate::data::CALIBRATE_ROW)?;
+    refuse_unsolvable(&motor, &bench, &a.data)?;
+    let spinner = crate::diagnose::spinner(
+        &format!(
+            "calibrating the baseline parameters to {} rows (about {})",
+            bench.rows.len(),
+            crate::output::human_seconds(bench.rows.len() as f64 * crate::data::CALIBRATE_ROW.seconds)
+        ),
+        a.quiet,
+    );
     let cal = Calibration::builder(&motor, &bench.rows)
         .tolerances(&tolerances)
         .options(&FitOptions::default())
         .refit_bounds(true)
         .run();
+    let mut cal = cal.map_err(|e| anyhow!("{}: {e}", a.data));
+    if let Ok(cal) = &mut cal {
+        rescale_uncertainties(cal, &bench.rows);
+    }
     spinner.finish_and_clear();
-    let mut cal = cal.map_err(|e| anyhow!("{}: {e}", a.data))?;
-    rescale_uncertainties(&mut cal, &bench.rows);
+    let cal = cal?;
     let chi2_per = cal.chi2 / cal.n_readings.max(1) as f64;
     if let Some(path) = &a.json {
         let doc = json!({
@@ -78,6 +100,36 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         writeln!(err, "warning: {w}")?;
     }
     Ok(0)
+}
+
+/// Refuses data at which the nominal motor has no solution at a single row (preloads of
+/// 1e308 N, frequencies far from any resonance, ...): a fit to them would move nothing
+/// and still write a "calibrated" motor. One solvable row is enough to go on; the fit
+/// counts the others as misses and says so.
+fn refuse_unsolvable(motor: &trum_core::Motor, bench: &trum_core::bench::BenchData, data: &str) -> Result<()> {
+    let prep = trum_core::solve::Prepared::new(motor);
+    let mut first_bad = None;
+    for (i, r) in bench.rows.iter().enumerate() {
+        let s = trum_core::solve::solve_prepared(&prep, motor, &r.op, None);
+        if s.status.is_valid() {
+            return Ok(());
+        }
+        first_bad.get_or_insert((i, s.status));
+    }
+    let Some((i, status)) = first_bad else { return Ok(()) };
+    let line = bench.lines.get(i).copied().unwrap_or(0);
+    let op = &bench.rows[i].op;
+    anyhow::bail!(
+        "{data}: the motor '{}' has no solution at any of the {} measured operating points (line {line}: preload {} N, \
+         {} V, {} Hz, {} N·m: {}); nothing to calibrate to: check the data's units and the motor",
+        motor.name,
+        bench.rows.len(),
+        fmt_sig(op.preload_n, 4),
+        fmt_sig(op.voltage_v, 4),
+        fmt_sig(op.frequency_hz, 6),
+        fmt_sig(op.torque_nm, 4),
+        status.as_str()
+    )
 }
 
 /// The calibrated motor file, with the fit recorded in comments.

@@ -6,12 +6,76 @@ use anyhow::{anyhow, bail, Context, Result};
 use std::io::Write;
 use std::path::Path;
 use trum_core::bench::{observations, BenchData};
-use trum_core::measurements::{parse_measurements, Measurements};
+use trum_core::measurements::{parse_measurements_with, Measurements, PlausibleRanges};
 use trum_core::Motor;
 
-/// Reads and checks a measurement file (layout: docs/MEASUREMENTS.md); warnings (ignored
-/// columns, ...) are printed to `err`.
-pub fn read_data(path: &str, motor: &Motor, err: &mut dyn Write) -> Result<(Measurements, BenchData)> {
+/// `--plausible COLUMN=LOW:HIGH`, shared by the commands that read a measurement file.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct PlausibleArgs {
+    /// Plausible range of a measured column, replacing its default (docs/MEASUREMENTS.md,
+    /// "Plausible ranges"): COLUMN=LOW:HIGH, an end left empty for no bound, or COLUMN=any (repeatable).
+    #[arg(long = "plausible", value_name = "COLUMN=LOW:HIGH")]
+    pub plausible: Vec<String>,
+}
+
+impl PlausibleArgs {
+    /// The ranges in force: the defaults with every `--plausible` applied; a column given
+    /// twice is an error (which one was meant?).
+    pub fn ranges(&self) -> Result<PlausibleRanges> {
+        let mut r = PlausibleRanges::default();
+        let mut seen: Vec<&str> = Vec::new();
+        for spec in &self.plausible {
+            let name = spec.split_once('=').map_or(spec.as_str(), |(n, _)| n.trim());
+            if seen.contains(&name) {
+                bail!("--plausible: '{name}' is given twice");
+            }
+            seen.push(name);
+            r.parse_assignment(spec).map_err(|m| anyhow!("--plausible '{spec}': {m}"))?;
+        }
+        Ok(r)
+    }
+}
+
+/// The size model of `calibrate` and `diagnose`: time and memory a measurement row costs
+/// (docs/CLI.md, "Limits"). Calibration: 10^6 rows took 417 s and 5.4 GB; a diagnosis
+/// about 6 ms a row on clean data (1120 rows in 6.9 s, docs/PERFORMANCE.md) and up to
+/// 40 ms a row on erratic data, memory as calibration's several times over.
+pub struct RowCost {
+    /// Seconds a row, on the reference machine.
+    pub seconds: f64,
+    /// Bytes of memory a row.
+    pub bytes: f64,
+    /// What the work is called in the message (`calibrate`).
+    pub what: &'static str,
+}
+
+/// Calibration's row cost.
+pub const CALIBRATE_ROW: RowCost = RowCost { seconds: 4.2e-4, bytes: 5.4e3, what: "calibrate" };
+/// The diagnosis's row cost (clean data; erratic data up to 7 times the time).
+pub const DIAGNOSE_ROW: RowCost = RowCost { seconds: 6e-3, bytes: 2e4, what: "diagnose" };
+
+/// Refuses more than `max_rows` rows before any work, with the estimate and the flag.
+pub fn check_rows(data: &str, rows: usize, max_rows: usize, cost: &RowCost) -> Result<()> {
+    if rows > max_rows {
+        bail!(
+            "{data} has {rows} rows: an estimated {} and {} of memory to {} them; that is more than --max-rows \
+             {max_rows} (docs/CLI.md, \"Limits\"); give --max-rows {rows} to run it anyway, or thin the data",
+            crate::output::human_seconds(rows as f64 * cost.seconds),
+            crate::output::human_bytes(rows as f64 * cost.bytes),
+            cost.what
+        );
+    }
+    Ok(())
+}
+
+/// Reads and checks a measurement file (layout: docs/MEASUREMENTS.md), values within
+/// `plausible`; warnings (ignored columns, ...) are printed to `err`.
+pub fn read_data(
+    path: &str,
+    motor: &Motor,
+    plausible: &PlausibleRanges,
+    err: &mut dyn Write,
+) -> Result<(Measurements, BenchData)> {
     let p = Path::new(path);
     if p.is_dir() {
         bail!("--data '{path}' is a directory, not a measurement file");
@@ -19,9 +83,10 @@ pub fn read_data(path: &str, motor: &Motor, err: &mut dyn Write) -> Result<(Meas
     if !p.exists() {
         bail!("measurement file '{path}' does not exist");
     }
+    crate::output::note_input(p, &format!("--data '{path}'"));
     let bytes = std::fs::read(p).with_context(|| format!("cannot read measurement file '{path}'"))?;
     // MeasurementError's message names the file, line and column; show it unchanged.
-    let m = parse_measurements(&bytes, path).map_err(|e| anyhow!("{e}"))?;
+    let m = parse_measurements_with(&bytes, path, plausible).map_err(|e| anyhow!("{e}"))?;
     for w in &m.warnings {
         writeln!(err, "warning: {w}")?;
     }

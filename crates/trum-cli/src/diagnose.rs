@@ -28,6 +28,12 @@ pub struct DiagnoseArgs {
     /// Measurement CSV (layout: docs/MEASUREMENTS.md).
     #[arg(long, value_name = "DATA.csv")]
     data: String,
+    #[command(flatten)]
+    plausible: crate::data::PlausibleArgs,
+    /// Most measurement rows to diagnose (docs/CLI.md, "Limits"): more are refused before
+    /// the run with the estimated time and memory; raise this to run anyway.
+    #[arg(long, value_name = "N", default_value_t = 10_000)]
+    max_rows: usize,
     /// Write the diagnosis as JSON here (`-`: JSON to stdout instead of the summary).
     #[arg(long, value_name = "OUT.json")]
     json: Option<PathBuf>,
@@ -45,7 +51,8 @@ pub struct DiagnoseArgs {
 
 pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
     let (motor, _) = load_motor(&a.motor)?;
-    let (_, bench) = read_data(&a.data, &motor, err)?;
+    let (_, bench) = read_data(&a.data, &motor, &a.plausible.ranges()?, err)?;
+    crate::data::check_rows(&a.data, bench.rows.len(), a.max_rows, &crate::data::DIAGNOSE_ROW)?;
     // Check the output paths before the long run, so a typo fails at once.
     for p in [&a.json, &a.report].into_iter().flatten() {
         drop(crate::output::OutputTarget::create(p, ".tmp")?);

@@ -89,6 +89,7 @@ where
     I: IntoIterator<Item = T>,
     T: Into<OsString> + Clone,
 {
+    output::signals::install();
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     // Not stderr's lock for the whole run: a worker thread that writes to stderr (the panic
@@ -115,6 +116,7 @@ where
             return e.exit_code();
         }
     };
+    output::reset_inputs();
     // Last resort: nothing should panic, but a bug must not print a backtrace at the user.
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(cli, out, err)));
     match result {

@@ -41,9 +41,14 @@ pub struct MapArgs {
     /// Output CSV file (`-` for stdout). Written to a temporary file and renamed at the end.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: PathBuf,
-    /// Worker threads (default: RAYON_NUM_THREADS or the number of cores).
+    /// Worker threads (default: RAYON_NUM_THREADS or the number of cores; never more than
+    /// the machine's cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// Largest grid to solve, in points (docs/CLI.md, "Limits"): a bigger grid is refused
+    /// before any work with its estimated size and time; raise this to run it anyway.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_POINTS)]
+    max_points: u64,
     /// No progress bar.
     #[arg(short, long)]
     quiet: bool,
@@ -145,8 +150,9 @@ pub fn run(a: &MapArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32>
     if a.chunk_points == 0 {
         bail!("--chunk-points must be >= 1");
     }
+    let threads = crate::output::worker_threads(a.threads, "--threads", err)?;
+    check_size(&motor, &grid, cols.len(), threads, a.max_points)?;
     let target = OutputTarget::create(&a.output, ".csv")?;
-    let threads = a.threads.unwrap_or(0);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start worker threads")?;
     let mut progress = Progress::new(grid.len(), "points", a.quiet);
     let result = match target.open()? {
@@ -162,6 +168,52 @@ pub fn run(a: &MapArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32>
     result?;
     target.finish()?;
     Ok(0)
+}
+
+/// Default of `--max-points`: 2·10^8 points, tens of GB of CSV and some minutes on two
+/// cores (10^8-point maps are run and measured in docs/PERFORMANCE.md).
+pub const DEFAULT_MAX_POINTS: u64 = 200_000_000;
+
+/// Bytes of a CSV cell, on average: a shortest round-trip double in positional notation
+/// (12-20 digits) and its comma, measured 17-19 on maps of the presets.
+const BYTES_PER_CELL: f64 = 19.0;
+
+/// Solver time a point [s] on one core, in a warm-started sweep with its formatting:
+/// 1 µs for the baseline (0.3 µs solving, the rest formatting and writing;
+/// docs/PERFORMANCE.md), 13 µs with the slowest effects on (numerical interface,
+/// voltage sag).
+fn seconds_per_point(motor: &Motor) -> f64 {
+    if motor.effects.is_none() {
+        1e-6
+    } else {
+        13e-6
+    }
+}
+
+/// The size model of `trum map`: (points, estimated CSV bytes, estimated seconds).
+pub fn size_estimate(motor: &Motor, grid: &Grid, columns: usize, threads: usize) -> (u64, f64, f64) {
+    let n = grid.len();
+    let bytes = n as f64 * (INPUT_COLUMNS.len() + 1 + columns) as f64 * BYTES_PER_CELL;
+    let secs = n as f64 * seconds_per_point(motor) / threads.max(1) as f64;
+    (n, bytes, secs)
+}
+
+/// Refuses a grid above `max_points` before any work, with its size and the flag.
+fn check_size(motor: &Motor, grid: &Grid, columns: usize, threads: usize, max_points: u64) -> Result<()> {
+    let (n, bytes, secs) = size_estimate(motor, grid, columns, threads);
+    if n > max_points {
+        bail!(
+            "the grid has {} points ({}): an estimated {} of CSV and {} on {threads} thread{}; that is more than \
+             --max-points {max_points} (docs/CLI.md, \"Limits\"); give --max-points {} to run it anyway, or a coarser grid",
+            if n == u64::MAX { "more than 1.8e19".to_string() } else { n.to_string() },
+            grid.axes().iter().map(|a| a.n.to_string()).collect::<Vec<_>>().join(" × "),
+            crate::output::human_bytes(bytes),
+            crate::output::human_seconds(secs),
+            if threads == 1 { "" } else { "s" },
+            n
+        );
+    }
+    Ok(())
 }
 
 /// The CSV header line.

@@ -8,10 +8,17 @@ use trum_core::presets;
 use trum_core::Motor;
 
 impl MotorArgs {
-    /// The motor with the command-line effects applied, and its `[sweep]` table.
+    /// The motor with the command-line effects applied, and its `[sweep]` table. An
+    /// effect given twice is an error (which of the two was meant?).
     pub fn load(&self) -> Result<(Motor, SweepTable)> {
         let (mut motor, sweep) = load_motor(&self.motor)?;
+        let mut seen: Vec<&str> = Vec::new();
         for spec in &self.effects {
+            let name = spec.split(['=', ':']).next().unwrap_or("").trim();
+            if seen.contains(&name) {
+                bail!("--effect '{spec}': {name} is given twice; give each effect once (NAME:param=value,... sets several parameters)");
+            }
+            seen.push(name);
             motor.effects.parse_assignment(spec).map_err(|m| anyhow!("--effect '{spec}': {m}{}", effect_hint(spec)))?;
         }
         Ok((motor, sweep))
@@ -22,8 +29,11 @@ impl MotorArgs {
 /// preset name. The error says which of the two was tried.
 pub fn load_motor(spec: &str) -> Result<(Motor, SweepTable)> {
     let path = Path::new(spec);
-    if path.is_file() {
-        let text = std::fs::read_to_string(path).with_context(|| format!("cannot read motor file '{spec}'"))?;
+    // any existing path but a directory is read: a regular file, and also /dev/null, a
+    // FIFO or a process substitution (`--motor <(...)`)
+    if path.exists() && !path.is_dir() {
+        crate::output::note_input(path, &format!("--motor '{spec}'"));
+        let text = read_text(path, spec)?;
         // ParamError's message names the file, line and key; show it unchanged.
         return Motor::from_toml_str_with_sweep(&text, spec).map_err(|e| anyhow!("{e}"));
     }
@@ -49,9 +59,10 @@ pub fn load_motor(spec: &str) -> Result<(Motor, SweepTable)> {
 pub fn load_tolerances(spec: &str) -> Result<std::collections::BTreeMap<String, f64>> {
     let path = Path::new(spec);
     if !path.is_file() {
+        // (a preset; or a device or FIFO already read once by load_motor)
         return Ok(Default::default());
     }
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read motor file '{spec}'"))?;
+    let text = read_text(path, spec)?;
     trum_core::params::tolerances_from_toml_str(&text, spec).map_err(|e| anyhow!("{e}"))
 }
 
@@ -63,4 +74,18 @@ pub fn effect_hint(spec: &str) -> String {
         return String::new();
     }
     crate::suggest::hint(name, crate::suggest::names(known))
+}
+
+/// A motor file's text; invalid UTF-8 is an error with its line and byte offset.
+fn read_text(path: &Path, spec: &str) -> Result<String> {
+    let bytes = std::fs::read(path).with_context(|| format!("cannot read motor file '{spec}'"))?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
+        anyhow!(
+            "{spec}: line {line}: byte 0x{:02X} at offset {at} is not valid UTF-8; save the file as UTF-8",
+            bytes.get(at).copied().unwrap_or(0)
+        )
+    })
 }

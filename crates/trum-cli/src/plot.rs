@@ -488,6 +488,7 @@ fn solve_grid(motor: &Motor, grid: &Grid) -> Data {
 /// Reads the needed columns of a CSV; empty cells are missing values.
 fn read_csv(path: &Path, needed: &[&str]) -> Result<Data> {
     let shown = path.display();
+    crate::output::note_input(path, &format!("--map '{shown}'"));
     let mut rdr = csv::ReaderBuilder::new()
         .flexible(false)
         .from_path(path)

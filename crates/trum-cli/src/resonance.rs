@@ -61,6 +61,7 @@ impl OscillatorArgs {
         let mut o = HertzOscillator::default();
         if let Some(path) = &self.oscillator {
             let shown = path.display();
+            crate::output::note_input(path, &format!("--oscillator '{shown}'"));
             let text =
                 std::fs::read_to_string(path).with_context(|| format!("cannot read oscillator file '{shown}'"))?;
             let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
@@ -447,6 +448,7 @@ struct Waveform {
 
 fn read_waveform(path: &Path) -> Result<Waveform> {
     let shown = path.display();
+    crate::output::note_input(path, &format!("--data '{shown}'"));
     let mut rdr = csv::ReaderBuilder::new()
         .flexible(false)
         .comment(Some(b'#'))

@@ -456,6 +456,19 @@ impl Motor {
     /// Checks every value (finite, sign, integrality, and the physical consistency checks
     /// the model needs). `text` lets errors point at a line of the TOML source.
     pub fn validate(&self, source_name: &str, text: Option<&str>) -> Result<(), ParamError> {
+        // A control character in the name would be written raw into motor files' comments,
+        // tables and terminals (an ESC changes the terminal's state); no use for one.
+        if let Some((i, c)) = self.name.char_indices().find(|(_, c)| c.is_control()) {
+            return Err(ParamError {
+                source_name: source_name.into(),
+                line: text.and_then(|t| line_of_key(t, "", "name")),
+                key: "name".into(),
+                reason: format!(
+                    "contains the control character U+{:04X} at byte {i}; a motor name must be printable text",
+                    c as u32
+                ),
+            });
+        }
         for (info, v) in Self::all_keys().iter().zip(self.values()) {
             if let Some(reason) = info.check.reason(v) {
                 return Err(ParamError {
@@ -534,7 +547,7 @@ impl Motor {
                     _ => token,
                 }
             } else {
-                String::new()
+                line.map(|l| key_on_line(text, l)).unwrap_or_default()
             };
             ParamError { source_name: source_name.into(), line, key, reason: msg }
         })?;
@@ -603,6 +616,7 @@ impl Motor {
     /// key to its provenance (paper value, assumed, calibrated) and is written as comments.
     pub fn to_toml_annotated(&self, header: &str, notes: &dyn Fn(&str) -> Option<String>) -> String {
         let mut s = String::new();
+        let header = printable(header);
         for l in header.lines() {
             let _ = writeln!(s, "# {l}").map(|_| ());
             if l.is_empty() {
@@ -623,7 +637,7 @@ impl Motor {
             }
             let dotted = format!("{}.{}", info.section, info.key);
             let val = fmt_toml_number(v, info.check == Check::PositiveInteger);
-            let note = notes(&dotted).map(|n| format!(" ({n})")).unwrap_or_default();
+            let note = notes(&dotted).map(|n| format!(" ({})", printable(&n).replace('\n', " "))).unwrap_or_default();
             let _ = writeln!(s, "{} = {}  # {}{}", info.key, val, info.doc, note);
         }
         s.push_str(&self.effects.to_toml());
@@ -636,6 +650,46 @@ impl Motor {
     }
 }
 
+/// The dotted key a TOML error's line holds: `stator.modal_mass_kg` for a key under
+/// `[stator]`, `stator` for a table header, empty when the line is neither (the toml
+/// crate's messages, `duplicate key` or `invalid type: integer `1``, do not name it).
+fn key_on_line(text: &str, line: usize) -> String {
+    let Some(l) = text.lines().nth(line.saturating_sub(1)).map(str::trim) else { return String::new() };
+    if let Some(h) = l.strip_prefix('[') {
+        return h.trim_start_matches('[').split(']').next().unwrap_or("").trim().to_string();
+    }
+    let Some((k, _)) = l.split_once('=') else { return String::new() };
+    let k = k.trim().trim_matches('"');
+    if k.is_empty() || k.contains('#') {
+        return String::new();
+    }
+    let section =
+        text.lines().take(line.saturating_sub(1)).collect::<Vec<_>>().into_iter().rev().find_map(|l| {
+            l.trim().strip_prefix('[').map(|h| h.trim_matches(|c| c == '[' || c == ']').trim().to_string())
+        });
+    match section {
+        Some(sec) if !sec.is_empty() => format!("{sec}.{k}"),
+        _ => k.to_string(),
+    }
+}
+
+/// `s` with every control character but the line feed written as `\u{1b}`: a TOML
+/// comment may hold no control character but the tab, and the header of a written motor
+/// file carries text from outside (a data file's name).
+fn printable(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        if c.is_control() && c != '\n' {
+            out.push_str(&format!("\\u{{{:x}}}", c as u32));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// A TOML basic string: quotes, backslashes and every control character escaped (TOML
+/// allows none of them raw, DEL included).
 pub(crate) fn toml_string(s: &str) -> String {
     let mut out = String::from("\"");
     for c in s.chars() {
@@ -643,7 +697,7 @@ pub(crate) fn toml_string(s: &str) -> String {
             '"' => out.push_str("\\\""),
             '\\' => out.push_str("\\\\"),
             '\n' => out.push_str("\\n"),
-            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04X}", c as u32)),
+            c if c.is_control() => out.push_str(&format!("\\u{:04X}", c as u32)),
             c => out.push(c),
         }
     }

@@ -9,14 +9,16 @@ use trum_core::bench::observations;
 use trum_core::calibrate::{baseline_params_with, calibrate_refitting_bounds, rescale_uncertainties, FitOptions};
 use trum_core::diagnose::json::{to_json, Provenance};
 use trum_core::diagnose::{diagnose, DiagnoseOptions};
-use trum_core::measurements::parse_measurements;
+use trum_core::measurements::{parse_measurements_with, PlausibleRanges};
 
 /// Diagnoses the measurement CSV `data` (its bytes; `source` names it in messages) against
 /// `motor`. Returns the JSON document as text and the reader's warnings. Bad files raise
 /// `trum.InputError` naming the file, line and column; data that cannot support a
-/// held-out test raise `trum.InputError` too. The work runs with the GIL released.
+/// held-out test raise `trum.InputError` too. `plausible` replaces columns' plausible
+/// ranges (`COLUMN=LOW:HIGH` or `COLUMN=any`, as the CLI's `--plausible`). The work runs
+/// with the GIL released.
 #[pyfunction]
-#[pyo3(signature = (motor, data, source, motor_source, exact_cv = false))]
+#[pyo3(signature = (motor, data, source, motor_source, exact_cv = false, plausible = Vec::new()))]
 pub fn diagnose_csv(
     py: Python<'_>,
     motor: &Bound<'_, PyMotor>,
@@ -24,10 +26,15 @@ pub fn diagnose_csv(
     source: String,
     motor_source: String,
     exact_cv: bool,
+    plausible: Vec<String>,
 ) -> PyResult<(String, Vec<String>)> {
     let m = motor.get().inner.clone();
+    let mut ranges = PlausibleRanges::default();
+    for spec in &plausible {
+        ranges.parse_assignment(spec).map_err(|e| input_err(py, format!("plausible '{spec}': {e}")))?;
+    }
     let out = detached(py, move || -> Result<(String, Vec<String>), String> {
-        let meas = parse_measurements(&data, &source).map_err(|e| e.to_string())?;
+        let meas = parse_measurements_with(&data, &source, &ranges).map_err(|e| e.to_string())?;
         let bench = observations(&meas, &m);
         let opts = DiagnoseOptions { exact_cv, ..DiagnoseOptions::default() };
         let d =

@@ -155,5 +155,10 @@ def test_matches_cli_point_json(motor):
 
 def test_huge_broadcast_is_memory_error_not_crash(motor):
     big = np.broadcast_to(np.array(200.0), (2**24, 1))
+    tq = np.broadcast_to(np.array(0.1), (1, 2**24))
+    # refused by the size guard, naming the limit, before anything is allocated
+    with pytest.raises(trum.InputError, match="281474976710656 points.*max_points"):
+        motor.solve(preload_n=big, torque_nm=tq, **OP)
+    # with the guard lifted, the allocation itself fails cleanly
     with pytest.raises(MemoryError, match="solve in chunks"):
-        motor.solve(preload_n=big, torque_nm=np.broadcast_to(np.array(0.1), (1, 2**24)), **OP)
+        motor.solve(preload_n=big, torque_nm=tq, max_points=2**62, **OP)

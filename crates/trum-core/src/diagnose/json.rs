@@ -19,6 +19,67 @@ pub fn num(v: f64) -> Value {
     }
 }
 
+/// Largest finite double: what a figure that overflowed (an infinity) is reported as.
+pub const OVERFLOWED: f64 = f64::MAX;
+
+/// The note of a diagnosis whose figures overflowed.
+pub const NON_FINITE_NOTE: &str = "some of the diagnosis' figures are not finite numbers (readings of extreme \
+     magnitude overflow the sums of squares): no effect can be named from these data; the figures that \
+     overflowed are given as 1.7976931348623157e308, a not-a-number as 0 (evidence, shrink) or as that \
+     value (a gap); check the data's plausible ranges (docs/MEASUREMENTS.md)";
+
+/// A diagnosis with a non-finite figure of the spec (the held-out and noise gaps, a
+/// candidate's evidence, gap after or shrink) is no diagnosis: the figures
+/// rest on sums that overflowed, and the ranking built on them means nothing. Such a
+/// diagnosis gets the verdict `unexplained`, incomplete, nothing confounded, a note, and
+/// finite figures in their place, so that every number the spec requires is a number
+/// (JSON has no NaN or infinity, and `null` is not a number): an infinity becomes
+/// [`OVERFLOWED`] with its sign; a not-a-number becomes 0 for evidence and shrink (no
+/// support, nothing closed) and [`OVERFLOWED`] for a gap (unbounded). A diagnosis with
+/// finite figures is returned unchanged.
+pub fn guard_non_finite(mut d: Diagnosis) -> Diagnosis {
+    let gap = |v: &mut f64| -> bool {
+        let bad = !v.is_finite();
+        if bad {
+            *v = if *v == f64::NEG_INFINITY { -OVERFLOWED } else { OVERFLOWED };
+        }
+        bad
+    };
+    let score = |v: &mut f64| -> bool {
+        let bad = !v.is_finite();
+        if bad {
+            *v = if v.is_nan() { 0.0 } else { v.signum() * OVERFLOWED };
+        }
+        bad
+    };
+    // the spec's figures decide; the rest are made finite without deciding anything
+    let mut bad = false;
+    bad |= gap(&mut d.baseline_heldout_nrmse);
+    bad |= gap(&mut d.noise_nrmse);
+    gap(&mut d.noise_nrmse_weights);
+    gap(&mut d.baseline_heldout_chi2_per_reading);
+    for r in &mut d.ranking {
+        bad |= score(&mut r.evidence);
+        bad |= gap(&mut r.heldout_nrmse_after);
+        bad |= score(&mut r.shrink);
+        gap(&mut r.heldout_chi2_after);
+        score(&mut r.shrink_interval.0);
+        score(&mut r.shrink_interval.1);
+    }
+    for g in &mut d.gap_where {
+        gap(&mut g.mean_residual);
+        score(&mut g.z);
+    }
+    if bad {
+        d.verdict = "unexplained".into();
+        d.complete = false;
+        d.confounded_with.clear();
+        d.partial = None;
+        d.notes.push(NON_FINITE_NOTE.into());
+    }
+    d
+}
+
 /// Unit of a measured column (empty when dimensionless or unknown).
 pub fn unit(column: &str) -> &'static str {
     Column::from_name(column).map(|c| c.spec().unit).unwrap_or("")

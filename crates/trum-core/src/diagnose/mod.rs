@@ -289,7 +289,8 @@ pub fn diagnose(
     let (gap_where, where_note) = where_::locate(&ctx, &base);
     notes.extend(where_note);
     let heldout = held_out(&ctx.rows, &base.cv.preds, &fits.cv_preds, &verdict);
-    Ok(Diagnosis {
+    // (no verdict from figures that overflowed: json::guard_non_finite)
+    Ok(json::guard_non_finite(Diagnosis {
         verdict,
         complete,
         confounded_with: confounded,
@@ -307,7 +308,7 @@ pub fn diagnose(
         folds: ctx.k,
         baseline_params: base.cal.params.iter().map(|p| (p.name.clone(), p.value)).collect(),
         heldout,
-    })
+    }))
 }
 
 /// Every reading of `rows` with its baseline held-out prediction (`base_preds`) and the

@@ -68,6 +68,18 @@ pub enum MeasurementErrorKind {
         /// The invalid byte.
         byte: u8,
     },
+    /// The bytes are UTF-16 (a byte-order mark, or a zero byte beside every ASCII one).
+    #[error("the file is UTF-16{}, not UTF-8; save it as UTF-8 (in a spreadsheet: CSV UTF-8)", if *.little_endian { " (little-endian)" } else { " (big-endian)" })]
+    Utf16 {
+        /// Byte order.
+        little_endian: bool,
+    },
+    /// The header is one field holding another separator.
+    #[error("the header is one column holding '{separator}': the file looks separated by '{separator}' (a spreadsheet's regional setting?); measurement files are comma-separated, with '.' as the decimal point")]
+    WrongDelimiter {
+        /// The separator found (`;`, a tab, `|`).
+        separator: char,
+    },
     /// Nothing but blank lines (or nothing at all).
     #[error("no data rows: the file is empty; expected a header row and at least one measurement row")]
     EmptyFile,
@@ -155,6 +167,26 @@ pub enum MeasurementErrorKind {
         text: String,
         /// The parsed value.
         value: f64,
+    },
+    /// A number inside the column's range but outside its plausible range.
+    #[error(
+        "\"{text}\" is outside the plausible range of {} for a traveling-wave ultrasonic motor, {} \
+         (a typo, a unit slip or a bench fault?); if the value is real, give the column another \
+         plausible range (docs/MEASUREMENTS.md, \"Plausible ranges\")",
+        .column.spec().quantity,
+        super::plausible::describe(*.column, (*.low, *.high))
+    )]
+    Implausible {
+        /// The column.
+        column: Column,
+        /// The cell text as written.
+        text: String,
+        /// The parsed value.
+        value: f64,
+        /// Low end of the plausible range in force.
+        low: f64,
+        /// High end of the plausible range in force.
+        high: f64,
     },
     /// A `run_id` given to the builder that contains a line break.
     #[error("contains a line break; run ids must be one line")]

@@ -24,6 +24,7 @@
 mod builder;
 mod columns;
 mod error;
+mod plausible;
 mod read;
 mod write;
 
@@ -31,7 +32,8 @@ pub use builder::MeasurementsBuilder;
 use columns::Access;
 pub use columns::{Column, ColumnSpec, Range, ABSOLUTE_ZERO_C, COLUMNS};
 pub use error::{MeasurementError, MeasurementErrorKind, MisnameReason, NumberIssue};
-pub use read::parse_measurements;
+pub use plausible::PlausibleRanges;
+pub use read::{parse_measurements, parse_measurements_with};
 
 /// A header column that is not part of the layout, kept with its raw cells and otherwise
 /// ignored.

@@ -2,7 +2,7 @@
 
 use super::{
     Column, ColumnSpec, ExtraColumn, MeasurementError, MeasurementErrorKind, Measurements, MisnameReason, NumberIssue,
-    COLUMNS,
+    PlausibleRanges, COLUMNS,
 };
 
 /// One cell as tokenized: text (trimmed unless quoted) and whether it was quoted.
@@ -310,14 +310,29 @@ fn unit_suffix(spec: &ColumnSpec) -> &'static str {
 /// spelling (unless the right column is present too), a ragged row, an unterminated
 /// quote, an empty required cell, a numeric cell that is not a plain decimal (`nan`,
 /// `inf`, hex, text), and a value outside its column's range. The first problem in file
-/// order is reported. Never panics.
+/// order is reported. Never panics. Values must also lie in their column's default
+/// plausible range ([`super::ColumnSpec::plausible`]); [`parse_measurements_with`] takes
+/// other ranges.
 pub fn parse_measurements(bytes: &[u8], source: &str) -> Result<Measurements, MeasurementError> {
+    parse_measurements_with(bytes, source, &PlausibleRanges::default())
+}
+
+/// [`parse_measurements`] with the given plausible ranges (a value outside its column's
+/// range is an error naming its line and column).
+pub fn parse_measurements_with(
+    bytes: &[u8],
+    source: &str,
+    plausible: &PlausibleRanges,
+) -> Result<Measurements, MeasurementError> {
     let err = |line: Option<usize>, column: Option<String>, kind| MeasurementError {
         source_name: source.to_string(),
         line,
         column,
         kind,
     };
+    if let Some(little_endian) = utf16(bytes) {
+        return Err(err(Some(1), None, MeasurementErrorKind::Utf16 { little_endian }));
+    }
     let text = match std::str::from_utf8(bytes) {
         Ok(t) => t,
         Err(e) => {
@@ -337,18 +352,26 @@ pub fn parse_measurements(bytes: &[u8], source: &str) -> Result<Measurements, Me
     let names: Vec<String> = header.fields.into_iter().map(|f| f.text).collect();
     let at_header = |column: Option<&str>, kind| err(Some(header_line), column.map(str::to_string), kind);
 
-    // Header checks, in order: data instead of a header, empty names, duplicates,
-    // misnamed quantities, missing required columns.
+    // Header checks, in order: another separator, data instead of a header, empty names,
+    // duplicates, misnamed quantities, missing required columns.
+    if let [only] = names.as_slice() {
+        if let Some(separator) = [';', '\t', '|'].into_iter().find(|c| only.contains(*c)) {
+            return Err(at_header(None, MeasurementErrorKind::WrongDelimiter { separator }));
+        }
+    }
     if names.iter().all(|n| parse_number(n).is_ok()) {
         return Err(at_header(None, MeasurementErrorKind::NoHeader));
     }
     if let Some(i) = names.iter().position(String::is_empty) {
         return Err(at_header(None, MeasurementErrorKind::EmptyColumnName { field: i + 1 }));
     }
+    // (a map: a header of 10^4 names is checked in linear time)
+    let mut first_at: std::collections::HashMap<&str, usize> = std::collections::HashMap::with_capacity(names.len());
     for (j, n) in names.iter().enumerate() {
-        if let Some(i) = names[..j].iter().position(|m| m == n) {
+        if let Some(&i) = first_at.get(n.as_str()) {
             return Err(at_header(Some(n), MeasurementErrorKind::DuplicateColumn { first: i + 1, second: j + 1 }));
         }
+        first_at.insert(n, j);
     }
     let known: Vec<Option<Column>> = names.iter().map(|n| Column::from_name(n)).collect();
     for (n, k) in names.iter().zip(&known) {
@@ -379,7 +402,11 @@ pub fn parse_measurements(bytes: &[u8], source: &str) -> Result<Measurements, Me
         }
     }
     if !unknown.is_empty() {
-        let list: Vec<String> = unknown.iter().map(|&i| format!("'{}'", names[i])).collect();
+        // the first ten by name, then a count: a warning stays one readable line
+        let mut list: Vec<String> = unknown.iter().take(10).map(|&i| format!("'{}'", names[i])).collect();
+        if unknown.len() > 10 {
+            list.push(format!("and {} more", unknown.len() - 10));
+        }
         let plural = if unknown.len() == 1 { "" } else { "s" };
         m.warnings.push(format!(
             "{source}: line {header_line}: ignoring unknown column{plural} {} (not part of the measurement layout)",
@@ -387,6 +414,11 @@ pub fn parse_measurements(bytes: &[u8], source: &str) -> Result<Measurements, Me
         ));
     }
 
+    // per header field, its place in `extra_columns` (unknown columns only)
+    let mut extra_of_field: Vec<Option<usize>> = vec![None; names.len()];
+    for (k, &i) in unknown.iter().enumerate() {
+        extra_of_field[i] = Some(k);
+    }
     loop {
         let record = match lexer.next_record() {
             Ok(Some(r)) => r,
@@ -405,10 +437,10 @@ pub fn parse_measurements(bytes: &[u8], source: &str) -> Result<Measurements, Me
                 MeasurementErrorKind::TooFewFields { found, expected: names.len() },
             ));
         }
-        for ((field, name), col) in record.fields.into_iter().zip(&names).zip(&known) {
+        for (f, ((field, name), col)) in record.fields.into_iter().zip(&names).zip(&known).enumerate() {
             let cell_err = |kind| err(Some(line), Some(name.clone()), kind);
             let Some(c) = *col else {
-                if let Some(x) = m.extra_columns.iter_mut().find(|x| &x.name == name) {
+                if let Some(x) = extra_of_field[f].and_then(|k| m.extra_columns.get_mut(k)) {
                     x.cells.push(field.text);
                 }
                 continue;
@@ -432,6 +464,16 @@ pub fn parse_measurements(bytes: &[u8], source: &str) -> Result<Measurements, Me
             if c.check(value).is_err() {
                 return Err(cell_err(MeasurementErrorKind::OutOfRange { column: c, text: text.to_string(), value }));
             }
+            if !plausible.contains(c, value) {
+                let (low, high) = plausible.get(c);
+                return Err(cell_err(MeasurementErrorKind::Implausible {
+                    column: c,
+                    text: text.to_string(),
+                    value,
+                    low,
+                    high,
+                }));
+            }
             m.push_value(c, Some(value));
         }
         m.lines.push(line);
@@ -440,6 +482,29 @@ pub fn parse_measurements(bytes: &[u8], source: &str) -> Result<Measurements, Me
         return Err(err(Some(header_line), None, MeasurementErrorKind::NoDataRows));
     }
     Ok(m)
+}
+
+/// `Some(little_endian)` when `bytes` look like UTF-16: a byte-order mark, or a zero in
+/// every other byte of the start (ASCII text in UTF-16), which UTF-8 text never has.
+fn utf16(bytes: &[u8]) -> Option<bool> {
+    match bytes {
+        [0xFF, 0xFE, ..] => return Some(true),
+        [0xFE, 0xFF, ..] => return Some(false),
+        _ => {}
+    }
+    let head = &bytes[..bytes.len().min(64) & !1];
+    if head.len() < 4 {
+        return None;
+    }
+    let zeros = |k: usize| head.iter().skip(k).step_by(2).all(|&b| b == 0);
+    let ascii = |k: usize| head.iter().skip(k).step_by(2).all(|&b| b != 0 && b < 0x80);
+    if zeros(1) && ascii(0) {
+        Some(true)
+    } else if zeros(0) && ascii(1) {
+        Some(false)
+    } else {
+        None
+    }
 }
 
 /// Line (1-based) and, when the header before it is intact, column of the first invalid

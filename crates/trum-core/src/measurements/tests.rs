@@ -14,12 +14,15 @@ fn good(name: &str) -> Measurements {
     parse_measurements(&bytes, name).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// The layout's checks alone (these tests use values such as 1 N and 3 Hz that the
+/// default plausible ranges refuse; `implausible_values_are_refused_with_line_and_column`
+/// tests those).
 fn parse_str(text: &str) -> Result<Measurements, MeasurementError> {
-    parse_measurements(text.as_bytes(), "t.csv")
+    parse_measurements_with(text.as_bytes(), "t.csv", &PlausibleRanges::unlimited())
 }
 
 fn message(text: &[u8]) -> String {
-    match parse_measurements(text, "t.csv") {
+    match parse_measurements_with(text, "t.csv", &PlausibleRanges::unlimited()) {
         Ok(m) => format!("parsed {} rows", m.len()),
         Err(e) => e.to_string(),
     }
@@ -80,7 +83,9 @@ fn round_trip_write_parse_identity() {
     assert!(m.has(Column::Efficiency) && m.efficiency == Some(vec![None; 4]));
     assert!(!m.has(Column::ElapsedS) || m.elapsed_s.as_ref().is_some_and(|v| v[0].is_none()));
     let text = m.to_csv_string();
-    let back = parse_measurements(text.as_bytes(), "synth.csv").unwrap_or_else(|e| panic!("{e}\n{text}"));
+    // (extreme values on purpose: the writer's number forms; so no plausibility check)
+    let back = parse_measurements_with(text.as_bytes(), "synth.csv", &PlausibleRanges::unlimited())
+        .unwrap_or_else(|e| panic!("{e}\n{text}"));
     assert_eq!(back, m, "{text}");
     assert_eq!(back.to_csv_string(), text);
     assert_eq!(back.run_id_at(0), Some("sweep, \"A\""));
@@ -429,4 +434,91 @@ fn never_panics_on_mutated_input() {
             }
         }
     }
+}
+
+#[test]
+fn implausible_values_are_refused_with_line_and_column() {
+    let head = "preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n250,150,42000,0,120\n";
+    for (row, column, text) in [
+        ("250,150,42000,0,1e5", "speed_rpm", "1e5"),
+        ("1e308,150,42000,0,120", "preload_n", "1e308"),
+        ("5e-324,150,42000,0,120", "preload_n", "5e-324"),
+        ("250,150,42,0,120", "frequency_hz", "42"),
+        ("250,150,42000,0,1e300", "speed_rpm", "1e300"),
+    ] {
+        let e = parse_measurements(format!("{head}{row}\n").as_bytes(), "t.csv")
+            .err()
+            .unwrap_or_else(|| panic!("{row} accepted"));
+        assert_eq!(e.line, Some(3), "{row}");
+        assert_eq!(e.column.as_deref(), Some(column), "{row}");
+        assert!(matches!(&e.kind, MeasurementErrorKind::Implausible { text: t, .. } if t == text), "{e}");
+        assert!(e.to_string().contains("outside the plausible range"), "{e}");
+        // lifted: read as written
+        let m = parse_measurements_with(format!("{head}{row}\n").as_bytes(), "t.csv", &PlausibleRanges::unlimited())
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(m.len(), 2);
+    }
+    // a wider range for one column only
+    let mut r = PlausibleRanges::default();
+    r.parse_assignment("speed_rpm=0:2e5").unwrap_or_else(|e| panic!("{e}"));
+    assert!(parse_measurements_with(format!("{head}250,150,42000,0,1e5\n").as_bytes(), "t.csv", &r).is_ok());
+    assert!(parse_measurements_with(format!("{head}1e308,150,42000,0,1\n").as_bytes(), "t.csv", &r).is_err());
+    // open ends and `any`
+    r.parse_assignment("preload_n=:").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(r.get(Column::PreloadN), (f64::NEG_INFINITY, f64::INFINITY));
+    r.parse_assignment("torque_nm = any").unwrap_or_else(|e| panic!("{e}"));
+    assert!(r.contains(Column::TorqueNm, 1e300));
+    for (bad, why) in [
+        ("speed", "expected COLUMN=LOW:HIGH"),
+        ("run_id=0:1", "not a numeric measurement column"),
+        ("speedrpm=0:1", "not a numeric measurement column"),
+        ("speed_rpm=5:1", "above the high end"),
+        ("speed_rpm=0:inf", "not a finite number"),
+        ("speed_rpm=10", "expected LOW:HIGH"),
+    ] {
+        let e = PlausibleRanges::default().parse_assignment(bad).err().unwrap_or_else(|| panic!("{bad} accepted"));
+        assert!(e.contains(why), "{bad}: {e}");
+    }
+    // every default range holds the spec's own example values and lies inside the layout's range
+    for c in COLUMNS.iter().filter(|c| c.column.is_numeric()) {
+        let (lo, hi) = c.plausible;
+        assert!(lo < hi && lo.is_finite() && hi.is_finite(), "{}", c.name);
+        assert!(c.column.check(hi).is_ok(), "{}", c.name);
+    }
+}
+
+#[test]
+fn another_delimiter_and_utf16_are_named() {
+    let e = message(b"preload_n;voltage_v;frequency_hz;torque_nm;speed_rpm\n250;150;42000;0;120\n");
+    assert!(e.contains("line 1") && e.contains("separated by ';'") && e.contains("comma-separated"), "{e}");
+    let e = message(b"preload_n\tvoltage_v\tfrequency_hz\ttorque_nm\tspeed_rpm\n250\t150\t42000\t0\t120\n");
+    assert!(e.contains("separated by '\t'"), "{e}");
+    let text = "preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n250,150,42000,0,120\n";
+    let le: Vec<u8> = text.encode_utf16().flat_map(u16::to_le_bytes).collect();
+    let be: Vec<u8> = text.encode_utf16().flat_map(u16::to_be_bytes).collect();
+    let with_bom: Vec<u8> = [0xFF, 0xFE].into_iter().chain(le.iter().copied()).collect();
+    for (bytes, endian) in [(&le, "little"), (&be, "big"), (&with_bom, "little")] {
+        let e = message(bytes);
+        assert!(e.contains(&format!("UTF-16 ({endian}-endian), not UTF-8")), "{e}");
+    }
+}
+
+#[test]
+fn ten_thousand_unknown_columns_give_one_short_warning_in_linear_time() {
+    let n = 10_000;
+    let mut head = String::from("preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm");
+    let mut row = String::from("250,150,42000,0,120");
+    for i in 0..n {
+        head += &format!(",x{i}");
+        row += ",1";
+    }
+    let text = format!("{head}\n{row}\n{row}\n");
+    let t0 = std::time::Instant::now();
+    let m = parse_str(&text).unwrap_or_else(|e| panic!("{e}"));
+    // quadratic handling took seconds at this size; linear takes milliseconds
+    assert!(t0.elapsed() < std::time::Duration::from_secs(1), "{:?}", t0.elapsed());
+    assert_eq!(m.extra_columns.len(), n);
+    assert_eq!(m.extra_columns[n - 1].cells, ["1", "1"]);
+    assert_eq!(m.warnings.len(), 1);
+    assert!(m.warnings[0].len() < 300 && m.warnings[0].contains("and 9990 more"), "{}", m.warnings[0]);
 }

@@ -403,6 +403,7 @@ pub(super) fn solve_drive_below(
     let rtol = amplitude_rtol(p);
     // Upper bound: |Z| ≥ ω·c, so W' ≤ Θ·V/(ω·c).
     let w_hi0 = p.theta * d.v / (d.omega * d.c);
+    let floor = d.clamp_floor(p.theta);
     let mut trials = Trials::new(p, d, guess, top.as_ref());
     let (warm_trial, below) = match top {
         Some(wt) => {
@@ -464,7 +465,7 @@ pub(super) fn solve_drive_below(
         } else {
             lo = Some(cur);
         }
-        if cur.w < 1e-9 * w_hi0 && r > 0.0 && lo.is_none() {
+        if cur.w < floor && r > 0.0 && lo.is_none() {
             // Descending towards zero with W' < W: the only fixed point is W = 0 (clamped).
             break;
         }
@@ -490,7 +491,7 @@ pub(super) fn solve_drive_below(
     }
     let evals = trials.evals;
     if !converged {
-        if cur.w < 1e-9 * w_hi0 {
+        if cur.w < floor {
             return finish(p, d, op, &clamped_trial(p, d), Status::Clamped, evals);
         }
         let mut s = finish(p, d, op, &cur, Status::NoConvergence, evals);

@@ -270,7 +270,7 @@ fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f6
                 |d: &Drive, _: f64, _: Option<&Solution>| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0);
             let (c, _, settled) = settle(p, op, Some(&low), (false, true), rise, &rest);
             let d = at(c.electrode_voltage_v);
-            let tiny = 1e-9 * p.theta * d.v / (d.omega * d.c);
+            let tiny = d.clamp_floor(p.theta);
             let t = trial(p, &d, tiny, None, None);
             if t.w >= t.w_next {
                 return (settled && c.status == Status::Clamped).then_some(c);
@@ -354,7 +354,7 @@ fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<S
     if h_hi.is_nan() || h_hi <= 0.0 {
         return None;
     }
-    let tiny = 1e-9 * bound;
+    let tiny = d.clamp_floor(p.theta);
     let mut lo = None;
     // the sample above `hi`, once there is one
     let mut above: Option<(f64, f64)> = None;

@@ -76,7 +76,26 @@ pub(crate) struct Drive {
     pub(crate) c: f64,
 }
 
+/// Quality factor k/(ω·c) above which the material damping no longer sets the amplitude
+/// scale of [`Drive::clamp_floor`]: no stator reaches it (bronze and steel stators with
+/// bonded piezoceramics: Q of 50 to a few thousand), and there the friction at the contact
+/// limits the amplitude instead.
+const FLOOR_Q_MAX: f64 = 1e5;
+
 impl Drive {
+    /// The amplitude [m] below which a descent towards zero is taken as the clamped
+    /// stator (W = 0), and at which a clamped state is probed for starting: 1e-9 of the
+    /// amplitude scale Θ·V/(ω·c), the undamped bound, but never of more than
+    /// [`FLOOR_Q_MAX`] times the static deflection Θ·V/k. Relative to the bound alone
+    /// the floor grew without limit as the damping fell (c = 1e-7 N·s/m at generic60
+    /// put it at 4 µm, above the running amplitude of 1 µm, and every point clamped),
+    /// though the friction keeps the amplitude finite at any damping.
+    pub(crate) fn clamp_floor(&self, theta: f64) -> f64 {
+        let bound = theta * self.v / (self.omega * self.c);
+        let static_deflection = theta * self.v / self.ks.abs();
+        1e-9 * bound.min(FLOOR_Q_MAX * static_deflection)
+    }
+
     /// The drive as set at `op`, before any effect acts on it.
     pub(crate) fn at(p: &Prepared, op: &OperatingPoint) -> Drive {
         Drive {

@@ -9,7 +9,7 @@ import numpy as np
 from . import _axes, _plot, _trum
 from ._axes import Values
 from ._errors import InputError
-from ._motor import Motor
+from ._motor import Motor, _max_points
 from ._registry import QUANTITY_NAMES, STATUS_NAMES, quantities
 from ._result import _require_pandas
 
@@ -226,6 +226,7 @@ def map(  # noqa: A001 - the CLI's name for it
     }
     for name in _trum.AXES:
         _check_axis(name, ax[name])
+    max_points = _max_points(max_points)
     n = int(np.prod([a.size for a in ax.values()], dtype=np.int64))
     if n > max_points:
         raise InputError(f"the map has {n} points, more than max_points = {max_points}; split it or raise max_points")

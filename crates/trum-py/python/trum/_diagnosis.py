@@ -4,7 +4,7 @@ from __future__ import annotations
 import json
 import os
 import warnings
-from typing import Any, Dict, List, Tuple, Union
+from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
 
 import numpy as np
 
@@ -20,9 +20,13 @@ DataLike = Union[str, "os.PathLike[str]", bytes, Any]
 
 def _read_data(data: DataLike) -> Tuple[bytes, str]:
     """The bytes of a measurement CSV and the name messages give it: a path, the file's
-    bytes, an open file (text or binary) or a pandas DataFrame (its columns as the CSV's)."""
+    bytes, its text, an open file (text or binary) or a pandas DataFrame (its columns as the
+    CSV's)."""
     if isinstance(data, (bytes, bytearray)):
         return bytes(data), "<bytes>"
+    if isinstance(data, str) and ("\n" in data or "\r" in data):
+        # CSV text rather than a path (no file name has a line break)
+        return data.encode("utf-8"), "<text>"
     if isinstance(data, (str, os.PathLike)):
         source = os.fspath(data)
         if os.path.isdir(source):
@@ -43,7 +47,22 @@ def _read_data(data: DataLike) -> Tuple[bytes, str]:
         name = getattr(data, "name", None)
         source = name if isinstance(name, str) else "<file>"
         return (raw.encode("utf-8") if isinstance(raw, str) else bytes(raw)), source
-    raise TypeError(f"data: expected a path, bytes, an open file or a pandas DataFrame, got {type(data).__name__}")
+    raise TypeError(
+        f"data: expected a measurement file's path, bytes or text, an open file or a pandas DataFrame, "
+        f"got {type(data).__name__}"
+    )
+
+
+def _plausible_specs(plausible: Optional[Mapping[str, Any]]) -> List[str]:
+    """``{"speed_rpm": (0, 2e4), "preload_n": None}`` as the CLI's ``--plausible`` specs."""
+    specs = []
+    for col, rng in (plausible or {}).items():
+        if rng is None:
+            specs.append(f"{col}=any")
+        else:
+            lo, hi = rng
+            specs.append(f"{col}={'' if lo is None else repr(float(lo))}:{'' if hi is None else repr(float(hi))}")
+    return specs
 
 
 class Diagnosis(dict):
@@ -124,24 +143,30 @@ def diagnose(
     data: DataLike,
     *,
     exact_cv: bool = False,
+    plausible: Optional[Mapping[str, Any]] = None,
 ) -> Diagnosis:
     """Where the calibrated baseline misses the measurements, which unmodelled effect
     causes it, and how far the held-out gap shrinks once it is added.
 
     ``motor`` is the nominal motor (a ``trum.Motor`` or a preset name); ``data`` a
-    measurement table in the layout of docs/MEASUREMENTS.md: a path, the file's bytes, an
-    open file or a pandas DataFrame with those columns. Returns the JSON document of
+    measurement table in the layout of docs/MEASUREMENTS.md: a path, the file's bytes or
+    text, an open file or a pandas DataFrame with those columns. Returns the JSON document of
     ``trum diagnose --json`` as a :class:`Diagnosis` (a dict: ``verdict``,
     ``confounded_with``, ``partial``, ``gap``, ``ranking``, ``notes``, ...; every field in
     docs/DIAGNOSIS_JSON.md, the method in docs/DIAGNOSIS.md), with ``to_pandas()`` and
     ``plot()``. Columns the reader ignores are reported with ``warnings.warn``. A bad file,
     or data that cannot support a held-out test, raises ``trum.InputError`` naming the
     file, line and column. The GIL is released while it runs.
+
+    A value outside its column's plausible range (docs/MEASUREMENTS.md) is such an error;
+    ``plausible={"speed_rpm": (0, 2e4), "preload_n": None}`` replaces ranges when the
+    values are real (``None`` for no bound at all; ``None`` at either end of a pair for
+    no bound there).
     """
     m = _motor(motor)
     raw, source = _read_data(data)
     motor_source = motor if isinstance(motor, str) else (m.preset or m.name)
-    text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv))
+    text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv), _plausible_specs(plausible))
     for w in notes:
         warnings.warn(w, stacklevel=2)
     return Diagnosis(json.loads(text))

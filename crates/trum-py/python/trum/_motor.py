@@ -1,6 +1,7 @@
 """``trum.Motor``: presets, TOML files and dicts of unit-suffixed keys; vectorised solve."""
 from __future__ import annotations
 
+import math
 import numbers
 import os
 from typing import Any, Dict, Iterable, List, Mapping, Optional, Tuple, Union
@@ -61,12 +62,29 @@ def _flatten(d: Mapping[str, Any], prefix: str = "") -> Iterable[Tuple[str, Any]
 
 
 def _as_f64(name: str, x: ArrayLike) -> np.ndarray:
+    if isinstance(x, np.ma.MaskedArray):
+        # A masked entry has no value to solve; NaN makes it an invalid point (status
+        # ``invalid_input``) instead of solving whatever the mask hides.
+        x = np.ma.filled(np.ma.asarray(x, dtype=np.float64), np.nan)
     a = np.asarray(x)
     if a.dtype.kind not in "iuf":
         raise InputError(f"{name}: expected real numbers, got an array of dtype {a.dtype}")
     if a.dtype != np.float64 or not a.dtype.isnative:
         a = a.astype(np.float64)  # the only copy: integer/float32/byte-swapped input
     return a
+
+
+#: Memory of one solved point in a ``Result`` (every quantity as float64, status, inputs).
+_BYTES_PER_POINT = 485
+
+
+def _max_points(max_points: object) -> int:
+    """``max_points`` as a whole number >= 1, else ``ValueError`` naming it."""
+    if isinstance(max_points, bool) or not isinstance(max_points, (int, np.integer)):
+        raise ValueError(f"max_points must be a whole number >= 1, got {max_points!r}")
+    if max_points < 1:
+        raise ValueError(f"max_points must be a whole number >= 1, got {max_points}")
+    return int(max_points)
 
 
 class Motor:
@@ -112,9 +130,13 @@ class Motor:
             raw = f.read()
         try:
             text = raw.decode("utf-8")
-        except UnicodeDecodeError:
+        except UnicodeDecodeError as e:
             # same words as the CLI
-            raise TrumError(f"cannot read motor file '{os.fspath(path)}': stream did not contain valid UTF-8") from None
+            line = 1 + raw[: e.start].count(b"\n")
+            raise TrumError(
+                f"{os.fspath(path)}: line {line}: byte 0x{raw[e.start]:02X} at offset {e.start} "
+                "is not valid UTF-8; save the file as UTF-8"
+            ) from None
         return cls.from_toml_str(text, os.fspath(path))
 
     @classmethod
@@ -252,6 +274,7 @@ class Motor:
         torque_nm: ArrayLike = 0.0,
         elapsed_s: ArrayLike = 0.0,
         parallel: Optional[bool] = None,
+        max_points: int = 20_000_000,
     ) -> Result:
         """Solves every operating point of the broadcast inputs (NumPy rules).
 
@@ -260,13 +283,19 @@ class Motor:
         bitwise whatever the array's size, chunking or process. Invalid points
         (e.g. a negative preload) do not raise: they get NaN and status
         ``invalid_input`` with ``Result.reason``. ``parallel=None`` uses all cores from
-        4096 points on. The GIL is released while solving.
+        4096 points on. The GIL is released while solving. A masked array's masked
+        entries are invalid points (NaN in, ``invalid_input`` out).
+
+        ``max_points`` bounds the broadcast size (each point's result takes about 485
+        bytes): a larger broadcast raises ``InputError`` with its shape and estimated
+        memory before anything is allocated; split it, or raise ``max_points``.
 
         Without ``voltage_v``/``frequency_hz`` the motor's drive is used (``Motor.drive``:
         its ``[drive]`` table or its preset's, else 200 V and 43 kHz), as the CLI does. A
         pandas Series input lends its index to ``Result.to_pandas()`` when the result is
         1-D and of its length.
         """
+        limit = _max_points(max_points)
         v0, f0 = self.drive or (200.0, 43e3)
         voltage_v = v0 if voltage_v is None else voltage_v
         frequency_hz = f0 if frequency_hz is None else frequency_hz
@@ -282,6 +311,18 @@ class Motor:
             "frequency_hz": _as_f64("frequency_hz", frequency_hz),
             "elapsed_s": _as_f64("elapsed_s", elapsed_s),
         }
+        try:
+            shape = np.broadcast_shapes(*(v.shape for v in ins.values()))
+        except ValueError:
+            shape = None  # the solver names the axes that do not broadcast
+        if shape is not None:
+            n = math.prod(shape)
+            if n > limit:
+                raise InputError(
+                    f"the broadcast inputs have {n} points (shape {shape}): about "
+                    f"{n * _BYTES_PER_POINT / 1e9:.1f} GB of results; more than max_points = {limit}; "
+                    "solve them in pieces, or raise max_points"
+                )
         data = _trum.solve_arrays(self._m, *ins.values(), parallel=parallel)
         res = Result(data, ins)
         if index is not None and len(res.shape) == 1 and res.shape[0] == len(index):

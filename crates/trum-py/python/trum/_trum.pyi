@@ -114,6 +114,11 @@ def step(
     snapshot_at_s: Sequence[float],
 ) -> Dict[str, Any]: ...
 def diagnose_csv(
-    motor: Motor, data: bytes, source: str, motor_source: str, exact_cv: bool = False
+    motor: Motor,
+    data: bytes,
+    source: str,
+    motor_source: str,
+    exact_cv: bool = False,
+    plausible: List[str] = ...,
 ) -> Tuple[str, List[str]]: ...
 def calibrate_csv(motor: Motor, data: bytes, source: str) -> Dict[str, Any]: ...

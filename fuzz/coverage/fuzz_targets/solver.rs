@@ -1,0 +1,73 @@
+//! The solver on a motor (a preset with up to four parameters overridden, effects on)
+//! and an operating point decoded from the bytes: values either raw f64 bits (NaN and
+//! infinities included) or a nominal value times 10^(-8..8). Properties: no panic; an
+//! invalid operating point gives `invalid_input`; for a motor that validates, a valid
+//! status has every quantity finite and the efficiency in [0, 1].
+#![no_main]
+use libfuzzer_sys::fuzz_target;
+use trum_core::effects::ALL as ALL_EFFECTS;
+use trum_core::quantities::QUANTITIES;
+use trum_core::{presets, solve, Motor, OperatingPoint, Status};
+
+struct Bytes<'a>(&'a [u8]);
+
+impl Bytes<'_> {
+    fn byte(&mut self) -> u8 {
+        let (b, rest) = self.0.split_first().map_or((0, &[][..]), |(b, r)| (*b, r));
+        self.0 = rest;
+        b
+    }
+    /// Raw bits (odd tag) or `nominal` × 10^((b − 128)/16).
+    fn value(&mut self, nominal: f64) -> f64 {
+        let tag = self.byte();
+        if tag & 1 == 1 && self.0.len() >= 8 {
+            let mut a = [0u8; 8];
+            a.copy_from_slice(&self.0[..8]);
+            self.0 = &self.0[8..];
+            f64::from_le_bytes(a)
+        } else {
+            nominal * 10f64.powf((f64::from(self.byte()) - 128.0) / 16.0)
+        }
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    let mut b = Bytes(data);
+    let preset = &presets::PRESETS[usize::from(b.byte()) % presets::PRESETS.len()];
+    let mut m: Motor = preset.motor();
+    let keys: Vec<String> = Motor::all_keys().iter().map(|k| format!("{}.{}", k.section, k.key)).collect();
+    for _ in 0..usize::from(b.byte() % 5) {
+        let key = &keys[usize::from(b.byte()) % keys.len()];
+        let nominal = m.param(key).unwrap_or(1.0);
+        let v = b.value(nominal);
+        if let Some(p) = m.param_mut(key) {
+            *p = v;
+        }
+    }
+    let fx = b.byte();
+    for (i, e) in ALL_EFFECTS.iter().enumerate() {
+        if fx & (1 << i) != 0 {
+            let typical: Vec<f64> =
+                e.info().params.iter().map(|p| p.typical * 10f64.powf((f64::from(b.byte()) - 128.0) / 64.0)).collect();
+            m.effects.set(*e, &typical);
+        }
+    }
+    let op = OperatingPoint {
+        preload_n: b.value(250.0),
+        torque_nm: b.value(0.1).abs() * if b.byte() < 16 { -1.0 } else { 1.0 },
+        voltage_v: b.value(200.0),
+        frequency_hz: b.value(43_000.0),
+        elapsed_s: if b.byte() < 128 { 0.0 } else { b.value(60.0) },
+    };
+    let valid_motor = m.validate("fuzz", None).is_ok();
+    let s = solve(&m, &op);
+    if op.invalid_reason().is_some() {
+        assert_eq!(s.status, Status::InvalidInput, "{op:?}");
+    }
+    if valid_motor && s.status.is_valid() {
+        for q in QUANTITIES.iter() {
+            assert!((q.get)(&s).is_finite(), "{} = {} at {op:?}, {m:?}", q.name, (q.get)(&s));
+        }
+        assert!((0.0..=1.0).contains(&s.efficiency), "{}", s.efficiency);
+    }
+});
