@@ -129,7 +129,7 @@ fn map_columns_rows_and_defaults() {
     let o = out.to_str().unwrap_or_default();
     ok(&["map", "--motor", "trum60a", "--preload-n", "100:300:3", "--torque-nm", "0:1.5:4", "-o", o, "-q"]);
     let (h, rows) = parse_csv(&std::fs::read_to_string(&out).expect("map written"));
-    let mut want = vec!["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status"];
+    let mut want = vec!["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status", "warnings"];
     want.extend(trum_core::quantities::QUANTITIES.iter().map(|q| q.name));
     assert_eq!(h, want);
     assert_eq!(rows.len(), 12);
@@ -137,12 +137,15 @@ fn map_columns_rows_and_defaults() {
     assert_eq!(&rows[1][..4], ["100", "0.5", "200", "43000"]);
     assert_eq!(&rows[11][..2], ["300", "1.5"]);
     // numbers are Rust's shortest round-trip form
-    let speed: f64 = rows[0][5].parse().expect("number");
-    assert_eq!(format!("{speed}"), rows[0][5]);
+    let speed: f64 = rows[0][6].parse().expect("number");
+    assert_eq!(format!("{speed}"), rows[0][6]);
 
     let sel = ok(&["map", "--motor", "generic60", "--columns", "speed_rpm,efficiency", "-o", "-"]);
     let (h, rows) = parse_csv(&sel);
-    assert_eq!(h, ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status", "speed_rpm", "efficiency"]);
+    assert_eq!(
+        h,
+        ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status", "warnings", "speed_rpm", "efficiency"]
+    );
     assert_eq!(rows.len(), 1);
     assert_eq!(&rows[0][..4], ["250", "0", "200", "43000"]);
 }
@@ -382,10 +385,20 @@ fn optimize_table_and_summary() {
     ]);
     assert!(out.contains("optimum preload") && out.contains("260-320 N"), "{out}");
     let (h, rows) = parse_csv(&std::fs::read_to_string(&csv_path).expect("csv"));
-    assert_eq!(h.len(), 10);
+    assert_eq!(h.len(), 11);
     assert_eq!(h[0], "preload_n");
     assert_eq!(h[9], "in_region");
+    assert_eq!(h[10], "warnings");
     assert_eq!(rows.len(), 7);
+    // at the paper's drive every candidate is within the preset's limits
+    assert!(rows.iter().all(|r| r[10].is_empty()), "{rows:?}");
+    assert!(!out.contains("[limits]"), "{out}");
+    // a voltage cap below the drive: every candidate flagged, and the summary says so
+    let capped = dir.path().join("capped.toml");
+    std::fs::write(&capped, "preset = \"trum60a\"\n[limits]\nmax_voltage_v = 150\n").expect("write");
+    let out = ok(&["optimize", "--motor", capped.to_str().unwrap_or_default(), "--preload-n", "150:450:4"]);
+    assert!(out.contains("every running candidate exceeds the motor's [limits]"), "{out}");
+    assert!(out.contains("max_voltage_v"), "{out}");
     let g = ok(&["optimize", "--motor", "generic60", "--preload-n", "150:450:4"]);
     assert!(!g.contains("260-320"), "{g}");
 }

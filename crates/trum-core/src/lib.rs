@@ -32,6 +32,7 @@ pub mod fluctuation;
 mod golden;
 pub mod interface;
 pub mod layout;
+pub mod limits;
 pub mod losses;
 pub mod measurements;
 pub mod noise;

@@ -347,6 +347,8 @@ fn solve_arrays<'py>(
     }
     let codes = Array::from_shape_vec(IxDyn(&shape), out.status).map_err(|e| PyValueError::new_err(e.to_string()))?;
     d.set_item("status_code", PyArray::from_owned_array(py, codes))?;
+    let warn = Array::from_shape_vec(IxDyn(&shape), out.warnings).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    d.set_item("warning_code", PyArray::from_owned_array(py, warn))?;
     d.set_item("reasons", reasons)?;
     Ok(d)
 }
@@ -362,8 +364,8 @@ fn axis(py: Python<'_>, name: &str, spec: (f64, f64, i64)) -> PyResult<Axis> {
 /// Full-factorial map over the grid axes `AXES` (preload, torque, voltage, frequency;
 /// points run torque fastest, then frequency, voltage, preload), solved as `trum map`
 /// solves it. Each axis is `(start, stop, n)`; the grid is checked as the CLI checks it.
-/// Returns a dict of flat columns: the four inputs, every quantity, `status_code` and
-/// `reasons`.
+/// Returns a dict of flat columns: the four inputs, every quantity, `status_code`,
+/// `warning_code` (bit i: `LIMIT_KEYS[i]` exceeded) and `reasons`.
 #[pyfunction]
 #[pyo3(signature = (motor, preload_n, torque_nm, voltage_v, frequency_hz, max_points = 20_000_000, parallel = None))]
 #[allow(clippy::too_many_arguments)]
@@ -411,6 +413,7 @@ fn map_grid<'py>(
         d.set_item(q.name, PyArray::from_vec(py, v))?;
     }
     d.set_item("status_code", PyArray::from_vec(py, out.status))?;
+    d.set_item("warning_code", PyArray::from_vec(py, out.warnings))?;
     d.set_item("reasons", reasons)?;
     Ok(d)
 }
@@ -467,8 +470,10 @@ fn criterion<'py>(
     table.set_item("no_load_speed_rpm", PyArray::from_vec(py, col(|r| r.no_load_speed_rpm)))?;
     table.set_item("score", PyArray::from_vec(py, col(|r| r.score)))?;
     table.set_item("in_region", PyArray::from_vec(py, r.rows.iter().map(|r| r.in_region).collect::<Vec<bool>>()))?;
+    table.set_item("warnings", r.rows.iter().map(|r| r.warnings.to_string()).collect::<Vec<String>>())?;
     let d = PyDict::new(py);
     d.set_item("table", table)?;
+    d.set_item("within_limits", r.within_limits)?;
     d.set_item("optimum_preload_n", r.optimum_preload_n)?;
     d.set_item("region_n", r.region_n)?;
     let c = PyDict::new(py);
@@ -542,11 +547,13 @@ fn _trum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(quantities_list, m)?)?;
     m.add_function(wrap_pyfunction!(parameter_keys, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::hertz_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::hertz_motor_params, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::hertz_response, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::hertz_identify, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::step, m)?)?;
     m.add_function(wrap_pyfunction!(diagnosis::diagnose_csv, m)?)?;
     m.add("STATUS_NAMES", STATUS_NAMES.to_vec())?;
+    m.add("LIMIT_KEYS", trum_core::limits::LIMIT_KEYS.to_vec())?;
     m.add("INPUTS", vector::INPUTS.to_vec())?;
     m.add("AXES", AXES.to_vec())?;
     m.add("PARALLEL_MIN_POINTS", vector::PARALLEL_MIN_POINTS)?;

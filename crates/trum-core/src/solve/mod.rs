@@ -46,6 +46,7 @@ pub use prepared::Prepared;
 pub(crate) use trial::Trial;
 pub(crate) use warm_start::{solve_in_sweep, SweepPoint, SWEEP_HISTORY};
 
+use crate::limits::LimitWarnings;
 use crate::params::Motor;
 use std::f64::consts::PI;
 
@@ -214,6 +215,9 @@ pub struct Solution {
     pub temperature_rise_at_elapsed_k: f64,
     /// Standard deviation of speed over a revolution [rev/min] (nonzero with `eccentricity`).
     pub speed_std_rpm: f64,
+    /// The motor's `[limits]` this point exceeds ([`crate::limits`]); empty when it is
+    /// inside all of them. Never changes the status or the numbers.
+    pub warnings: LimitWarnings,
 }
 
 impl Solution {
@@ -259,6 +263,7 @@ impl Solution {
             temperature_rise_k: n,
             temperature_rise_at_elapsed_k: n,
             speed_std_rpm: n,
+            warnings: LimitWarnings::NONE,
         }
     }
 }
@@ -289,7 +294,14 @@ pub(crate) fn solve_prepared_with(
         return Solution::invalid(Status::InvalidInput);
     }
     let s = if p.runout_m > 0.0 { eccentric_average_with(p, motor, op, guess, solve_at) } else { solve_at(op, guess) };
-    finite_or_unconverged(p, s)
+    with_warnings(motor, op, finite_or_unconverged(p, s))
+}
+
+/// `s` with the warnings of the motor's `[limits]` it exceeds (every public solve path
+/// ends here).
+pub(crate) fn with_warnings(motor: &Motor, op: &OperatingPoint, mut s: Solution) -> Solution {
+    s.warnings = motor.limits.check_point(motor.thermal.ambient_c, op, &s);
+    s
 }
 
 /// Every path (averaged and linearised ones too): non-finite numbers never carry a valid

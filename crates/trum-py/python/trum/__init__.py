@@ -10,6 +10,7 @@ SI units everywhere; every name carries its unit (``speed_rpm``, ``preload_n``).
 """
 from ._errors import InputError, ParameterError, ParameterKeyError, TrumError
 from ._registry import (
+    LIMIT_KEYS,
     QUANTITY_NAMES,
     STATUS_NAMES,
     EffectInfo,
@@ -68,6 +69,7 @@ __all__ = [
     "ParameterInfo",
     "STATUS_NAMES",
     "QUANTITY_NAMES",
+    "LIMIT_KEYS",
     "TrumError",
     "ParameterError",
     "ParameterKeyError",

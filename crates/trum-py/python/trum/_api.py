@@ -10,7 +10,7 @@ import numpy as np
 from . import _trum
 from ._errors import InputError
 from ._motor import Motor
-from ._registry import QUANTITY_NAMES, STATUS_NAMES
+from ._registry import QUANTITY_NAMES, STATUS_NAMES, warning_words
 from ._result import _require_pandas
 
 AxisSpec = Union[float, Tuple[float, float, int]]
@@ -51,7 +51,8 @@ def map(  # noqa: A001 - the CLI's name for it
     computes it. Each axis is a value or ``(start, stop, n)``; every point must be a valid
     operating point (preload, voltage, frequency > 0, torque >= 0), else ``InputError``
     names the axis. Returns flat columns ``{preload_n, torque_nm, voltage_v, frequency_hz,
-    status, <quantities>}`` ready for
+    status, warnings, <quantities>}`` (``warnings``: the motor's ``[limits]`` keys a point
+    exceeds, ``;``-joined, "" when none, as ``trum map`` writes them) ready for
     ``pandas.DataFrame``; points run torque fastest, then frequency, voltage, preload.
     Points are warm-started from their predecessors in the same fixed chunks as
     ``trum map``, so the numbers are the CLI's, equal to ``Motor.solve`` within the solver
@@ -68,6 +69,7 @@ def map(  # noqa: A001 - the CLI's name for it
     )
     out: Dict[str, np.ndarray] = {k: d[k] for k in _trum.AXES}
     out["status"] = _STATUS[d["status_code"]]
+    out["warnings"] = warning_words(d["warning_code"])
     out.update({q: d[q] for q in QUANTITY_NAMES})
     return out
 
@@ -80,6 +82,9 @@ class Optimum:
     optimum_preload_n: float
     region_n: Tuple[float, float]
     config: Dict[str, Any] = field(default_factory=dict)
+    #: True when the optimum was chosen among the candidates within the motor's
+    #: ``[limits]`` (the ``warnings`` column); False when none is within them.
+    within_limits: bool = True
 
     def to_pandas(self) -> Any:
         """The table as a DataFrame."""
@@ -106,7 +111,8 @@ def optimize(
     each scaled to [0, 1] and combined with ``weights`` (stall_torque, efficiency,
     temperature_rise, speed_fluctuation — a 4-sequence or a dict with those names).
     Unset settings take the core defaults (200 V, 43 kHz, 150-500 N in 36 steps,
-    weights 1, 1, 2, 2).
+    weights 1, 1, 2, 2). Candidates beyond the motor's ``[limits]`` (``warnings`` column)
+    are scored but kept out of the optimum and its region, as in ``trum optimize``.
     """
     w: Optional[list] = None
     if isinstance(weights, Mapping):
@@ -134,6 +140,7 @@ def optimize(
     )
     table = dict(d["table"])
     table["status"] = np.array(table["status"])
+    table["warnings"] = np.array(table["warnings"], dtype=object)
     cfg = dict(d["config"])
     cfg["weights"] = dict(zip(WEIGHT_NAMES, cfg["weights"]))
-    return Optimum(table, d["optimum_preload_n"], tuple(d["region_n"]), cfg)
+    return Optimum(table, d["optimum_preload_n"], tuple(d["region_n"]), cfg, bool(d["within_limits"]))

@@ -7,6 +7,7 @@ import numpy.typing as npt
 
 __version__: str
 STATUS_NAMES: List[str]
+LIMIT_KEYS: List[str]
 INPUTS: List[str]
 AXES: List[str]
 PARALLEL_MIN_POINTS: int
@@ -79,6 +80,7 @@ def effects_list() -> List[Tuple[str, str, str, List[Tuple[str, str, float, floa
 def quantities_list() -> List[Tuple[str, str, str]]: ...
 def parameter_keys() -> List[Tuple[str, str]]: ...
 def hertz_defaults() -> List[Tuple[str, float]]: ...
+def hertz_motor_params(motor: Motor) -> List[Tuple[str, float]]: ...
 def hertz_response(
     params: Sequence[Tuple[str, float]],
     voltage_v: Sequence[float],
