@@ -28,6 +28,7 @@ pub mod diagnose;
 pub mod dynamics;
 pub mod effects;
 pub mod error;
+pub mod estimate;
 pub mod fluctuation;
 mod golden;
 pub mod interface;

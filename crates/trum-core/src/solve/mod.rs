@@ -29,6 +29,7 @@
 //! The contact interface laws live in [`crate::interface`], the W-dependent modal
 //! stiffness in [`crate::stator`].
 
+mod at_amplitude;
 pub(crate) mod bracket;
 mod branches;
 mod descent;
@@ -39,6 +40,7 @@ mod prepared;
 pub(crate) mod trial;
 mod warm_start;
 
+pub use at_amplitude::solve_at_amplitude;
 pub use branches::{amplitude_branches, jump_frequencies_hz, AmplitudeBranch};
 pub(crate) use eccentric::eccentric_average_with;
 pub(crate) use fixed_points::{iterated, solve_clamped, solve_effects, state_map};
