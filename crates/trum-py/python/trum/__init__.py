@@ -28,6 +28,7 @@ from ._result import Result
 from ._motor import Motor
 from ._api import Optimum, map, optimize
 from ._diagnosis import diagnose
+from ._estimate import ESTIMATE_COLUMNS, ESTIMATE_STATUS_NAMES, estimate
 from ._dynamics import (
     HertzIdentification,
     Resonance,
@@ -51,6 +52,9 @@ __all__ = [
     "identify_hertz",
     "step",
     "diagnose",
+    "estimate",
+    "ESTIMATE_COLUMNS",
+    "ESTIMATE_STATUS_NAMES",
     "hertz_defaults",
     "Resonance",
     "ResonanceCurve",

@@ -8,6 +8,8 @@ import numpy.typing as npt
 __version__: str
 STATUS_NAMES: List[str]
 LIMIT_KEYS: List[str]
+ESTIMATE_STATUS_NAMES: List[str]
+ESTIMATE_COLUMNS: List[Tuple[str, str, str]]
 INPUTS: List[str]
 AXES: List[str]
 PARALLEL_MIN_POINTS: int
@@ -116,3 +118,13 @@ def step(
 def diagnose_csv(
     motor: Motor, data: bytes, source: str, motor_source: str, exact_cv: bool = False
 ) -> Tuple[str, List[str]]: ...
+
+def estimate_rows(
+    motor: Motor,
+    preload_n: Sequence[float],
+    voltage_v: Sequence[float],
+    frequency_hz: Sequence[float],
+    torque_nm: Sequence[float],
+    feedback_v: Sequence[float],
+    speed_rpm: Optional[Sequence[float]] = None,
+) -> Dict[str, Any]: ...
