@@ -117,6 +117,9 @@ pub struct PlotArgs {
 struct Data {
     names: Vec<String>,
     cols: Vec<Vec<f64>>,
+    /// Per row, whether the point is beyond one of the motor's `[limits]` (points solved
+    /// from a motor; `None` for a CSV).
+    beyond: Option<Vec<bool>>,
 }
 
 impl Data {
@@ -323,6 +326,7 @@ fn solve_grid(motor: &Motor, grid: &Grid) -> Data {
     let mut names: Vec<String> = ["preload_n", "torque_nm", "voltage_v", "frequency_hz"].map(String::from).to_vec();
     names.extend(QUANTITIES.iter().map(|q| q.name.to_string()));
     let mut cols = vec![Vec::with_capacity(total as usize); names.len()];
+    let beyond = chunks.iter().flatten().map(|(_, s)| !s.warnings.is_empty()).collect();
     for (op, s) in chunks.iter().flatten() {
         let valid = s.status.is_valid();
         let row = [op.preload_n, op.torque_nm, op.voltage_v, op.frequency_hz]
@@ -332,7 +336,7 @@ fn solve_grid(motor: &Motor, grid: &Grid) -> Data {
             c.push(v);
         }
     }
-    Data { names, cols }
+    Data { names, cols, beyond: Some(beyond) }
 }
 
 /// Reads the needed columns of a CSV; empty cells are missing values.
@@ -370,7 +374,7 @@ fn read_csv(path: &Path, needed: &[&str]) -> Result<Data> {
     if cols.first().is_none_or(|c| c.is_empty()) {
         bail!("{shown}: no data rows");
     }
-    Ok(Data { names: needed.iter().map(|s| s.to_string()).collect(), cols })
+    Ok(Data { names: needed.iter().map(|s| s.to_string()).collect(), cols, beyond: None })
 }
 
 /// `name [unit]`, with `N m` printed as `N·m`.
@@ -417,7 +421,7 @@ fn draw<DB: DrawingBackend>(
     match &spec.z {
         Some(z) => {
             let zs = data.col(z, "--z")?;
-            heat_map(root, spec, xs, ys, zs, labels, err)
+            heat_map(root, spec, xs, ys, zs, data.beyond.as_deref(), labels, err)
         }
         None => {
             let gs = match &spec.group {
@@ -577,12 +581,14 @@ fn distinct_sorted(v: &[f64]) -> Vec<f64> {
     d
 }
 
+#[allow(clippy::too_many_arguments)]
 fn heat_map<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     spec: &Spec,
     xs: &[f64],
     ys: &[f64],
     zs: &[f64],
+    beyond: Option<&[bool]>,
     labels: bool,
     err: &mut dyn Write,
 ) -> Result<()> {
@@ -596,6 +602,7 @@ fn heat_map<DB: DrawingBackend>(
         bail!("the heat map would have {} cells; plot a coarser map", ux.len() * uy.len());
     }
     let mut cell = vec![f64::NAN; ux.len() * uy.len()];
+    let mut marked = vec![false; cell.len()];
     let mut repeated = false;
     for i in 0..xs.len() {
         let (Ok(ix), Ok(iy)) =
@@ -606,6 +613,7 @@ fn heat_map<DB: DrawingBackend>(
         let c = &mut cell[iy * ux.len() + ix];
         repeated |= !c.is_nan();
         *c = zs[i];
+        marked[iy * ux.len() + ix] = beyond.is_some_and(|b| b[i]);
     }
     if repeated {
         writeln!(
@@ -624,8 +632,10 @@ fn heat_map<DB: DrawingBackend>(
     let (main, bar) = root.split_horizontally(w.saturating_sub(130));
     let mut cb = ChartBuilder::on(&main);
     cb.margin(20);
+    let any_marked = marked.iter().any(|&m| m);
+    let title = if any_marked { format!("{} (x: beyond [limits])", spec.title) } else { spec.title.clone() };
     if labels {
-        cb.caption(&spec.title, ("sans-serif", 22)).x_label_area_size(55).y_label_area_size(80);
+        cb.caption(&title, ("sans-serif", 22)).x_label_area_size(55).y_label_area_size(80);
     }
     let mut chart = cb.build_cartesian_2d(ex[0]..ex[ex.len() - 1], ey[0]..ey[ey.len() - 1]).map_err(de)?;
     let mut mesh = chart.configure_mesh();
@@ -652,6 +662,17 @@ fn heat_map<DB: DrawingBackend>(
             })
         }))
         .map_err(de)?;
+    // cells beyond a limit: a cross at the centre, sized to the cell
+    if any_marked {
+        let (w_px, h_px) = main.dim_in_pixel();
+        let size = ((w_px.min(h_px) as f64) / (2.5 * ux.len().max(uy.len()) as f64)).clamp(2.0, 8.0) as i32;
+        chart
+            .draw_series((0..cell.len()).filter(|&k| marked[k]).map(|k| {
+                let (ix, iy) = (k % ux.len(), k / ux.len());
+                Cross::new((0.5 * (ex[ix] + ex[ix + 1]), 0.5 * (ey[iy] + ey[iy + 1])), size, BLACK.stroke_width(1))
+            }))
+            .map_err(de)?;
+    }
 
     // colour bar
     let mut cb = ChartBuilder::on(&bar);

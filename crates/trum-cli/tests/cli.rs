@@ -437,6 +437,30 @@ fn plots_png_and_svg() {
     ]);
     let text = std::fs::read_to_string(&svg).expect("svg");
     assert!(text.starts_with("<svg") && text.contains("<rect"), "{}", &text[..200.min(text.len())]);
+    assert!(!text.contains("beyond [limits]"), "generic60 at 200 V, 43 kHz is within its limits");
+    // a heat map over a band that crosses the resonance marks the cells beyond a limit
+    let hot = d.join("hot.svg");
+    ok(&[
+        "plot",
+        "--motor",
+        "generic60",
+        "--x",
+        "frequency_hz",
+        "--y",
+        "preload_n",
+        "--z",
+        "temperature_rise_k",
+        "--frequency-hz",
+        "39500:43000:15",
+        "--preload-n",
+        "100:400:4",
+        "-o",
+        hot.to_str().unwrap_or_default(),
+    ]);
+    let marked = std::fs::read_to_string(&hot).expect("svg");
+    let lines = marked.matches("<line").count();
+    assert!(lines > text.matches("<line").count() + 8, "crosses drawn: {lines} lines");
+    assert!(marked.contains("beyond [limits]") || !marked.contains("<text"), "the title says what x means");
     // from a map CSV
     let map = d.join("m.csv");
     ok(&[
