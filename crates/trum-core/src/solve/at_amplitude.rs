@@ -15,7 +15,8 @@ use super::{OperatingPoint, Prepared, Solution, Status};
 /// the modal impedance at this amplitude, which balance the losses only at the solved
 /// amplitude. Status: `Stall` when the load is at or above the drive at this amplitude,
 /// `Clamped` for a zero amplitude, `InvalidInput` for an invalid point or amplitude, else
-/// `Ok`. `iterations` is 1.
+/// `Ok`. `iterations` is 1; `warnings` is left empty (the caller checks the limits that
+/// apply to its use, as [`crate::estimate`] does).
 pub fn solve_at_amplitude(p: &Prepared, op: &OperatingPoint, amplitude_m: f64) -> Solution {
     if op.invalid_reason().is_some() || !(amplitude_m.is_finite() && amplitude_m >= 0.0) {
         return Solution::invalid(Status::InvalidInput);
