@@ -396,3 +396,28 @@ fn resonance_takes_the_motor_with_overrides() {
     let e = fails(&["resonance", "--motor", "no_such_motor", "-o", p(&out)]);
     assert!(e.contains("unknown preset 'no_such_motor'"), "{e}");
 }
+
+/// `identify-hertz --motor` reads a feedback-voltage record through the motor's feedback
+/// gain: the displacement amplitude it reports is the record's voltage over that gain.
+#[test]
+fn identify_hertz_takes_the_motors_feedback_gain() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = dir.path().join("w.csv");
+    let g = trum_core::presets::preset("generic60").expect("preset").electrical.feedback_gain_v_per_m;
+    let f = 40_950.0;
+    let mut csv = String::from("time_s,feedback_voltage_v\n");
+    for i in 0..768 {
+        let t = i as f64 / (64.0 * f);
+        csv.push_str(&format!("{t},{}\n", g * (1e-7 + 1.5e-6 * (2.0 * std::f64::consts::PI * f * t - 2.0).cos())));
+    }
+    std::fs::write(&data, csv).expect("write");
+    let args =
+        ["identify-hertz", "--motor", "generic60", "--data", p(&data), "--frequency-hz", "40950", "--voltage-v", "200"];
+    let out = ok(&[&args[..], &["--json"]].concat());
+    let j: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let a = j["displacement_amplitude_m"].as_f64().expect("amplitude");
+    assert!((a - 1.5e-6).abs() < 1e-9, "{a}");
+    // without a motor the gain must be given
+    let e = fails(&["identify-hertz", "--data", p(&data), "--frequency-hz", "40950", "--voltage-v", "200"]);
+    assert!(e.contains("--feedback-gain-v-per-m is needed"), "{e}");
+}
