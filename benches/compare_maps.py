@@ -27,7 +27,8 @@ def main():
         print("different headers or row counts")
         return 1
     head = old[0]
-    st = head.index("status")
+    # status and the warnings after it are words, compared exactly
+    st = head.index("warnings") if "warnings" in head else head.index("status")
     cols = range(st + 1, len(head))
     peak = [0.0] * len(head)
     for r in old[1:]:

@@ -12,6 +12,7 @@ mod args;
 mod calib;
 mod data;
 mod diagnose;
+mod estimate;
 mod format;
 mod grid;
 mod info;
@@ -63,6 +64,8 @@ enum Command {
     Synth(synth::SynthArgs),
     /// Calibrate the uncertain motor parameters to a measurement CSV; write the calibrated motor file.
     Calibrate(calib::CalibrateArgs),
+    /// Estimate contact state, losses and efficiency per measurement row from the measured preload and feedback voltage (Sun et al. 2021).
+    Estimate(estimate::EstimateArgs),
     /// Diagnose the sim-to-real gap: where the model misses, which effect causes it, how far it shrinks.
     Diagnose(diagnose::DiagnoseArgs),
     /// Nonlinear (Hertzian) resonance curves: every branch, backbone and jump frequencies vs voltage and preload ([Hertz2022]: docs/REFERENCES.md).
@@ -155,6 +158,7 @@ fn run(cli: Cli, out: &mut dyn Write, err: &mut dyn Write) -> anyhow::Result<i32
         Command::Synth(a) => synth::run(&a, out, err),
         Command::Calibrate(a) => calib::run(&a, out, err),
         Command::Diagnose(a) => diagnose::run(&a, out, err),
+        Command::Estimate(a) => estimate::run(&a, out, err),
         Command::Resonance(a) => resonance::run(&a, out, err),
         Command::IdentifyHertz(a) => resonance::identify(&a, out),
         Command::Step(a) => step::run(&a, out, err),

@@ -104,8 +104,10 @@ pub fn parse_columns(spec: Option<&str>) -> Result<Vec<&'static Quantity>> {
     let Some(spec) = spec else { return Ok(QUANTITIES.iter().collect()) };
     let mut cols: Vec<&'static Quantity> = Vec::new();
     for name in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        if INPUT_COLUMNS.contains(&name) || name == "status" {
-            bail!("--columns: '{name}' is always written (inputs and status come first); list only quantities");
+        if INPUT_COLUMNS.contains(&name) || name == "status" || name == "warnings" {
+            bail!(
+                "--columns: '{name}' is always written (inputs, status and warnings come first); list only quantities"
+            );
         }
         let q = quantities::find(name).map_err(|m| {
             let hint = crate::suggest::hint(name, crate::suggest::names(quantities::QUANTITIES.iter().map(|q| q.name)));
@@ -216,10 +218,12 @@ fn check_size(motor: &Motor, grid: &Grid, columns: usize, threads: usize, max_po
     Ok(())
 }
 
-/// The CSV header line.
+/// The CSV header line: inputs, `status`, `warnings` (the motor's `[limits]` keys the
+/// point exceeds, `;`-separated, empty when none), then the quantities.
 pub fn header(cols: &[&Quantity]) -> String {
     let mut h: Vec<&str> = INPUT_COLUMNS.to_vec();
     h.push("status");
+    h.push("warnings");
     h.extend(cols.iter().map(|q| q.name));
     h.join(",") + "\n"
 }
@@ -235,6 +239,10 @@ fn chunk_csv(motor: &Motor, prep: &Prepared, grid: &Grid, cols: &[&Quantity], ra
             buf.push(b',');
         }
         buf.extend_from_slice(s.status.as_str().as_bytes());
+        buf.push(b',');
+        if !s.warnings.is_empty() {
+            buf.extend_from_slice(s.warnings.to_string().as_bytes());
+        }
         let valid = s.status.is_valid();
         for (c, q) in cols.iter().enumerate() {
             buf.push(b',');

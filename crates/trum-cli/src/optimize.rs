@@ -51,7 +51,7 @@ pub struct OptimizeArgs {
 }
 
 /// Columns of the criterion table.
-pub const COLUMNS: [&str; 10] = [
+pub const COLUMNS: [&str; 11] = [
     "preload_n",
     "status",
     "stall_torque_nm",
@@ -62,6 +62,7 @@ pub const COLUMNS: [&str; 10] = [
     "no_load_speed_rpm",
     "score",
     "in_region",
+    "warnings",
 ];
 
 fn parse_weights(s: &str) -> Result<[f64; 4]> {
@@ -96,6 +97,7 @@ fn row_cells(r: &CriterionRow, fmt: &dyn Fn(f64) -> String) -> Vec<String> {
         fmt(r.no_load_speed_rpm),
         ind(r.score),
         r.in_region.to_string(),
+        r.warnings.to_string(),
     ]
 }
 
@@ -183,8 +185,24 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
         fmt_sig(100.0 * cfg.region_tolerance, 3),
         a.weights
     );
+    // an end of the candidates within the limits next to candidates beyond them is an end
+    // set by the limits, not by the searched range
+    let limited_side = |above: bool| {
+        res.within_limits
+            && res.rows.iter().any(|r| {
+                r.score.is_finite()
+                    && !r.warnings.is_empty()
+                    && if above { r.preload_n > res.optimum_preload_n } else { r.preload_n < res.optimum_preload_n }
+            })
+    };
     match res.optimum_edge() {
         Edge::Interior => {}
+        Edge::Low if limited_side(false) => summary.push_str(
+            "\nnote: the optimum is the lowest candidate within the motor's [limits]; the running candidates below it exceed them",
+        ),
+        Edge::High if limited_side(true) => summary.push_str(
+            "\nnote: the optimum is the highest candidate within the motor's [limits]; the running candidates above it exceed them",
+        ),
         Edge::Low => summary.push_str(&format!(
             "\nwarning: the optimum is the lowest running candidate ({} N): the best preload may lie below the searched range; widen it, e.g. --preload-n {}:{}:{}",
             fmt_sig(res.optimum_preload_n, 5),
@@ -201,7 +219,12 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
         )),
     }
     if res.optimum_edge() == Edge::Interior {
-        let running: Vec<f64> = res.rows.iter().filter(|r| r.score.is_finite()).map(|r| r.preload_n).collect();
+        let running: Vec<f64> = res
+            .rows
+            .iter()
+            .filter(|r| r.score.is_finite() && (!res.within_limits || r.warnings.is_empty()))
+            .map(|r| r.preload_n)
+            .collect();
         let (lo, hi) = (running.first().copied(), running.last().copied());
         if lo == Some(res.region_n.0) {
             summary.push_str("\nnote: the optimum region reaches the lowest running candidate; it may extend below the searched range");
@@ -209,6 +232,16 @@ pub fn run(a: &OptimizeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
         if hi == Some(res.region_n.1) {
             summary.push_str("\nnote: the optimum region reaches the highest running candidate; it may extend above the searched range");
         }
+    }
+    let beyond = res.rows.iter().filter(|r| r.score.is_finite() && !r.warnings.is_empty()).count();
+    if beyond > 0 && res.within_limits {
+        summary.push_str(&format!(
+            "\nnote: {beyond} running candidate(s) exceed the motor's [limits] (warnings column) and are kept out of the optimum and its region"
+        ));
+    } else if beyond > 0 {
+        summary.push_str(
+            "\nwarning: every running candidate exceeds the motor's [limits] (warnings column); the optimum is chosen among them all",
+        );
     }
     if let Some((_, paper, source)) = PAPER_REGIONS_N.iter().find(|(n, _, _)| motor.preset.as_deref() == Some(*n)) {
         let (overlap, frac) = region_overlap(res.region_n, *paper);

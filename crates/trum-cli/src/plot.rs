@@ -117,6 +117,9 @@ pub struct PlotArgs {
 struct Data {
     names: Vec<String>,
     cols: Vec<Vec<f64>>,
+    /// Per row, whether the point is beyond one of the motor's `[limits]` (points solved
+    /// from a motor; `None` for a CSV).
+    beyond: Option<Vec<bool>>,
 }
 
 impl Data {
@@ -474,6 +477,7 @@ fn solve_grid(motor: &Motor, grid: &Grid) -> Data {
     let mut names: Vec<String> = AXES.map(String::from).to_vec();
     names.extend(QUANTITIES.iter().map(|q| q.name.to_string()));
     let mut cols = vec![Vec::with_capacity(total as usize); names.len()];
+    let beyond = chunks.iter().flatten().map(|(_, s)| !s.warnings.is_empty()).collect();
     for (op, s) in chunks.iter().flatten() {
         let valid = s.status.is_valid();
         let row =
@@ -482,7 +486,7 @@ fn solve_grid(motor: &Motor, grid: &Grid) -> Data {
             c.push(v);
         }
     }
-    Data { names, cols }
+    Data { names, cols, beyond: Some(beyond) }
 }
 
 /// Reads the needed columns of a CSV; empty cells are missing values.
@@ -524,7 +528,7 @@ fn read_csv(path: &Path, needed: &[&str]) -> Result<Data> {
     if cols.first().is_none_or(|c| c.is_empty()) {
         bail!("{shown}: no data rows");
     }
-    Ok(Data { names: needed.iter().map(|s| s.to_string()).collect(), cols })
+    Ok(Data { names: needed.iter().map(|s| s.to_string()).collect(), cols, beyond: None })
 }
 
 /// How a column is shown on an axis: words, the unit shown and the factor from the
@@ -627,7 +631,7 @@ fn draw<DB: DrawingBackend>(
     match &spec.z {
         Some(z) => {
             let zs = data.col(z, "--z")?;
-            heat_map(root, spec, xs, ys, zs, look, err)
+            heat_map(root, spec, xs, ys, zs, data.beyond.as_deref(), look, err)
         }
         None => {
             let gs = match &spec.group {
@@ -856,12 +860,14 @@ fn distinct_sorted(v: &[f64]) -> Vec<f64> {
     d
 }
 
+#[allow(clippy::too_many_arguments)]
 fn heat_map<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     spec: &Spec,
     xs: &[f64],
     ys: &[f64],
     zs: &[f64],
+    beyond: Option<&[bool]>,
     look: Look,
     err: &mut dyn Write,
 ) -> Result<()> {
@@ -875,6 +881,7 @@ fn heat_map<DB: DrawingBackend>(
         bail!("the heat map would have {} cells; plot a coarser map", ux.len() * uy.len());
     }
     let mut cell = vec![f64::NAN; ux.len() * uy.len()];
+    let mut marked = vec![false; cell.len()];
     let mut repeated = false;
     for i in 0..xs.len() {
         let (Ok(ix), Ok(iy)) =
@@ -885,6 +892,7 @@ fn heat_map<DB: DrawingBackend>(
         let c = &mut cell[iy * ux.len() + ix];
         repeated |= !c.is_nan();
         *c = zs[i];
+        marked[iy * ux.len() + ix] = beyond.is_some_and(|b| b[i]);
     }
     if repeated {
         writeln!(
@@ -903,7 +911,9 @@ fn heat_map<DB: DrawingBackend>(
     let (fx, fy) = (display(&spec.x).2, display(&spec.y).2);
     let ex: Vec<f64> = ex.iter().map(|v| v * fx).collect();
     let ey: Vec<f64> = ey.iter().map(|v| v * fy).collect();
-    let area = titled(root, &spec.title, &spec.subtitle, look)?;
+    let any_marked = marked.iter().any(|&m| m);
+    let title = if any_marked { format!("{} (x: beyond [limits])", spec.title) } else { spec.title.clone() };
+    let area = titled(root, &title, &spec.subtitle, look)?;
     let (w, _) = area.dim_in_pixel();
     let (main, bar) = area.split_horizontally(w.saturating_sub(look.px(130.0)));
     let mut cb = ChartBuilder::on(&main);
@@ -936,6 +946,17 @@ fn heat_map<DB: DrawingBackend>(
             })
         }))
         .map_err(de)?;
+    // cells beyond a limit: a cross at the centre, sized to the cell
+    if any_marked {
+        let (w_px, h_px) = main.dim_in_pixel();
+        let size = ((w_px.min(h_px) as f64) / (2.5 * ux.len().max(uy.len()) as f64)).clamp(2.0, 8.0) as i32;
+        chart
+            .draw_series((0..cell.len()).filter(|&k| marked[k]).map(|k| {
+                let (ix, iy) = (k % ux.len(), k / ux.len());
+                Cross::new((0.5 * (ex[ix] + ex[ix + 1]), 0.5 * (ey[iy] + ey[iy + 1])), size, BLACK.stroke_width(1))
+            }))
+            .map_err(de)?;
+    }
 
     colour_bar(&bar, z_name, (z0, z1), fz, look)
 }

@@ -8,6 +8,7 @@ use clap::Args;
 use serde_json::{json, Map, Value};
 use std::io::Write;
 use trum_core::layout::status_meaning;
+use trum_core::limits::LimitedQuantities;
 use trum_core::quantities::QUANTITIES;
 use trum_core::{solve, OperatingPoint, Status};
 
@@ -49,6 +50,7 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
     }
     let s = solve(&motor, &op);
     let valid = s.status.is_valid();
+    let limit_notes = motor.limits.describe(&LimitedQuantities::of_point(motor.thermal.ambient_c, &op, &s), s.warnings);
     let inputs: [(&str, f64, &str); 5] = [
         ("preload_n", op.preload_n, "N"),
         ("torque_nm", op.torque_nm, "N·m"),
@@ -77,6 +79,8 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
             "valid": valid,
             "full_contact": s.full_contact,
             "iterations": s.iterations,
+            "warnings": s.warnings.keys().collect::<Vec<_>>(),
+            "warning_details": limit_notes,
             "quantities": q,
             "units": units,
         });
@@ -86,6 +90,12 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
         writeln!(out, "motor    {}{}", motor.name, preset)?;
         writeln!(out, "effects  {}", motor.effects)?;
         writeln!(out, "status   {}{}", s.status, status_note(s.status, s.full_contact))?;
+        if limit_notes.is_empty() {
+            writeln!(out, "limits   inside the motor's [limits]")?;
+        }
+        for (i, note) in limit_notes.iter().enumerate() {
+            writeln!(out, "{}{note}", if i == 0 { "warning  " } else { "         " })?;
+        }
         writeln!(out)?;
         let mut rows = Vec::new();
         for (n, v, u) in inputs {

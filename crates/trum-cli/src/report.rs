@@ -88,6 +88,7 @@ pub fn html(d: &Diagnosis, motor: &Motor, data: &str, bench: &BenchData) -> Stri
     where_table(&mut h, d);
     residual_maps(&mut h, d, bench);
     curves(&mut h, d, bench);
+    limits(&mut h, motor, bench);
     notes(&mut h, d);
     let _ = writeln!(
         h,
@@ -393,6 +394,58 @@ fn curves(h: &mut String, d: &Diagnosis, bench: &BenchData) {
         }
     }
     let _ = writeln!(h, "</div>");
+}
+
+/// The bench rows whose operating point the motor model puts beyond one of its `[limits]`
+/// (the model at the read operating point, `trum point`'s warnings).
+fn limits(h: &mut String, motor: &Motor, bench: &BenchData) {
+    use trum_core::limits::LIMIT_KEYS;
+    let _ = writeln!(h, "<h2>Physical limits</h2>");
+    let p = trum_core::solve::Prepared::new(motor);
+    let mut beyond: Vec<(usize, Option<usize>)> = vec![(0, None); LIMIT_KEYS.len()];
+    for (i, r) in bench.rows.iter().enumerate() {
+        let w = trum_core::solve::solve_prepared(&p, motor, &r.op, None).warnings;
+        for (k, slot) in beyond.iter_mut().enumerate() {
+            if w.contains(LIMIT_KEYS[k]) {
+                slot.0 += 1;
+                slot.1.get_or_insert(i);
+            }
+        }
+    }
+    if beyond.iter().all(|b| b.0 == 0) {
+        let _ = writeln!(
+            h,
+            "<p>No bench point is beyond the motor's <code>[limits]</code> (the model at the read operating points).</p>"
+        );
+        return;
+    }
+    let _ = writeln!(
+        h,
+        "<p class=\"cap\">Bench points the model (at the read operating points) puts beyond the motor's <code>[limits]</code> \
+         (docs/MOTOR_FILE.md): its numbers there describe a motor no real one survives running continuously.</p>\
+         <table><tr><th>limit</th><th>value</th><th>rows beyond it</th><th>first such row (preload, torque, voltage, frequency)</th></tr>"
+    );
+    let maxima = [
+        motor.limits.max_voltage_v,
+        motor.limits.max_amplitude_m,
+        motor.limits.max_stator_temperature_c,
+        motor.limits.max_input_power_w,
+    ];
+    for (k, (n, first)) in beyond.iter().enumerate() {
+        let Some(i) = first else { continue };
+        let op = &bench.rows[*i].op;
+        let _ = writeln!(
+            h,
+            "<tr><td><code>{}</code></td><td class=\"n\">{}</td><td class=\"n\">{n}</td><td>{} N, {} N·m, {} V, {} Hz</td></tr>",
+            LIMIT_KEYS[k],
+            fmt_sig(maxima[k], 4),
+            fmt_sig(op.preload_n, 5),
+            fmt_sig(op.torque_nm, 4),
+            fmt_sig(op.voltage_v, 4),
+            fmt_sig(op.frequency_hz, 6)
+        );
+    }
+    let _ = writeln!(h, "</table>");
 }
 
 fn notes(h: &mut String, d: &Diagnosis) {

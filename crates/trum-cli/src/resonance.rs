@@ -2,7 +2,8 @@
 //! eq. 10-12, docs/REFERENCES.md) and `trum identify-hertz` (β from a waveform by harmonic balance, eq. 5-9).
 //!
 //! Both use the oscillator parameters of `trum_core::dynamics::hertz::HertzOscillator`:
-//! its 60 mm TRUM defaults, overridden by an `--oscillator` TOML file and then by flags.
+//! those of `--motor` (`HertzOscillator::from_motor`) or, without one, its 60 mm TRUM
+//! defaults, overridden by an `--oscillator` TOML file and then by flags.
 
 use crate::data::{num, write_atomic};
 use crate::format::{csv_number, fmt_sig};
@@ -22,9 +23,15 @@ use trum_core::dynamics::hertz::{
 use trum_core::layout::{response_rows, response_status, response_summary, ResponseCell, RESPONSE_COLUMNS};
 use trum_core::sweep::Axis;
 
-/// Oscillator parameters: defaults, then `--oscillator FILE`, then the flags.
+/// Oscillator parameters: the motor's (or the defaults), then `--oscillator FILE`, then the flags.
 #[derive(Args, Debug, Clone, Default)]
 pub struct OscillatorArgs {
+    /// Motor (TOML file or preset) whose modal mass, damping, stiffness (free resonance), force factor and hertz_softening the oscillator takes (default: the 60 mm TRUM oscillator of the Hertzian paper).
+    #[arg(long, value_name = "FILE|PRESET")]
+    motor: Option<String>,
+    /// Switch an effect on the motor on (as in `trum point`; only hertz_softening reaches the oscillator).
+    #[arg(long = "effect", value_name = "NAME=STRENGTH", requires = "motor")]
+    effects: Vec<String>,
     /// TOML file of oscillator parameters (any subset of the keys listed in docs/CLI.md; the rest keep the 60 mm TRUM defaults).
     #[arg(long, value_name = "FILE")]
     oscillator: Option<PathBuf>,
@@ -56,9 +63,20 @@ fn line_of(text: &str, key: &str) -> usize {
 }
 
 impl OscillatorArgs {
+    /// The motor of `--motor` with its `--effect`s, if given.
+    fn motor(&self) -> Result<Option<trum_core::Motor>> {
+        self.motor
+            .as_ref()
+            .map(|m| crate::args::MotorArgs { motor: m.clone(), effects: self.effects.clone() }.load().map(|(m, _)| m))
+            .transpose()
+    }
+
     /// The oscillator; every error names the file, line and key (or the flag) and why.
     pub fn load(&self) -> Result<HertzOscillator> {
-        let mut o = HertzOscillator::default();
+        let mut o = match self.motor()? {
+            Some(m) => HertzOscillator::from_motor(&m),
+            None => HertzOscillator::default(),
+        };
         if let Some(path) = &self.oscillator {
             let shown = path.display();
             crate::output::note_input(path, &format!("--oscillator '{shown}'"));
@@ -428,7 +446,7 @@ pub struct IdentifyArgs {
     /// Harmonic drive force amplitude F [N] (instead of --voltage-v).
     #[arg(long, value_name = "N", conflicts_with = "voltage_v")]
     drive_force_n: Option<f64>,
-    /// Feedback gain g of v = g w [V/m] (for a `feedback_voltage_v` column).
+    /// Feedback gain g of v = g w [V/m] (for a `feedback_voltage_v` column; default: the motor's electrical.feedback_gain_v_per_m).
     #[arg(long, value_name = "V_PER_M", allow_hyphen_values = true)]
     feedback_gain_v_per_m: Option<f64>,
     /// Harmonics H in the Fourier fit (1-16).
@@ -505,11 +523,15 @@ pub fn identify(a: &IdentifyArgs, out: &mut dyn Write) -> Result<i32> {
     let osc = a.osc.load()?;
     let w = read_waveform(&a.data)?;
     let shown = a.data.display();
-    let gain = match (w.column, a.feedback_gain_v_per_m) {
+    let motor_gain = a.osc.motor()?.map(|m| m.electrical.feedback_gain_v_per_m).filter(|g| *g > 0.0);
+    let gain = match (w.column, a.feedback_gain_v_per_m.or(motor_gain)) {
         ("displacement_m", None) => 1.0,
+        ("displacement_m", Some(_)) if a.feedback_gain_v_per_m.is_none() => 1.0,
         ("displacement_m", Some(_)) => bail!("--feedback-gain-v-per-m: '{shown}' holds displacement_m, not a voltage"),
         (_, Some(g)) => g,
-        (_, None) => bail!("--feedback-gain-v-per-m is needed: '{shown}' holds feedback_voltage_v"),
+        (_, None) => bail!(
+            "--feedback-gain-v-per-m is needed: '{shown}' holds feedback_voltage_v (or give --motor with a feedback gain)"
+        ),
     };
     let force = match (a.drive_force_n, a.voltage_v) {
         (Some(f), _) => f,

@@ -129,7 +129,7 @@ fn map_columns_rows_and_defaults() {
     let o = out.to_str().unwrap_or_default();
     ok(&["map", "--motor", "trum60a", "--preload-n", "100:300:3", "--torque-nm", "0:1.5:4", "-o", o, "-q"]);
     let (h, rows) = parse_csv(&std::fs::read_to_string(&out).expect("map written"));
-    let mut want = vec!["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status"];
+    let mut want = vec!["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status", "warnings"];
     want.extend(trum_core::quantities::QUANTITIES.iter().map(|q| q.name));
     assert_eq!(h, want);
     assert_eq!(rows.len(), 12);
@@ -137,8 +137,8 @@ fn map_columns_rows_and_defaults() {
     assert_eq!(&rows[1][..4], ["100", "0.5", "200", "43000"]);
     assert_eq!(&rows[11][..2], ["300", "1.5"]);
     // numbers are Rust's shortest round-trip form
-    let speed: f64 = rows[0][5].parse().expect("number");
-    assert_eq!(format!("{speed}"), rows[0][5]);
+    let speed: f64 = rows[0][6].parse().expect("number");
+    assert_eq!(format!("{speed}"), rows[0][6]);
 
     // no axes anywhere: the motor's default map (9 preloads x 25 torques up to the stall
     // torque at 500 N, at its drive; generic60 has none: 200 V, 43 kHz), not one point
@@ -146,13 +146,23 @@ fn map_columns_rows_and_defaults() {
     let (h, rows) = parse_csv(&sel);
     assert_eq!(
         h,
-        ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status", "speed_rpm", "efficiency", "stall_torque_nm"]
+        [
+            "preload_n",
+            "torque_nm",
+            "voltage_v",
+            "frequency_hz",
+            "status",
+            "warnings",
+            "speed_rpm",
+            "efficiency",
+            "stall_torque_nm"
+        ]
     );
     assert_eq!(rows.len(), 9 * 25);
     assert_eq!(&rows[0][..4], ["100", "0", "200", "43000"]);
     assert_eq!(rows[224][0], "500");
     let top: f64 = rows[224][1].parse().expect("number");
-    let stall_500: f64 = rows[200][7].parse().expect("number");
+    let stall_500: f64 = rows[200][8].parse().expect("number");
     assert!(top >= stall_500 && top <= 1.1 * stall_500, "torque axis ends at {top}, stall torque {stall_500}");
     assert!(rows.iter().any(|r| r[4] == "stall"), "the default map reaches the stall torque");
     // one axis given: the other axes take their defaults, as before
@@ -395,10 +405,20 @@ fn optimize_table_and_summary() {
     ]);
     assert!(out.contains("optimum preload") && out.contains("260-320 N"), "{out}");
     let (h, rows) = parse_csv(&std::fs::read_to_string(&csv_path).expect("csv"));
-    assert_eq!(h.len(), 10);
+    assert_eq!(h.len(), 11);
     assert_eq!(h[0], "preload_n");
     assert_eq!(h[9], "in_region");
+    assert_eq!(h[10], "warnings");
     assert_eq!(rows.len(), 7);
+    // at the paper's drive every candidate is within the preset's limits
+    assert!(rows.iter().all(|r| r[10].is_empty()), "{rows:?}");
+    assert!(!out.contains("[limits]"), "{out}");
+    // a voltage cap below the drive: every candidate flagged, and the summary says so
+    let capped = dir.path().join("capped.toml");
+    std::fs::write(&capped, "preset = \"trum60a\"\n[limits]\nmax_voltage_v = 150\n").expect("write");
+    let out = ok(&["optimize", "--motor", capped.to_str().unwrap_or_default(), "--preload-n", "150:450:4"]);
+    assert!(out.contains("every running candidate exceeds the motor's [limits]"), "{out}");
+    assert!(out.contains("max_voltage_v"), "{out}");
     let g = ok(&["optimize", "--motor", "generic60", "--preload-n", "150:450:4"]);
     assert!(!g.contains("260-320"), "{g}");
 }
@@ -468,6 +488,30 @@ fn plots_png_and_svg() {
             assert!(text.contains(words), "{words} missing from the efficiency map");
         }
     }
+    assert!(!text.contains("beyond [limits]"), "generic60 at 200 V, 43 kHz is within its limits");
+    // a heat map over a band that crosses the resonance marks the cells beyond a limit
+    let hot = d.join("hot.svg");
+    ok(&[
+        "plot",
+        "--motor",
+        "generic60",
+        "--x",
+        "frequency_hz",
+        "--y",
+        "preload_n",
+        "--z",
+        "temperature_rise_k",
+        "--frequency-hz",
+        "39500:43000:15",
+        "--preload-n",
+        "100:400:4",
+        "-o",
+        hot.to_str().unwrap_or_default(),
+    ]);
+    let marked = std::fs::read_to_string(&hot).expect("svg");
+    let lines = marked.matches("<line").count();
+    assert!(lines > text.matches("<line").count() + 8, "crosses drawn: {lines} lines");
+    assert!(marked.contains("beyond [limits]") || !marked.contains("<text"), "the title says what x means");
     // from a map CSV
     let map = d.join("m.csv");
     ok(&[

@@ -206,6 +206,17 @@ fn an_unexplained_verdict_names_what_explains_part_of_the_gap() {
             assert!(!line.contains("explains part") && !report.contains("explains part"), "{line}");
         }
     }
+    // the paper's no-load points at 150 V are inside the preset's limits; under a 100 V cap
+    // the report lists all four rows beyond it
+    assert!(report.contains("No bench point is beyond the motor's <code>[limits]</code>"), "limits section");
+    let capped = path(dir.path(), "capped.toml");
+    std::fs::write(&capped, "preset = \"trum60-qut\"\n[limits]\nmax_voltage_v = 100\n").expect("write");
+    ok(&["diagnose", "--motor", &capped, "--data", data, "--report", &html]);
+    let report = std::fs::read_to_string(&html).expect("report");
+    assert!(
+        report.contains("<tr><td><code>max_voltage_v</code></td><td class=\"n\">100</td><td class=\"n\">4</td>"),
+        "limits table"
+    );
 }
 
 /// One diagnosis of a no-effect campaign: JSON fields and values, the report, the summary.

@@ -391,3 +391,53 @@ fn step_bad_input_and_failed_runs_leave_no_file() {
     assert!(e.contains("unknown preset 'trum61'"), "{e}");
     assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0, "no partial output");
 }
+
+/// `--motor` gives the oscillator the motor's modal parameters: the linear resonance the
+/// summary prints is the motor's free resonance, and flags still override it.
+#[test]
+fn resonance_takes_the_motor_with_overrides() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("r.csv");
+    let args = ["resonance", "--motor", "trum60a", "--voltage-v", "1", "--preload-n", "250", "-o", p(&out)];
+    let summary = ok(&args);
+    let f_r = trum_core::presets::preset("trum60a").expect("preset").stator.resonance_frequency_hz;
+    let row = summary.lines().nth(1).expect("a summary row");
+    let cells: Vec<&str> = row.split_whitespace().collect();
+    assert!((num(cells[3]) - f_r).abs() < 1e-3 * f_r / 1e4, "{summary}");
+    let (h, rows) = csv_rows(&std::fs::read_to_string(&out).expect("csv"));
+    let (fi, ai) = (
+        h.iter().position(|c| c == "frequency_hz").expect("col"),
+        h.iter().position(|c| c == "amplitude_m").expect("col"),
+    );
+    let peak = rows.iter().max_by(|a, b| num(&a[ai]).total_cmp(&num(&b[ai]))).expect("rows");
+    assert!((num(&peak[fi]) - f_r).abs() < 0.01 * f_r, "peak at {} Hz, motor resonance {f_r}", peak[fi]);
+    let moved = ok(&[&args[..], &["--linear-resonance-hz", "41000"]].concat());
+    assert!(moved.lines().nth(1).is_some_and(|l| l.contains("41000")), "{moved}");
+    let e = fails(&["resonance", "--motor", "no_such_motor", "-o", p(&out)]);
+    assert!(e.contains("unknown preset 'no_such_motor'"), "{e}");
+}
+
+/// `identify-hertz --motor` reads a feedback-voltage record through the motor's feedback
+/// gain: the displacement amplitude it reports is the record's voltage over that gain.
+#[test]
+fn identify_hertz_takes_the_motors_feedback_gain() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = dir.path().join("w.csv");
+    let g = trum_core::presets::preset("generic60").expect("preset").electrical.feedback_gain_v_per_m;
+    let f = 40_950.0;
+    let mut csv = String::from("time_s,feedback_voltage_v\n");
+    for i in 0..768 {
+        let t = i as f64 / (64.0 * f);
+        csv.push_str(&format!("{t},{}\n", g * (1e-7 + 1.5e-6 * (2.0 * std::f64::consts::PI * f * t - 2.0).cos())));
+    }
+    std::fs::write(&data, csv).expect("write");
+    let args =
+        ["identify-hertz", "--motor", "generic60", "--data", p(&data), "--frequency-hz", "40950", "--voltage-v", "200"];
+    let out = ok(&[&args[..], &["--json"]].concat());
+    let j: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let a = j["displacement_amplitude_m"].as_f64().expect("amplitude");
+    assert!((a - 1.5e-6).abs() < 1e-9, "{a}");
+    // without a motor the gain must be given
+    let e = fails(&["identify-hertz", "--data", p(&data), "--frequency-hz", "40950", "--voltage-v", "200"]);
+    assert!(e.contains("--feedback-gain-v-per-m is needed"), "{e}");
+}

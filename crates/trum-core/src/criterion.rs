@@ -8,6 +8,12 @@
 //! region is the contiguous run of candidates around it whose score is within
 //! `region_tolerance` of the best.
 //!
+//! Candidates that exceed a limit of the motor's `[limits]` ([`crate::limits`]; the drive
+//! voltage, the larger amplitude and input power of the no-load and run points, and the
+//! temperature after the run time, ambient included) are scored but kept out of the
+//! optimum and its region, unless no running candidate is within the limits
+//! ([`CriterionResult::within_limits`]).
+//!
 //! The paper combines the four indicators graphically (its Figure 9), giving priority to
 //! speed smoothness and temperature rise; the default weights here do the same (2, 2 for
 //! fluctuation and temperature; 1, 1 for stall torque and efficiency) and are
@@ -15,6 +21,7 @@
 
 use crate::error::TrumError;
 use crate::fluctuation::fluctuation_about;
+use crate::limits::{LimitWarnings, LimitedQuantities};
 use crate::params::Motor;
 use crate::solve::{solve_prepared, OperatingPoint, Prepared, Status};
 use crate::sweep::Axis;
@@ -121,6 +128,16 @@ pub struct CriterionRow {
     pub score: f64,
     /// True inside the optimum region.
     pub in_region: bool,
+    /// The motor's `[limits]` the candidate exceeds (module docs say on what).
+    pub warnings: LimitWarnings,
+}
+
+impl CriterionRow {
+    /// True when the candidate may be the optimum: running, scored and, when `limits`,
+    /// within the motor's limits.
+    fn eligible(&self, limits: bool) -> bool {
+        self.score.is_finite() && (!limits || self.warnings.is_empty())
+    }
 }
 
 /// The criterion's table and conclusion.
@@ -132,6 +149,9 @@ pub struct CriterionResult {
     pub optimum_preload_n: f64,
     /// Optimum region [N].
     pub region_n: (f64, f64),
+    /// True when the optimum and its region were chosen among the candidates within the
+    /// motor's limits; false when no running candidate is within them (then among all).
+    pub within_limits: bool,
 }
 
 /// Where the optimum sits in the searched range.
@@ -146,10 +166,11 @@ pub enum Edge {
 }
 
 impl CriterionResult {
-    /// Whether the optimum is the first or last running candidate (clamped or stalled
-    /// candidates at the ends do not count as searched).
+    /// Whether the optimum is the first or last eligible candidate (clamped or stalled
+    /// candidates at the ends, and those beyond a limit, do not count as searched).
     pub fn optimum_edge(&self) -> Edge {
-        let running: Vec<f64> = self.rows.iter().filter(|r| r.score.is_finite()).map(|r| r.preload_n).collect();
+        let running: Vec<f64> =
+            self.rows.iter().filter(|r| r.eligible(self.within_limits)).map(|r| r.preload_n).collect();
         match (running.first(), running.last()) {
             (Some(&lo), _) if self.optimum_preload_n <= lo => Edge::Low,
             (_, Some(&hi)) if self.optimum_preload_n >= hi => Edge::High,
@@ -236,7 +257,10 @@ pub fn evaluate(
             no_load_speed_rpm: s0.speed_rpm,
             score: f64::NAN,
             in_region: false,
+            warnings: LimitWarnings::NONE,
         };
+        let mut limited = LimitedQuantities::of_point(motor.thermal.ambient_c, &op0, &s0);
+        limited.stator_temperature_c = f64::NAN;
         if s0.status == Status::Ok {
             row.stall_torque_nm = loaded_stall_torque_nm(&p, motor, f, cfg.voltage_v, cfg.frequency_hz);
         }
@@ -269,13 +293,20 @@ pub fn evaluate(
             );
             row.temperature_rise_after_run_k =
                 thermal::temperature_rise_k(run.total_loss_w(), p.alpha_s, p.heat_cap, cfg.run_time_s);
+            if run.status.is_valid() {
+                limited.amplitude_m = limited.amplitude_m.max(run.amplitude_m);
+                limited.input_power_w = limited.input_power_w.max(run.input_power_w);
+            }
+            limited.stator_temperature_c = motor.thermal.ambient_c + row.temperature_rise_after_run_k;
             row.speed_std_rpm = fluctuation_about(motor, &p, &op0, &s0, cfg.runout_m, 16).speed_std_rpm;
         }
+        row.warnings = motor.limits.check(&limited);
         rows.push(row);
         progress(i + 1, n);
     }
     score(&mut rows, cfg);
-    let (bi, best) = rows.iter().enumerate().filter(|(_, r)| r.score.is_finite()).fold(
+    let within_limits = rows.iter().any(|r| r.eligible(true));
+    let (bi, best) = rows.iter().enumerate().filter(|(_, r)| r.eligible(within_limits)).fold(
         (usize::MAX, f64::NEG_INFINITY),
         |acc, (i, r)| {
             if r.score > acc.1 {
@@ -290,10 +321,11 @@ pub fn evaluate(
     }
     let thr = best - cfg.region_tolerance * best.abs();
     let (mut lo, mut hi) = (bi, bi);
-    while lo > 0 && rows[lo - 1].score >= thr {
+    let inside = |r: &CriterionRow| r.eligible(within_limits) && r.score >= thr;
+    while lo > 0 && inside(&rows[lo - 1]) {
         lo -= 1;
     }
-    while hi + 1 < rows.len() && rows[hi + 1].score >= thr {
+    while hi + 1 < rows.len() && inside(&rows[hi + 1]) {
         hi += 1;
     }
     for r in rows.iter_mut().take(hi + 1).skip(lo) {
@@ -303,6 +335,7 @@ pub fn evaluate(
         optimum_preload_n: rows[bi].preload_n,
         region_n: (rows[lo].preload_n, rows[hi].preload_n),
         rows,
+        within_limits,
     })
 }
 
@@ -424,15 +457,52 @@ mod tests {
             no_load_speed_rpm: 100.0,
             score,
             in_region: false,
+            warnings: LimitWarnings::NONE,
         };
         let res = |opt: f64, scores: [f64; 4]| CriterionResult {
             rows: [100.0, 200.0, 300.0, 400.0].iter().zip(scores).map(|(&f, s)| row(f, s)).collect(),
             optimum_preload_n: opt,
             region_n: (opt, opt),
+            within_limits: true,
         };
         assert_eq!(res(100.0, [0.9, 0.5, 0.4, 0.3]).optimum_edge(), Edge::Low);
         assert_eq!(res(400.0, [0.1, 0.5, 0.6, 0.9]).optimum_edge(), Edge::High);
         assert_eq!(res(300.0, [0.1, 0.5, 0.9, f64::NAN]).optimum_edge(), Edge::High);
         assert_eq!(res(200.0, [0.1, 0.9, 0.6, 0.3]).optimum_edge(), Edge::Interior);
+    }
+
+    /// A candidate beyond a limit is scored as before but kept out of the optimum and its
+    /// region; with no candidate within the limits the optimum is chosen among all.
+    #[test]
+    fn candidates_beyond_a_limit_are_kept_out_of_the_optimum() {
+        let motor = crate::presets::preset("trum60a").expect("preset");
+        let cfg = CriterionConfig {
+            preload_n: Axis::linspace(150.0, 500.0, 8),
+            frequency_hz: 42_000.0,
+            torque_samples: 8,
+            ..CriterionConfig::seed000()
+        };
+        let free = evaluate(&motor, &cfg, &mut |_, _| {}).expect("criterion");
+        assert!(free.within_limits && free.rows.iter().all(|r| r.warnings.is_empty()), "{free:?}");
+        // an input-power cap just below the optimum's no-load input (it grows with preload here)
+        let at = |f: f64| crate::solve::solve(&motor, &OperatingPoint::new(f, 0.0, cfg.voltage_v, cfg.frequency_hz));
+        let mut capped = motor.clone();
+        capped.limits.max_input_power_w = 0.99 * at(free.optimum_preload_n).input_power_w;
+        let r = evaluate(&capped, &cfg, &mut |_, _| {}).expect("criterion");
+        assert!(r.within_limits);
+        for (a, b) in r.rows.iter().zip(&free.rows) {
+            assert_eq!(a.score.to_bits(), b.score.to_bits(), "limits change no score");
+            let beyond = at(a.preload_n).input_power_w > capped.limits.max_input_power_w;
+            assert_eq!(a.warnings.contains("max_input_power_w"), beyond, "{a:?}");
+            assert!(!(a.in_region && beyond), "{a:?}");
+        }
+        assert!(r.optimum_preload_n < free.optimum_preload_n, "{} vs {}", r.optimum_preload_n, free.optimum_preload_n);
+        assert!(r.region_n.1 < free.optimum_preload_n);
+        // nothing within the limits: the optimum among all, said so
+        capped.limits.max_voltage_v = 100.0;
+        let all = evaluate(&capped, &cfg, &mut |_, _| {}).expect("criterion");
+        assert!(!all.within_limits);
+        assert!(all.rows.iter().all(|r| r.warnings.contains("max_voltage_v")));
+        assert_eq!((all.optimum_preload_n, all.region_n), (free.optimum_preload_n, free.region_n));
     }
 }

@@ -22,10 +22,15 @@ pub(crate) enum Check {
     Finite,
     /// a whole number >= 1
     PositiveInteger,
+    /// > 0, `inf` allowed (a limit that is not set)
+    PositiveOrInf,
 }
 
 impl Check {
     fn reason(self, v: f64) -> Option<String> {
+        if self == Check::PositiveOrInf {
+            return (v.is_nan() || v <= 0.0).then(|| format!("{v} must be > 0 (or inf: no limit)"));
+        }
         if !v.is_finite() {
             return Some(format!("{v} is not a finite number"));
         }
@@ -73,6 +78,8 @@ macro_rules! section {
             ];
             fn values(&self) -> Vec<f64> { vec![ $( self.$field, )* ] }
             fn apply(&mut self, p: &$patch) { $( if let Some(v) = p.$field { self.$field = v.0; } )* }
+            // (unused for a section that is optional in a complete file)
+            #[allow(dead_code)]
             fn from_patch(p: &$patch) -> Result<Self, &'static str> {
                 Ok(Self { $( $field: p.$field.ok_or(stringify!($field))?.0, )* })
             }
@@ -173,6 +180,23 @@ section! {
     }
 }
 
+section! {
+    /// Physical limits of the motor: every solved point names the limits it exceeds
+    /// ([`crate::limits`]). A motor file without `[limits]` takes the defaults of the
+    /// piezoceramic traveling-wave ring motor ([`Limits::piezoceramic_ring`],
+    /// docs/MOTOR_FILE.md gives their sources); `inf` switches a limit off.
+    Limits / LimitsPatch = "limits" {
+        /// Highest drive voltage amplitude per phase, zero-to-peak [V].
+        max_voltage_v: PositiveOrInf = "highest drive voltage amplitude per phase, zero-to-peak [V]",
+        /// Highest wave amplitude at the contact surface [m].
+        max_amplitude_m: PositiveOrInf = "highest wave amplitude at the contact surface [m]",
+        /// Highest steady motor temperature, ambient plus the steady rise [°C].
+        max_stator_temperature_c: PositiveOrInf = "highest steady stator temperature, ambient plus steady rise [degC]",
+        /// Highest electrical input power, both phases [W].
+        max_input_power_w: PositiveOrInf = "highest electrical input power, both phases [W]",
+    }
+}
+
 /// A complete motor definition. Build one from a preset ([`crate::presets::preset`]) or
 /// a TOML motor file ([`Motor::from_toml_str`]).
 #[derive(Clone, Debug, PartialEq)]
@@ -197,6 +221,8 @@ pub struct Motor {
     pub assembly: Assembly,
     /// Switched-on unmodelled effects (none by default).
     pub effects: Effects,
+    /// Physical limits the solved points are checked against.
+    pub limits: Limits,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -215,6 +241,7 @@ struct MotorFile {
     sweep: Option<SweepPatch>,
     tolerances: Option<toml::Table>,
     drive: Option<DrivePatch>,
+    limits: Option<LimitsPatch>,
 }
 
 /// Reads the `[tolerances]` table of a motor file: how well each uncertain baseline
@@ -403,6 +430,7 @@ impl Motor {
             Rotor::KEYS,
             Thermal::KEYS,
             Assembly::KEYS,
+            Limits::KEYS,
         ]
         .concat()
     }
@@ -416,6 +444,7 @@ impl Motor {
             self.rotor.values(),
             self.thermal.values(),
             self.assembly.values(),
+            self.limits.values(),
         ]
         .concat()
     }
@@ -431,6 +460,7 @@ impl Motor {
             "rotor" => self.rotor.get_mut(key),
             "thermal" => self.thermal.get_mut(key),
             "assembly" => self.assembly.get_mut(key),
+            "limits" => self.limits.get_mut(key),
             _ => None,
         }
     }
@@ -563,7 +593,7 @@ impl Motor {
         macro_rules! apply {
             ($($sec:ident),*) => { $( if let Some(p) = &file.$sec { motor.$sec.apply(p); } )* };
         }
-        apply!(geometry, friction_layer, stator, electrical, rotor, thermal, assembly);
+        apply!(geometry, friction_layer, stator, electrical, rotor, thermal, assembly, limits);
         if let Some(name) = &file.name {
             motor.name = name.clone();
         } else if file.preset.is_none() {
@@ -608,6 +638,7 @@ impl Motor {
             thermal: build!(thermal, Thermal),
             assembly: build!(assembly, Assembly),
             effects: Effects::none(),
+            limits: Limits::piezoceramic_ring(),
         })
     }
 

@@ -1,6 +1,8 @@
 //! What the solver reports for one operating point: its status and every quantity of the
 //! steady state. Shared by the solver and the quantity table (`crate::quantities`).
 
+use crate::limits::LimitWarnings;
+
 /// Whether the model has a physical solution at the point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Status {
@@ -118,6 +120,9 @@ pub struct Solution {
     pub temperature_rise_at_elapsed_k: f64,
     /// Standard deviation of speed over a revolution [rev/min] (nonzero with `eccentricity`).
     pub speed_std_rpm: f64,
+    /// The motor's `[limits]` this point exceeds ([`crate::limits`]); empty when it is
+    /// inside all of them. Never changes the status or the numbers.
+    pub warnings: LimitWarnings,
 }
 
 impl Solution {
@@ -163,6 +168,7 @@ impl Solution {
             temperature_rise_k: n,
             temperature_rise_at_elapsed_k: n,
             speed_std_rpm: n,
+            warnings: LimitWarnings::NONE,
         }
     }
 }

@@ -51,6 +51,14 @@ pub fn hertz_defaults() -> Vec<(&'static str, f64)> {
     HertzOscillator::PARAM_KEYS.iter().map(|k| (*k, o.param_mut(k).map_or(f64::NAN, |v| *v))).collect()
 }
 
+/// The oscillator parameters `{name: value}` of a motor (`HertzOscillator::from_motor`:
+/// modal mass, damping, stiffness of the free resonance, force factor, hertz_softening).
+#[pyfunction]
+pub fn hertz_motor_params(motor: &Bound<'_, PyMotor>) -> Vec<(&'static str, f64)> {
+    let mut o = HertzOscillator::from_motor(&motor.get().inner);
+    HertzOscillator::PARAM_KEYS.iter().map(|k| (*k, o.param_mut(k).map_or(f64::NAN, |v| *v))).collect()
+}
+
 /// Response curves of every (voltage, preload) pair, voltage slowest. `frequency_hz`
 /// `None`: 401 points over the core's default band. Returns `{frequency_hz, curves}`;
 /// each curve is a dict with the operating point, `status`, `reason`, the branch points

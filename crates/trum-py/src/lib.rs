@@ -379,6 +379,8 @@ fn solve_arrays<'py>(
     }
     let codes = Array::from_shape_vec(IxDyn(&shape), out.status).map_err(|e| PyValueError::new_err(e.to_string()))?;
     d.set_item("status_code", PyArray::from_owned_array(py, codes))?;
+    let warn = Array::from_shape_vec(IxDyn(&shape), out.warnings).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    d.set_item("warning_code", PyArray::from_owned_array(py, warn))?;
     d.set_item("reasons", reasons)?;
     Ok(d)
 }
@@ -394,8 +396,8 @@ fn axis(py: Python<'_>, name: &str, spec: (f64, f64, i64)) -> PyResult<Axis> {
 /// Full-factorial map over the grid axes `AXES` (preload, torque, voltage, frequency;
 /// points run torque fastest, then frequency, voltage, preload), solved as `trum map`
 /// solves it. Each axis is `(start, stop, n)`; the grid is checked as the CLI checks it.
-/// Returns a dict of flat columns: the four inputs, every quantity, `status_code` and
-/// `reasons`.
+/// Returns a dict of flat columns: the four inputs, every quantity, `status_code`,
+/// `warning_code` (bit i: `LIMIT_KEYS[i]` exceeded) and `reasons`.
 #[pyfunction]
 #[pyo3(signature = (motor, preload_n, torque_nm, voltage_v, frequency_hz, max_points = 20_000_000, parallel = None))]
 #[allow(clippy::too_many_arguments)]
@@ -443,6 +445,7 @@ fn map_grid<'py>(
         d.set_item(q.name, PyArray::from_vec(py, v))?;
     }
     d.set_item("status_code", PyArray::from_vec(py, out.status))?;
+    d.set_item("warning_code", PyArray::from_vec(py, out.warnings))?;
     d.set_item("reasons", reasons)?;
     Ok(d)
 }
@@ -499,8 +502,10 @@ fn criterion<'py>(
     table.set_item("no_load_speed_rpm", PyArray::from_vec(py, col(|r| r.no_load_speed_rpm)))?;
     table.set_item("score", PyArray::from_vec(py, col(|r| r.score)))?;
     table.set_item("in_region", PyArray::from_vec(py, r.rows.iter().map(|r| r.in_region).collect::<Vec<bool>>()))?;
+    table.set_item("warnings", r.rows.iter().map(|r| r.warnings.to_string()).collect::<Vec<String>>())?;
     let d = PyDict::new(py);
     d.set_item("table", table)?;
+    d.set_item("within_limits", r.within_limits)?;
     d.set_item("optimum_preload_n", r.optimum_preload_n)?;
     d.set_item("region_n", r.region_n)?;
     let c = PyDict::new(py);
@@ -514,6 +519,54 @@ fn criterion<'py>(
     c.set_item("region_tolerance", cfg.region_tolerance)?;
     c.set_item("torque_samples", cfg.torque_samples)?;
     d.set_item("config", c)?;
+    Ok(d)
+}
+
+/// The measured-input estimator (`trum_core::estimate`) over rows given as 1-D columns of
+/// equal length: `feedback_v` NaN where not measured, `speed_rpm` NaN or `None`. Returns a
+/// dict: every `ESTIMATE_COLUMNS` name, `status_code` (into `ESTIMATE_STATUS_NAMES`) and
+/// `warning_code` (bits into `LIMIT_KEYS`).
+#[pyfunction]
+#[pyo3(signature = (motor, preload_n, voltage_v, frequency_hz, torque_nm, feedback_v, speed_rpm = None))]
+#[allow(clippy::too_many_arguments)]
+fn estimate_rows<'py>(
+    py: Python<'py>,
+    motor: &Bound<'py, PyMotor>,
+    preload_n: Vec<f64>,
+    voltage_v: Vec<f64>,
+    frequency_hz: Vec<f64>,
+    torque_nm: Vec<f64>,
+    feedback_v: Vec<f64>,
+    speed_rpm: Option<Vec<f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use trum_core::estimate::{Estimator, MeasuredPoint, ESTIMATE_COLUMNS};
+    let n = preload_n.len();
+    let lens = [voltage_v.len(), frequency_hz.len(), torque_nm.len(), feedback_v.len()];
+    if lens.iter().any(|&l| l != n) || speed_rpm.as_ref().is_some_and(|s| s.len() != n) {
+        return Err(input_err(py, "estimate: every column must have the same number of rows"));
+    }
+    let est = Estimator::new(&motor.get().inner).map_err(|e| trum_err(py, e))?;
+    let out = detached(py, || {
+        (0..n)
+            .map(|i| {
+                est.estimate(&MeasuredPoint {
+                    preload_n: preload_n[i],
+                    voltage_v: voltage_v[i],
+                    frequency_hz: frequency_hz[i],
+                    torque_nm: torque_nm[i],
+                    feedback_v: Some(feedback_v[i]).filter(|v| !v.is_nan()),
+                    speed_rpm: speed_rpm.as_ref().map(|s| s[i]).filter(|v| !v.is_nan()),
+                })
+            })
+            .collect::<Vec<_>>()
+    })?;
+    let d = PyDict::new(py);
+    for c in ESTIMATE_COLUMNS {
+        d.set_item(c.name, PyArray::from_vec(py, out.iter().map(c.get).collect::<Vec<f64>>()))?;
+    }
+    d.set_item("status_code", PyArray::from_vec(py, out.iter().map(|e| e.status.code()).collect::<Vec<u8>>()))?;
+    d.set_item("warning_code", PyArray::from_vec(py, out.iter().map(|e| e.warnings.bits()).collect::<Vec<u8>>()))?;
+    d.set_item("full_contact", PyArray::from_vec(py, out.iter().map(|e| e.full_contact).collect::<Vec<bool>>()))?;
     Ok(d)
 }
 
@@ -568,18 +621,26 @@ fn _trum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(map_grid, m)?)?;
     m.add_function(wrap_pyfunction!(criterion, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate_rows, m)?)?;
     m.add_function(wrap_pyfunction!(presets_list, m)?)?;
     m.add_function(wrap_pyfunction!(preset_toml, m)?)?;
     m.add_function(wrap_pyfunction!(effects_list, m)?)?;
     m.add_function(wrap_pyfunction!(quantities_list, m)?)?;
     m.add_function(wrap_pyfunction!(parameter_keys, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::hertz_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::hertz_motor_params, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::hertz_response, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::hertz_identify, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::step, m)?)?;
     m.add_function(wrap_pyfunction!(diagnosis::diagnose_csv, m)?)?;
     m.add_function(wrap_pyfunction!(diagnosis::calibrate_csv, m)?)?;
     m.add("STATUS_NAMES", STATUS_NAMES.to_vec())?;
+    m.add("LIMIT_KEYS", trum_core::limits::LIMIT_KEYS.to_vec())?;
+    m.add("ESTIMATE_STATUS_NAMES", trum_core::estimate::EstimateStatus::NAMES.to_vec())?;
+    m.add(
+        "ESTIMATE_COLUMNS",
+        trum_core::estimate::ESTIMATE_COLUMNS.iter().map(|c| (c.name, c.unit, c.doc)).collect::<Vec<_>>(),
+    )?;
     m.add("INPUTS", vector::INPUTS.to_vec())?;
     m.add("AXES", AXES.to_vec())?;
     m.add("PARALLEL_MIN_POINTS", vector::PARALLEL_MIN_POINTS)?;

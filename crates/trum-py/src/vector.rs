@@ -74,6 +74,8 @@ pub struct Columns {
     pub values: Vec<Vec<f64>>,
     /// Status codes (`trum_core::layout::STATUS_NAMES` indexed by code).
     pub status: Vec<u8>,
+    /// Limit warnings, bit i for `trum_core::limits::LIMIT_KEYS[i]`.
+    pub warnings: Vec<u8>,
 }
 
 /// Mutable views of one chunk of every output column.
@@ -81,12 +83,14 @@ struct ChunkOut<'a> {
     start: usize,
     values: Vec<&'a mut [f64]>,
     status: &'a mut [u8],
+    warnings: &'a mut [u8],
 }
 
 impl ChunkOut<'_> {
     #[inline]
     fn write(&mut self, j: usize, s: &Solution) {
         self.status[j] = status_code(s.status);
+        self.warnings[j] = s.warnings.bits();
         let valid = s.status.is_valid();
         for (col, v) in self.values.iter_mut().zip(values(s)) {
             col[j] = if valid { v } else { f64::NAN };
@@ -105,7 +109,7 @@ impl Columns {
             Some(v)
         }
         let values = (0..QUANTITIES.len()).map(|_| zeros(n)).collect::<Option<Vec<_>>>()?;
-        Some(Columns { values, status: zeros(n)? })
+        Some(Columns { values, status: zeros(n)?, warnings: zeros(n)? })
     }
 
     /// Splits every column into chunks of `chunk` points.
@@ -114,8 +118,14 @@ impl Columns {
         let mut out: Vec<ChunkOut<'_>> = self
             .status
             .chunks_mut(chunk)
+            .zip(self.warnings.chunks_mut(chunk))
             .enumerate()
-            .map(|(c, status)| ChunkOut { start: c * chunk, values: Vec::with_capacity(QUANTITIES.len()), status })
+            .map(|(c, (status, warnings))| ChunkOut {
+                start: c * chunk,
+                values: Vec::with_capacity(QUANTITIES.len()),
+                status,
+                warnings,
+            })
             .collect();
         for col in self.values.iter_mut() {
             for (c, s) in col.chunks_mut(chunk).enumerate() {

@@ -129,8 +129,8 @@ def test_registries():
 
 def test_map_columns_and_values(motor):
     d = trum.map(motor, preload_n=trum.linspace(150, 300, 4), voltage_v=200, frequency_hz=43e3, torque_nm=trum.linspace(0.0, 0.3, 7))
-    assert list(d)[:5] == ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status"]
-    assert list(d)[5:] == list(trum.QUANTITY_NAMES)
+    assert list(d)[:6] == ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status", "warnings"]
+    assert list(d)[6:] == list(trum.QUANTITY_NAMES)
     assert all(len(v) == 28 for v in d.values())
     assert d["torque_nm"][:7].tolist() == pytest.approx(np.linspace(0, 0.3, 7).tolist())
     res = motor.solve(preload_n=d["preload_n"], torque_nm=d["torque_nm"], voltage_v=200, frequency_hz=43e3)
@@ -141,7 +141,7 @@ def test_map_columns_and_values(motor):
     for k in trum.QUANTITY_NAMES:
         np.testing.assert_array_equal(par[k], d[k])
     pd = pytest.importorskip("pandas")
-    assert pd.DataFrame(d).shape == (28, 5 + len(trum.QUANTITY_NAMES))
+    assert pd.DataFrame(d).shape == (28, 6 + len(trum.QUANTITY_NAMES))
 
 
 @pytest.mark.skipif(not os.environ.get("TRUM_BIN"), reason="set TRUM_BIN to a trum CLI binary to compare with it")
@@ -156,6 +156,7 @@ def test_map_is_the_clis_map_bit_for_bit(motor):
     assert len(rows) == d["speed_rpm"].size == 4200
     for i, row in enumerate(rows):
         assert row["status"] == d["status"][i], i
+        assert row["warnings"] == d["warnings"][i], i
         for col in ("preload_n", "torque_nm", "voltage_v", "speed_rpm", "efficiency", "amplitude_m"):
             # shortest round-trip CSV numbers: equal bit for bit; empty cells are NaN here
             want = d[col][i]
@@ -259,6 +260,10 @@ def test_map_to_xarray(motor):
 def test_optimize(motor):
     o = trum.optimize(motor, preload_n=trum.linspace(150, 500, 8), torque_samples=8)
     t = o.table
+    assert o.within_limits and list(t["warnings"]) == [""] * 8
+    capped = motor.with_params({"limits.max_voltage_v": 150})
+    c = trum.optimize(capped, preload_n=(150, 500, 8), torque_samples=8)
+    assert not c.within_limits and all(w == "max_voltage_v" for w in c.table["warnings"])
     assert len(t["preload_n"]) == 8 and o.optimum_preload_n in t["preload_n"]
     assert o.region_n[0] <= o.optimum_preload_n <= o.region_n[1]
     assert o.config["weights"] == {"stall_torque": 1.0, "efficiency": 1.0, "temperature_rise": 2.0, "speed_fluctuation": 2.0}
@@ -270,3 +275,22 @@ def test_optimize(motor):
         trum.optimize(motor, weights={"speed": 1})
     pytest.importorskip("pandas")
     assert o.to_pandas().shape[0] == 8
+
+
+def test_warnings_name_each_limit_a_point_exceeds(motor):
+    assert trum.LIMIT_KEYS == ("max_voltage_v", "max_amplitude_m", "max_stator_temperature_c", "max_input_power_w")
+    g = trum.Motor("generic60")
+    # inside; beyond the voltage; near resonance beyond amplitude and temperature
+    res = g.solve(preload_n=250.0, voltage_v=[200.0, 350.0, 200.0], frequency_hz=[43e3, 43e3, 40e3])
+    assert res.warnings.tolist() == ["", "max_voltage_v", "max_amplitude_m;max_stator_temperature_c"]
+    assert res.within_limits.tolist() == [True, False, False]
+    assert res.status.tolist() == ["ok", "ok", "ok"]
+    assert res["warnings"].tolist() == res.warnings.tolist() and "warnings" in res.keys()
+    df = res.to_pandas()
+    assert df["warnings"].tolist() == res.warnings.tolist()
+    assert res.to_dict()["warnings"].tolist() == res.warnings.tolist()
+    # a limit of the motor file, changed like any parameter
+    capped = g.with_params({"limits.max_input_power_w": 1.0})
+    assert capped.solve(preload_n=250.0, voltage_v=200.0, frequency_hz=43e3).warnings.item() == "max_input_power_w"
+    with pytest.raises(trum.ParameterError, match="limits.max_voltage"):
+        trum.Motor.from_toml_str('preset = "generic60"\n[limits]\nmax_voltage = 1\n')

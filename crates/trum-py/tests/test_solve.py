@@ -111,7 +111,8 @@ def test_invalid_points_are_nan_with_status_and_reason(motor):
 def test_result_containers(motor):
     r = motor.solve(preload_n=[150.0, 250.0], torque_nm=[[0.0], [0.1]], **OP)
     d = r.to_dict()
-    assert list(d) == ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "elapsed_s", "status", *trum.QUANTITY_NAMES]
+    assert list(d) == ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "elapsed_s", "status", "warnings",
+                       *trum.QUANTITY_NAMES]
     assert all(v.shape == (2, 2) for v in d.values())
     assert "speed_rpm" in dir(r)
     with pytest.raises(AttributeError, match="quantities are"):

@@ -249,6 +249,40 @@ impl EffectiveDuffing {
 }
 
 impl HertzOscillator {
+    /// The oscillator of a motor, so that `trum resonance` and the steady solver describe
+    /// one motor: m = `stator.modal_mass_kg`, c = `stator.modal_damping_ns_per_m`,
+    /// k = m·(2π·`stator.resonance_frequency_hz`)² (its linear resonance is the free
+    /// stator's), A = `stator.force_factor_n_per_v` (the modal force per volt of Chen et
+    /// al. 2020 Appendix A is the Hertzian driving-circuit paper (2022)'s A of eq. 3).
+    /// β comes from the motor's `hertz_softening` effect, β(N) = −β0·(1 + g·N) (softening
+    /// is negative here): `beta_n_per_m3` is its value at the reference preload N_ref and
+    /// `beta_preload_exponent` = g·N_ref/(1 + g·N_ref) matches its slope there, with no
+    /// voltage dependence; without the effect β = 0 (the linear oscillator). The dynamic
+    /// contact coefficient k_c and the references keep their defaults (the motor has no
+    /// counterpart). The friction layer's contact stiffness and damping are not in this
+    /// oscillator: it is the stator's modal resonator under the static preload.
+    pub fn from_motor(motor: &crate::params::Motor) -> HertzOscillator {
+        use crate::effects::Effect;
+        let st = &motor.stator;
+        let d = HertzOscillator::default();
+        let (beta0, gain) =
+            (motor.effects.value(Effect::HertzSoftening, 0), motor.effects.value(Effect::HertzSoftening, 1));
+        let growth = gain * d.reference_preload_n;
+        HertzOscillator {
+            modal_mass_kg: st.modal_mass_kg,
+            damping_ns_per_m: st.modal_damping_ns_per_m,
+            linear_stiffness_n_per_m: crate::stator::modal_stiffness_n_per_m(
+                st.modal_mass_kg,
+                st.resonance_frequency_hz,
+            ),
+            beta_n_per_m3: -beta0 * (1.0 + growth),
+            force_factor_n_per_v: st.force_factor_n_per_v,
+            beta_preload_exponent: if beta0 > 0.0 { growth / (1.0 + growth) } else { 0.0 },
+            beta_voltage_exponent: 0.0,
+            ..d
+        }
+    }
+
     /// Checks every field (finite, positive where required). the Hertzian driving-circuit paper (2022) eq. 2-3.
     pub fn validate(&self) -> HertzResult<()> {
         check_positive("modal_mass_kg", self.modal_mass_kg)?;

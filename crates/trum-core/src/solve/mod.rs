@@ -30,6 +30,7 @@
 //! The contact interface laws live in [`crate::interface`], the W-dependent modal
 //! stiffness in [`crate::stator`].
 
+mod at_amplitude;
 pub(crate) mod bracket;
 mod branches;
 mod descent;
@@ -40,6 +41,7 @@ mod prepared;
 pub(crate) mod trial;
 mod warm_start;
 
+pub use at_amplitude::solve_at_amplitude;
 pub use branches::{amplitude_branches, jump_frequencies_hz, AmplitudeBranch};
 pub(crate) use eccentric::eccentric_average_with;
 pub(crate) use fixed_points::{iterated, solve_clamped, solve_effects, state_map};
@@ -81,7 +83,14 @@ pub(crate) fn solve_prepared_with(
         return Solution::invalid(Status::InvalidInput);
     }
     let s = if p.runout_m > 0.0 { eccentric_average_with(p, motor, op, guess, solve_at) } else { solve_at(op, guess) };
-    finite_or_unconverged(p, s)
+    with_warnings(motor, op, finite_or_unconverged(p, s))
+}
+
+/// `s` with the warnings of the motor's `[limits]` it exceeds (every public solve path
+/// ends here).
+pub(crate) fn with_warnings(motor: &Motor, op: &OperatingPoint, mut s: Solution) -> Solution {
+    s.warnings = motor.limits.check_point(motor.thermal.ambient_c, op, &s);
+    s
 }
 
 /// Every path (averaged and linearised ones too): non-finite numbers never carry a valid

@@ -40,6 +40,17 @@ pub(crate) fn solve_in_sweep(
     last: Option<&Solution>,
     history: &[SweepPoint],
 ) -> Solution {
+    super::with_warnings(motor, op, warm_solve(p, motor, op, last, history))
+}
+
+/// [`solve_in_sweep`] without the limit check.
+fn warm_solve(
+    p: &Prepared,
+    motor: &Motor,
+    op: &OperatingPoint,
+    last: Option<&Solution>,
+    history: &[SweepPoint],
+) -> Solution {
     let guess = last.filter(|g| g.status.is_valid());
     let on_line = |h: &SweepPoint| h.running && OperatingPoint { torque_nm: op.torque_nm, ..h.op } == *op;
     let top = history.last().filter(|h| {

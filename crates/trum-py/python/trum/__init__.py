@@ -10,6 +10,7 @@ SI units everywhere; every name carries its unit (``speed_rpm``, ``preload_n``).
 """
 from ._errors import InputError, ParameterError, ParameterKeyError, TrumError
 from ._registry import (
+    LIMIT_KEYS,
     QUANTITY_NAMES,
     STATUS_NAMES,
     EffectInfo,
@@ -28,6 +29,7 @@ from ._motor import Motor
 from ._axes import linspace
 from ._api import MapResult, Optimum, map, optimize
 from ._diagnosis import Calibration, Diagnosis, calibrate, diagnose
+from ._estimate import ESTIMATE_COLUMNS, ESTIMATE_STATUS_NAMES, estimate
 from ._dynamics import (
     HertzIdentification,
     Resonance,
@@ -56,6 +58,9 @@ __all__ = [
     "diagnose",
     "calibrate",
     "Calibration",
+    "estimate",
+    "ESTIMATE_COLUMNS",
+    "ESTIMATE_STATUS_NAMES",
     "hertz_defaults",
     "Resonance",
     "ResonanceCurve",
@@ -74,6 +79,7 @@ __all__ = [
     "ParameterInfo",
     "STATUS_NAMES",
     "QUANTITY_NAMES",
+    "LIMIT_KEYS",
     "TrumError",
     "ParameterError",
     "ParameterKeyError",

@@ -10,7 +10,7 @@ from . import _axes, _plot, _trum
 from ._axes import Values
 from ._errors import InputError
 from ._motor import Motor, _max_points
-from ._registry import QUANTITY_NAMES, STATUS_NAMES, quantities
+from ._registry import QUANTITY_NAMES, STATUS_NAMES, quantities, warning_words
 from ._result import _require_pandas
 
 AxisSpec = Values
@@ -210,7 +210,8 @@ def map(  # noqa: A001 - the CLI's name for it
     voltage, frequency > 0, torque >= 0), else ``InputError`` names the axis.
 
     Returns a :class:`MapResult`: flat columns ``{preload_n, torque_nm, voltage_v,
-    frequency_hz, status, <quantities>}``; points run torque fastest, then frequency,
+    frequency_hz, status, warnings, <quantities>}`` (``warnings``: the motor's ``[limits]``
+    keys a point exceeds, ``;``-joined, "" when none, as ``trum map`` writes them); points run torque fastest, then frequency,
     voltage, preload. When every axis is evenly spaced the grid is solved as ``trum map``
     solves it (warm-started in the same fixed chunks: the CLI's numbers bit for bit, not
     depending on threads); other values are solved point by point from a cold start, as
@@ -247,6 +248,7 @@ def map(  # noqa: A001 - the CLI's name for it
         codes = d["status_code"]
         q = {k: d[k] for k in QUANTITY_NAMES}
     out["status"] = _STATUS[codes]
+    out["warnings"] = warning_words(d["warning_code"])
     out.update(q)
     out.axes = ax
     out.motor = m.name
@@ -264,6 +266,9 @@ class Optimum:
     config: Dict[str, Any] = field(default_factory=dict)
     motor: str = ""
     effects: str = ""
+    #: True when the optimum was chosen among the candidates within the motor's
+    #: ``[limits]`` (the ``warnings`` column); False when none is within them.
+    within_limits: bool = True
 
     def to_pandas(self) -> Any:
         """The table as a tidy DataFrame (one row per candidate preload, unit-suffixed
@@ -324,6 +329,8 @@ def optimize(
     ``preload_n`` is evenly spaced values (``trum.linspace(150, 500, 36)``). Unset settings
     take the motor's drive (its ``[drive]``, as ``trum optimize``), else the core defaults
     (200 V, 43 kHz, 150-500 N in 36 steps, weights 1, 1, 2, 2).
+    Candidates beyond the motor's ``[limits]`` (``warnings`` column) are scored but kept
+    out of the optimum and its region, as in ``trum optimize``.
     """
     w: Optional[list] = None
     if isinstance(weights, Mapping):
@@ -352,9 +359,10 @@ def optimize(
     )
     table = dict(d["table"])
     table["status"] = np.array(table["status"])
+    table["warnings"] = np.array(table["warnings"], dtype=object)
     cfg = dict(d["config"])
     cfg["weights"] = dict(zip(WEIGHT_NAMES, cfg["weights"]))
-    return Optimum(table, d["optimum_preload_n"], tuple(d["region_n"]), cfg, m.name, m.effects)
+    return Optimum(table, d["optimum_preload_n"], tuple(d["region_n"]), cfg, m.name, m.effects, bool(d["within_limits"]))
 
 
 def _criterion_preloads(spec: AxisSpec) -> Tuple[float, float, int]:

@@ -26,12 +26,14 @@ def hertz_defaults() -> Dict[str, float]:
     return dict(_trum.hertz_defaults())
 
 
-def _params(oscillator: Optional[Mapping[str, Any]]) -> List[tuple]:
+def _params(oscillator: Optional[Mapping[str, Any]], motor: Any = None) -> List[tuple]:
+    """The motor's oscillator parameters (if a motor is given), then ``oscillator``'s overrides."""
+    base = [] if motor is None else list(_trum.hertz_motor_params(_motor(motor)))
     if oscillator is None:
-        return []
+        return base
     if not isinstance(oscillator, Mapping):
         raise InputError(f"oscillator: expected a dict of parameters, got {type(oscillator).__name__}")
-    return [(str(k), _number("oscillator", str(k), v)) for k, v in oscillator.items()]
+    return base + [(str(k), _number("oscillator", str(k), v)) for k, v in oscillator.items()]
 
 
 def _values(name: str, v: Values) -> List[float]:
@@ -181,6 +183,7 @@ def resonance(
     frequency_hz: Optional[Values] = None,
     method: str = "multiple_scales",
     oscillator: Optional[Mapping[str, float]] = None,
+    motor: Union[Motor, str, None] = None,
 ) -> Resonance:
     """Amplitude–frequency response of the Hertzian oscillator ([Hertz2022] eq. 10-12) for
     every voltage × preload: all branches incl. the unstable one, backbone, jump-up and
@@ -188,13 +191,16 @@ def resonance(
     number or explicit values (a list, a 1-D array); a range is ``trum.linspace(start,
     stop, n)``; ``voltage_v=None`` is 100, 200 and 300 V; ``frequency_hz=None`` picks 401 points
     over a band holding every peak and jump. ``method``: ``'multiple_scales'`` or
-    ``'harmonic_balance'``. ``oscillator``: parameters overriding :func:`hertz_defaults`.
-    A point the softening spring cannot carry has status ``'no_static_equilibrium'``."""
+    ``'harmonic_balance'``. ``motor``: a :class:`trum.Motor` or preset name whose modal
+    mass, damping, free resonance, force factor and ``hertz_softening`` the oscillator takes
+    (as ``trum resonance --motor``); without it, :func:`hertz_defaults`. ``oscillator``:
+    parameters overriding either. A point the softening spring cannot carry has status
+    ``'no_static_equilibrium'``."""
     if voltage_v is None:
         voltage_v = [100.0, 200.0, 300.0]
     freqs = None if frequency_hz is None else np.ascontiguousarray(_values("frequency_hz", frequency_hz))
     d = _trum.hertz_response(
-        _params(oscillator), _values("voltage_v", voltage_v), _values("preload_n", preload_n), freqs, method
+        _params(oscillator, motor), _values("voltage_v", voltage_v), _values("preload_n", preload_n), freqs, method
     )
     curves = []
     for c in d["curves"]:
@@ -230,9 +236,11 @@ def identify_hertz(
     feedback_gain_v_per_m: Optional[float] = None,
     oscillator: Optional[Mapping[str, float]] = None,
     harmonics: int = 3,
+    motor: Union[Motor, str, None] = None,
 ) -> HertzIdentification:
     """The cubic coefficient β from a sampled waveform ([Hertz2022] eq. 5-9), given m, c and
-    k (``oscillator``, e.g. ``{"modal_mass_kg": ..., "damping_ns_per_m": ...}``).
+    k: the ``motor``'s (as in :func:`resonance`) or the defaults, overridden by
+    ``oscillator`` (e.g. ``{"modal_mass_kg": ..., "damping_ns_per_m": ...}``).
 
     ``signal`` is the feedback-electrode voltage [V] when ``feedback_gain_v_per_m`` is
     given, else the modal displacement [m]. The drive force is ``drive_force_n``, or
@@ -245,7 +253,7 @@ def identify_hertz(
     if isinstance(harmonics, bool) or not isinstance(harmonics, numbers.Integral) or harmonics < 0:
         raise InputError(f"harmonics: expected a whole number >= 1, got {harmonics!r}")
     d = _trum.hertz_identify(
-        t, s, float(frequency_hz), _params(oscillator), voltage_v=voltage_v, preload_n=preload_n,
+        t, s, float(frequency_hz), _params(oscillator, motor), voltage_v=voltage_v, preload_n=preload_n,
         drive_force_n=drive_force_n, feedback_gain_v_per_m=feedback_gain_v_per_m, harmonics=int(harmonics),
     )
     return HertzIdentification(**d)

@@ -1,7 +1,7 @@
 """Registries of the core: presets, effects, output quantities, motor parameter keys."""
 from __future__ import annotations
 
-from typing import List, NamedTuple, Tuple
+from typing import Any, List, NamedTuple, Tuple
 
 from . import _trum
 
@@ -80,4 +80,20 @@ def parameters() -> List[ParameterInfo]:
 
 
 STATUS_NAMES: Tuple[str, ...] = tuple(_trum.STATUS_NAMES)
+#: The ``[limits]`` keys of a motor file, in the bit order of ``warning_code``.
+LIMIT_KEYS: Tuple[str, ...] = tuple(_trum.LIMIT_KEYS)
+
+
+def warning_words(codes: Any) -> Any:
+    """``warning_code`` bits as the ``;``-joined limit keys ("" for none), same shape (object array)."""
+    import numpy as np
+
+    codes = np.asarray(codes)
+    table = np.array(
+        [";".join(k for i, k in enumerate(LIMIT_KEYS) if c & (1 << i)) for c in range(1 << len(LIMIT_KEYS))],
+        dtype=object,
+    )
+    out = np.empty(codes.shape, dtype=object)
+    out[...] = table[codes & ((1 << len(LIMIT_KEYS)) - 1)]
+    return out
 QUANTITY_NAMES: Tuple[str, ...] = tuple(q[0] for q in _trum.quantities_list())

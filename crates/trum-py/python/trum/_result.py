@@ -5,7 +5,7 @@ from typing import Any, Dict, Iterator, List, Tuple
 
 import numpy as np
 
-from ._registry import QUANTITY_NAMES, STATUS_NAMES
+from ._registry import QUANTITY_NAMES, STATUS_NAMES, warning_words
 
 _STATUS = np.array(STATUS_NAMES)
 _VALID_MAX_CODE = 2  # ok, stall, clamped are physical steady states
@@ -25,7 +25,8 @@ class Result:
     Every quantity of ``trum.quantities()`` is a float64 array attribute (``res.speed_rpm``),
     NaN where the point has no valid steady state. ``status`` (str array) is the source of
     truth: ``ok``, ``stall``, ``clamped`` are valid; ``no_convergence`` and
-    ``invalid_input`` are not, and ``reason`` says why.
+    ``invalid_input`` are not, and ``reason`` says why. ``warnings`` names the motor's
+    ``[limits]`` each point exceeds (``trum.LIMIT_KEYS``; "" when none).
     """
 
     # Quantity attributes (for type checkers; values live in ``_q``).
@@ -62,6 +63,8 @@ class Result:
         self.shape: Tuple[int, ...] = tuple(data.pop("shape"))
         #: uint8 codes into ``trum.STATUS_NAMES`` (``pandas.Categorical.from_codes`` friendly).
         self.status_code: np.ndarray = data.pop("status_code")
+        #: uint8 bits into ``trum.LIMIT_KEYS`` (bit i: that limit exceeded).
+        self.warning_code: np.ndarray = data.pop("warning_code")
         self._reasons: List[Tuple[int, str]] = data.pop("reasons")
         self._q: Dict[str, np.ndarray] = {n: data[n] for n in QUANTITY_NAMES}
         #: The inputs, broadcast to ``shape`` (read-only views).
@@ -82,6 +85,8 @@ class Result:
             return self._q[name]
         if name == "status":
             return self.status
+        if name == "warnings":
+            return self.warnings
         if name in self.inputs:
             return self.inputs[name]
         raise KeyError(name)
@@ -96,8 +101,8 @@ class Result:
         return iter(self.keys())
 
     def keys(self) -> List[str]:
-        """Column names of ``to_dict``: inputs, ``status``, quantities."""
-        return [*self.inputs, "status", *QUANTITY_NAMES]
+        """Column names of ``to_dict``: inputs, ``status``, ``warnings``, quantities."""
+        return [*self.inputs, "status", "warnings", *QUANTITY_NAMES]
 
     @property
     def size(self) -> int:
@@ -108,6 +113,16 @@ class Result:
     def status(self) -> np.ndarray:
         """Status word per point (``ok``, ``stall``, ``clamped``, ``no_convergence``, ``invalid_input``)."""
         return _STATUS[self.status_code]
+
+    @property
+    def warnings(self) -> np.ndarray:
+        """The motor's ``[limits]`` each point exceeds, ``;``-joined keys (object array; "" when none)."""
+        return warning_words(self.warning_code)
+
+    @property
+    def within_limits(self) -> np.ndarray:
+        """True where the point exceeds none of the motor's ``[limits]``."""
+        return self.warning_code == 0
 
     @property
     def valid(self) -> np.ndarray:
@@ -129,18 +144,21 @@ class Result:
         return {n: int(k) for n, k in zip(STATUS_NAMES, c)}
 
     def to_dict(self) -> Dict[str, np.ndarray]:
-        """``{column: array}`` with the broadcast shape: inputs, ``status``, quantities."""
+        """``{column: array}`` with the broadcast shape: inputs, ``status``, ``warnings``, quantities."""
         d: Dict[str, np.ndarray] = {k: np.array(v) for k, v in self.inputs.items()}
         d["status"] = self.status
+        d["warnings"] = self.warnings
         d.update(self._q)
         return d
 
     def to_pandas(self) -> Any:
-        """A DataFrame with one row per point (C order); ``status`` is categorical. The
-        index is that of a pandas Series given to ``solve`` (1-D results), else 0..n-1."""
+        """A DataFrame with one row per point (C order); ``status`` is categorical, ``warnings``
+        a string column. The index is that of a pandas Series given to ``solve`` (1-D
+        results), else 0..n-1."""
         pd = _require_pandas()
         cols: Dict[str, Any] = {k: np.ravel(v) for k, v in self.inputs.items()}
         cols["status"] = pd.Categorical.from_codes(self.status_code.reshape(-1), categories=list(STATUS_NAMES))
+        cols["warnings"] = self.warnings.reshape(-1)
         cols.update({k: v.reshape(-1) for k, v in self._q.items()})
         return pd.DataFrame(cols, index=self._index)
 

@@ -7,6 +7,9 @@ import numpy.typing as npt
 
 __version__: str
 STATUS_NAMES: List[str]
+LIMIT_KEYS: List[str]
+ESTIMATE_STATUS_NAMES: List[str]
+ESTIMATE_COLUMNS: List[Tuple[str, str, str]]
 INPUTS: List[str]
 AXES: List[str]
 PARALLEL_MIN_POINTS: int
@@ -81,6 +84,7 @@ def effects_list() -> List[Tuple[str, str, str, List[Tuple[str, str, float, floa
 def quantities_list() -> List[Tuple[str, str, str]]: ...
 def parameter_keys() -> List[Tuple[str, str]]: ...
 def hertz_defaults() -> List[Tuple[str, float]]: ...
+def hertz_motor_params(motor: Motor) -> List[Tuple[str, float]]: ...
 def hertz_response(
     params: Sequence[Tuple[str, float]],
     voltage_v: Sequence[float],
@@ -122,3 +126,13 @@ def diagnose_csv(
     plausible: List[str] = ...,
 ) -> Tuple[str, List[str]]: ...
 def calibrate_csv(motor: Motor, data: bytes, source: str) -> Dict[str, Any]: ...
+
+def estimate_rows(
+    motor: Motor,
+    preload_n: Sequence[float],
+    voltage_v: Sequence[float],
+    frequency_hz: Sequence[float],
+    torque_nm: Sequence[float],
+    feedback_v: Sequence[float],
+    speed_rpm: Optional[Sequence[float]] = None,
+) -> Dict[str, Any]: ...

@@ -400,3 +400,36 @@ fn parameters_by_name_family_and_band() {
     assert_eq!(bb[0].amplitude_m, 0.0);
     assert!(o.response_family(&ops, &[0.0], ResponseMethod::MultipleScales).is_err());
 }
+
+/// The oscillator of a motor is that motor: its linear resonance is the free stator's
+/// `resonance_frequency_hz`, the linear peak is the modal force over c·ω at resonance,
+/// and `hertz_softening`'s β(N) = −β0·(1 + g·N) is met at the reference preload with
+/// its slope; without the effect the oscillator is linear.
+#[test]
+fn the_oscillator_of_a_motor_has_the_motors_modal_parameters() {
+    let mut motor = crate::presets::preset("trum60a").unwrap();
+    let o = HertzOscillator::from_motor(&motor);
+    let st = &motor.stator;
+    assert_eq!(o.beta_n_per_m3, 0.0);
+    let op = OperatingPoint { voltage_v: 1.0, preload_n: 250.0 };
+    let eff = o.effective(&op).unwrap();
+    assert!(rel(eff.linear_resonance_hz(), st.resonance_frequency_hz) < 1e-12, "{}", eff.linear_resonance_hz());
+    let f_r = st.resonance_frequency_hz;
+    let freqs: Vec<f64> = (0..2001).map(|i| f_r - 200.0 + 0.2 * i as f64).collect();
+    let r = o.frequency_response(&op, &freqs, ResponseMethod::HarmonicBalance).unwrap();
+    let peak = r.iter().map(|p| p.amplitude_m).fold(0.0, f64::max);
+    let force = st.force_factor_n_per_v * op.voltage_v + o.dynamic_contact_coefficient * op.preload_n;
+    let want = force / (st.modal_damping_ns_per_m * 2.0 * PI * f_r);
+    assert!(rel(peak, want) < 1e-4, "peak {peak} vs F/(c w) {want}");
+    // β from hertz_softening: value and logarithmic slope at the reference preload
+    motor.effects.parse_assignment("hertz_softening:beta_n_per_m3=2e18,preload_gain_per_n=0.005").unwrap();
+    let o = HertzOscillator::from_motor(&motor);
+    let beta = |n: f64| o.beta_at_n_per_m3(&OperatingPoint { voltage_v: 200.0, preload_n: n }).unwrap();
+    let truth = |n: f64| -2e18 * (1.0 + 0.005 * n);
+    let n_ref = o.reference_preload_n;
+    assert!(rel(beta(n_ref), truth(n_ref)) < 1e-12);
+    let slope = |f: &dyn Fn(f64) -> f64| (f(n_ref * 1.001) - f(n_ref * 0.999)) / (0.002 * n_ref);
+    assert!(rel(slope(&beta), slope(&truth)) < 1e-5);
+    // and the voltage does not change it
+    assert_eq!(o.beta_at_n_per_m3(&OperatingPoint { voltage_v: 50.0, preload_n: n_ref }).unwrap(), beta(n_ref));
+}
