@@ -247,6 +247,12 @@ pub struct StepMetrics {
     pub delay_s: Option<f64>,
     /// Rise time from 10 % to 90 % of the final speed [s].
     pub rise_time_s: Option<f64>,
+    /// 0-100 % rise time: first time the speed reaches the final speed [s] (the rise
+    /// time of an underdamped response in Ogata's definitions; `None` without overshoot
+    /// when the speed never reaches it).
+    pub rise_to_final_s: Option<f64>,
+    /// Peak time: when the speed reaches its largest value [s].
+    pub peak_time_s: Option<f64>,
     /// Overshoot (peak − final)/final, ≥ 0 [-].
     pub overshoot: Option<f64>,
     /// Time after which the speed stays within ±2 % of the final speed [s]

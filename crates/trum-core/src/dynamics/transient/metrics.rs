@@ -13,7 +13,7 @@ fn first_crossing(time_s: &[f64], speed: &[f64], level: f64) -> Option<f64> {
     Some(time_s[i - 1] + u * (time_s[i] - time_s[i - 1]))
 }
 
-/// Delay (50 %), rise time (10-90 %), overshoot and settling time (±2 % band) of a
+/// Delay (50 %), rise time (10-90 % and 0-100 %), peak time, overshoot and settling time (±2 % band) of a
 /// speed history against its final value. Control-textbook definitions (Ogata,
 /// *Modern Control Engineering*, §5-3); the bar-type transient paper reports delay and overshoot without
 /// defining them. A negative final speed (the rotor turning backwards) is measured on the
@@ -37,6 +37,8 @@ pub fn step_metrics(time_s: &[f64], speed_rpm: &[f64], final_speed_rpm: f64) -> 
         peak_speed_rpm: peak,
         delay_s: None,
         rise_time_s: None,
+        rise_to_final_s: None,
+        peak_time_s: None,
         overshoot: None,
         settling_time_s: None,
     };
@@ -49,6 +51,8 @@ pub fn step_metrics(time_s: &[f64], speed_rpm: &[f64], final_speed_rpm: f64) -> 
         (Some(a), Some(b)) => Some(b - a),
         _ => None,
     };
+    m.rise_to_final_s = first_crossing(t, s, f);
+    m.peak_time_s = s.iter().position(|&v| v == peak).map(|i| t[i]);
     m.overshoot = Some(((peak - f) / f).max(0.0));
     let band = 0.02 * f;
     m.settling_time_s = match s.iter().rposition(|&v| (v - f).abs() > band) {
