@@ -217,7 +217,7 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
         crate::plot::check_plot_path(p)?;
     }
     let motor = load(a, err)?;
-    let axis = |ax: &Option<Axis>, default: f64| ax.clone().unwrap_or(Axis { start: default, stop: default, n: 1 });
+    let axis = |ax: &Option<Axis>, default: f64| ax.unwrap_or(Axis { start: default, stop: default, n: 1 });
     let (drive_axis, drive_flag, freq_default, phase_default) = match &motor {
         StepMotor::Ring(_) => (axis(&a.voltage_v, 200.0), "--voltage-v", 43e3, 90.0),
         StepMotor::Bar(b) => {
