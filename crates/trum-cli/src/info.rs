@@ -51,14 +51,22 @@ pub fn presets(a: &PresetsArgs, out: &mut dyn Write) -> Result<i32> {
             writeln!(out, "{}", serde_json::to_string_pretty(&list)?)?;
         }
         None => {
-            let rows: Vec<Vec<String>> = PRESETS
+            let mut rows: Vec<Vec<String>> = PRESETS
                 .iter()
                 .map(|p| vec![p.name.to_string(), p.summary.to_string(), p.sources.to_string()])
                 .collect();
+            // bar-type motors run only in `trum step`; the summary says so
+            rows.extend(presets::BAR_PRESETS.iter().map(|p| {
+                vec![p.name.to_string(), format!("{} (bar-type: `trum step` only)", p.summary), p.sources.to_string()]
+            }));
             write_table(out, &["name", "summary", "sources"], &[Align::Left; 3], &rows)?;
             writeln!(out, "\n`trum presets show NAME > motor.toml` writes one as a motor file to edit.")?;
         }
         Some(PresetsAction::Show { name }) => {
+            if let Some(b) = presets::find_bar(name) {
+                write!(out, "{}", b.to_toml())?;
+                return Ok(0);
+            }
             let p = presets::find(name).map_err(|e| anyhow!("{}{}", e.reason, crate::suggest::preset_hint(name)))?;
             write!(out, "{}", p.to_toml())?;
         }

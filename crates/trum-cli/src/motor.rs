@@ -3,6 +3,7 @@
 use crate::args::MotorArgs;
 use anyhow::{anyhow, bail, Context, Result};
 use std::path::Path;
+use trum_core::dynamics::bar_type::BarMotor;
 use trum_core::params::SweepTable;
 use trum_core::presets;
 use trum_core::Motor;
@@ -34,11 +35,18 @@ pub fn load_motor(spec: &str) -> Result<(Motor, SweepTable)> {
     if path.exists() && !path.is_dir() {
         crate::output::note_input(path, &format!("--motor '{spec}'"));
         let text = read_text(path, spec)?;
+        if BarMotor::is_bar_file(&text) {
+            bail!("'{spec}' is a bar-type motor file: {BAR_ONLY}");
+        }
         // ParamError's message names the file, line and key; show it unchanged.
         return Motor::from_toml_str_with_sweep(&text, spec).map_err(|e| anyhow!("{e}"));
     }
     if path.is_dir() {
         bail!("--motor '{spec}' is a directory, not a motor file");
+    }
+    if presets::find_bar(spec).is_some() {
+        let names = presets::PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", ");
+        bail!("'{spec}' is a bar-type motor preset: {BAR_ONLY}; the ring-motor presets are: {names}");
     }
     match presets::find(spec) {
         Ok(p) => Ok((p.motor(), SweepTable::default())),
@@ -52,6 +60,25 @@ pub fn load_motor(spec: &str) -> Result<(Motor, SweepTable)> {
             bail!("unknown preset '{spec}' (and no file of that name exists); valid presets are: {names}{hint}")
         }
     }
+}
+
+/// What a ring-motor command says when it is given a bar-type motor.
+const BAR_ONLY: &str =
+    "the bar-type motor model is a step-response model, so only `trum step` runs it; this command needs a ring motor";
+
+/// `--motor` as a bar-type motor (a bar-type preset name, or a file with `kind = "bar"`
+/// or a bar-type `preset`); `None` when it names a ring motor or nothing readable (the
+/// ring-motor reader then gives the error).
+pub fn load_bar_motor(spec: &str) -> Result<Option<BarMotor>> {
+    let path = Path::new(spec);
+    if path.is_file() {
+        let text = std::fs::read_to_string(path).with_context(|| format!("cannot read motor file '{spec}'"))?;
+        if !BarMotor::is_bar_file(&text) {
+            return Ok(None);
+        }
+        return BarMotor::from_toml_str(&text, spec).map(Some).map_err(|e| anyhow!("{e}"));
+    }
+    Ok(presets::find_bar(spec).map(|p| p.motor()))
 }
 
 /// The `[tolerances]` table of `--motor` when it is a motor file (empty for a preset): the

@@ -1,6 +1,8 @@
 //! `trum step`: the start-up (step response) of the rotor speed with the stick-slip
 //! contact of [BarTransient] (docs/REFERENCES.md; `trum_core::dynamics::transient`), compared with the steady-state
-//! solver at the same operating point; time series, contact snapshots and plots.
+//! solver at the same operating point; time series, contact snapshots and plots. A
+//! bar-type motor (`trum_core::dynamics::bar_type`, e.g. the `bar36` preset) runs on the
+//! same integrator, driven by a moment; it has no steady solver.
 
 use crate::args::MotorArgs;
 use crate::data::write_atomic;
@@ -14,6 +16,7 @@ use plotters::style::RGBColor;
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::PathBuf;
+use trum_core::dynamics::bar_type::{bar_step_response, BarMotor, BarStepConfig};
 use trum_core::dynamics::transient::{
     steady_comparison, step_response, SteadyComparison, StepResponse, TransientConfig, TransientError,
 };
@@ -24,33 +27,36 @@ use trum_core::Motor;
 pub struct StepArgs {
     #[command(flatten)]
     motor: MotorArgs,
-    /// Drive voltage amplitude per phase, zero-to-peak [V]: VALUE or START:STOP:N.
-    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true, default_value = "200")]
-    voltage_v: Axis,
-    /// Drive frequency [Hz]: VALUE or START:STOP:N.
-    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true, default_value = "43000")]
-    frequency_hz: Axis,
-    /// Phase of phase B behind phase A [deg] (90: travelling wave, 0: standing wave): VALUE or START:STOP:N.
-    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true, default_value = "90")]
-    phase_difference_deg: Axis,
-    /// Axial preload [N].
-    #[arg(long, default_value_t = 260.0)]
-    preload_n: f64,
+    /// Ring motor: drive voltage amplitude per phase, zero-to-peak [V] (default 200): VALUE or START:STOP:N.
+    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true)]
+    voltage_v: Option<Axis>,
+    /// Bar-type motor: drive moment amplitude per axis [N·m] (default: the motor's [drive]): VALUE or START:STOP:N.
+    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true)]
+    moment_nm: Option<Axis>,
+    /// Drive frequency [Hz] (ring default 43000; bar-type: the motor's [drive]): VALUE or START:STOP:N.
+    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true)]
+    frequency_hz: Option<Axis>,
+    /// Phase of phase B behind phase A [deg] (default 90: travelling wave; 0: standing wave; -90: reversed): VALUE or START:STOP:N.
+    #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true)]
+    phase_difference_deg: Option<Axis>,
+    /// Axial preload [N] (ring default 260; bar-type: the motor's [drive]).
+    #[arg(long)]
+    preload_n: Option<f64>,
     /// Load torque [N·m].
     #[arg(long, default_value_t = 0.0)]
     torque_nm: f64,
-    /// Simulated time [s].
-    #[arg(long, default_value_t = 10e-3)]
-    duration_s: f64,
+    /// Simulated time [s] (ring default 0.01, bar-type 0.015).
+    #[arg(long)]
+    duration_s: Option<f64>,
     /// Time steps per drive period.
     #[arg(long, default_value_t = 64)]
     steps_per_period: usize,
-    /// Contact nodes per wavelength (256 in [BarTransient]).
+    /// Contact nodes per wavelength (256 in [BarTransient]; on a bar-type motor, nodes on the contact circle).
     #[arg(long, default_value_t = 256)]
     nodes_per_wavelength: usize,
-    /// Tangential stiffness of the contact layer as a multiple of the normal (Winkler) stiffness.
-    #[arg(long, default_value_t = trum_core::dynamics::transient::DEFAULT_TANGENTIAL_STIFFNESS_RATIO)]
-    tangential_stiffness_ratio: f64,
+    /// Ring motor: tangential stiffness of the contact layer as a multiple of the normal (Winkler) stiffness (default 300).
+    #[arg(long)]
+    tangential_stiffness_ratio: Option<f64>,
     /// Record the time series every this many steps.
     #[arg(long, default_value_t = 16)]
     record_every: usize,
@@ -82,11 +88,30 @@ pub struct StepArgs {
 
 /// One operating point of the sweep and its outcome.
 struct Run {
-    voltage_v: f64,
+    /// Drive amplitude: voltage [V] (ring motor) or moment [N·m] (bar-type motor).
+    drive: f64,
     frequency_hz: f64,
     phase_deg: f64,
     result: Result<StepResponse, TransientError>,
-    steady: SteadyComparison,
+    /// The steady solver at the same point (ring motors only).
+    steady: Option<SteadyComparison>,
+}
+
+/// The motor of a run: a ring motor (driven by a voltage, with a steady solver) or a
+/// bar-type motor (driven by a moment).
+enum StepMotor {
+    Ring(Motor),
+    Bar(BarMotor),
+}
+
+impl StepMotor {
+    /// Name of the drive column and its unit.
+    fn drive_column(&self) -> (&'static str, &'static str) {
+        match self {
+            StepMotor::Ring(_) => ("voltage_v", "V"),
+            StepMotor::Bar(_) => ("moment_nm", "N·m"),
+        }
+    }
 }
 
 fn values(ax: &Axis, flag: &str) -> Result<Vec<f64>> {
@@ -96,8 +121,9 @@ fn values(ax: &Axis, flag: &str) -> Result<Vec<f64>> {
     Ok((0..ax.n).map(|i| ax.at(i)).collect())
 }
 
-/// Status of a run: `ok`, `not_moving` (no positive final speed, no metrics),
-/// `not_settled` (outside the ±2 % band at the end), or the failure.
+/// Status of a run: `ok` (moving, a negative speed is rotation the other way),
+/// `not_moving` (at rest at the end, no metrics), `not_settled` (outside the ±2 % band at
+/// the end), or the failure.
 fn status(r: &Result<StepResponse, TransientError>) -> &'static str {
     match r {
         Ok(s) => s.metrics.status(),
@@ -115,31 +141,48 @@ fn quantities(r: &Run) -> Vec<(&'static str, f64, &'static str, &'static str)> {
     };
     let opt = |v: Option<f64>| v.unwrap_or(nan);
     let rel = |x: f64, y: f64| (x - y) / y;
+    let st = |f: fn(&SteadyComparison) -> f64| r.steady.as_ref().map_or(nan, f);
     let speed = a.map_or(nan, |a| a.speed_rpm);
     let torque = a.map_or(nan, |a| a.contact_torque_nm);
     let amp = a.map_or(nan, |a| a.amplitude_m);
     vec![
         ("delay_s", opt(m.and_then(|m| m.delay_s)), "s", "time to 50 % of the final speed"),
         ("rise_time_s", opt(m.and_then(|m| m.rise_time_s)), "s", "10 % to 90 % of the final speed"),
+        ("rise_to_final_s", opt(m.and_then(|m| m.rise_to_final_s)), "s", "0 to 100 %: first time at the final speed"),
+        ("peak_time_s", opt(m.and_then(|m| m.peak_time_s)), "s", "time of the peak speed"),
         ("overshoot", opt(m.and_then(|m| m.overshoot)), "-", "(peak - final) / final"),
         ("settling_time_s", opt(m.and_then(|m| m.settling_time_s)), "s", "last entry into the ±2 % band"),
-        ("peak_speed_rpm", m.map_or(nan, |m| m.peak_speed_rpm), "rpm", "largest period-averaged speed"),
+        ("peak_speed_rpm", m.map_or(nan, |m| m.peak_speed_rpm), "rpm", "peak period-averaged speed (signed)"),
         ("final_speed_rpm", speed, "rpm", "mean speed over the last 20 % of the run"),
-        ("steady_speed_rpm", r.steady.speed_rpm, "rpm", "steady-state solver at this point"),
-        ("speed_difference", rel(speed, r.steady.speed_rpm), "-", "(final - steady) / steady"),
+        ("steady_speed_rpm", st(|s| s.speed_rpm), "rpm", "steady-state solver at this point"),
+        ("speed_difference", rel(speed, st(|s| s.speed_rpm)), "-", "(final - steady) / steady"),
         ("contact_torque_nm", torque, "N·m", "mean contact torque over the last 20 %"),
-        ("steady_contact_torque_nm", r.steady.contact_torque_nm, "N·m", "load + rotor viscous torque at steady speed"),
-        ("torque_difference", rel(torque, r.steady.contact_torque_nm), "-", "(transient - steady) / steady"),
+        ("steady_contact_torque_nm", st(|s| s.contact_torque_nm), "N·m", "load + rotor viscous torque at steady speed"),
+        ("torque_difference", rel(torque, st(|s| s.contact_torque_nm)), "-", "(transient - steady) / steady"),
         ("amplitude_m", amp, "m", "mean wave amplitude over the last 20 %"),
-        ("steady_amplitude_m", r.steady.amplitude_m, "m", "steady-state wave amplitude"),
+        ("steady_amplitude_m", st(|s| s.amplitude_m), "m", "steady-state wave amplitude"),
         ("contact_fraction", a.map_or(nan, |a| a.contact_fraction), "-", "mean fraction of the wavelength in contact"),
         ("stick_fraction", a.map_or(nan, |a| a.stick_fraction), "-", "mean fraction of the wavelength sticking"),
     ]
 }
 
-pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
-    for p in [&a.plot, &a.snapshot_plot].into_iter().flatten() {
-        crate::plot::check_plot_path(p)?;
+/// The motor of `--motor`: a bar-type motor, or a ring motor with the effects handling
+/// of the transient model.
+fn load(a: &StepArgs, err: &mut dyn Write) -> Result<StepMotor> {
+    if let Some(bar) = crate::motor::load_bar_motor(&a.motor.motor)? {
+        if !a.motor.effects.is_empty() {
+            bail!("--effect: the bar-type motor model has no unmodelled effects");
+        }
+        if a.voltage_v.is_some() {
+            bail!("--voltage-v: a bar-type motor is driven by a moment; use --moment-nm");
+        }
+        if a.tangential_stiffness_ratio.is_some() {
+            bail!("--tangential-stiffness-ratio: a bar-type motor file sets contact.tangential_stiffness_n_per_m2");
+        }
+        return Ok(StepMotor::Bar(bar));
+    }
+    if a.moment_nm.is_some() {
+        bail!("--moment-nm drives a bar-type motor; a ring motor is driven by --voltage-v");
     }
     let (mut motor, _) = a.motor.load()?;
     // A paper preset may carry effects its paper's model includes (docs/PRESETS.md); the
@@ -158,11 +201,41 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
             "the transient model does not include unmodelled effects; remove --effect and the motor file's [effects]"
         );
     }
-    let volts = values(&a.voltage_v, "--voltage-v")?;
-    let freqs = values(&a.frequency_hz, "--frequency-hz")?;
-    let phases = values(&a.phase_difference_deg, "--phase-difference-deg")?;
+    Ok(StepMotor::Ring(motor))
+}
+
+/// Settings of one run, for either kind of motor.
+enum Settings {
+    Ring(TransientConfig),
+    Bar(BarStepConfig),
+}
+
+impl Settings {
+    fn validate(&self) -> Result<(), TransientError> {
+        match self {
+            Settings::Ring(c) => c.validate(),
+            Settings::Bar(c) => c.validate(),
+        }
+    }
+}
+
+pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
+    for p in [&a.plot, &a.snapshot_plot].into_iter().flatten() {
+        crate::plot::check_plot_path(p)?;
+    }
+    let motor = load(a, err)?;
+    let axis = |ax: &Option<Axis>, default: f64| ax.unwrap_or(Axis { start: default, stop: default, n: 1 });
+    let (drive_axis, drive_flag, freq_default, phase_default) = match &motor {
+        StepMotor::Ring(_) => (axis(&a.voltage_v, 200.0), "--voltage-v", 43e3, 90.0),
+        StepMotor::Bar(b) => {
+            (axis(&a.moment_nm, b.moment_amplitude_nm), "--moment-nm", b.frequency_hz, b.phase_difference_deg)
+        }
+    };
+    let drives = values(&drive_axis, drive_flag)?;
+    let freqs = values(&axis(&a.frequency_hz, freq_default), "--frequency-hz")?;
+    let phases = values(&axis(&a.phase_difference_deg, phase_default), "--phase-difference-deg")?;
     let mut points = Vec::new();
-    for &v in &volts {
+    for &v in &drives {
         for &f in &freqs {
             points.extend(phases.iter().map(|&p| (v, f, p)));
         }
@@ -171,19 +244,39 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
     if !single && (a.output.is_some() || a.plot.is_some() || !a.snapshot_at_s.is_empty()) {
         bail!("-o, --plot and --snapshot-at-s need a single operating point; a sweep writes --table");
     }
-    let config = |v: f64, f: f64, p: f64| TransientConfig {
-        duration_s: a.duration_s,
-        steps_per_period: a.steps_per_period,
-        nodes_per_wavelength: a.nodes_per_wavelength,
-        phase_difference_rad: p.to_radians(),
-        load_torque_nm: a.torque_nm,
-        voltage_v: v,
-        frequency_hz: f,
-        preload_n: a.preload_n,
-        record_every: a.record_every,
-        snapshot_times_s: a.snapshot_at_s.clone(),
-        tangential_stiffness_ratio: a.tangential_stiffness_ratio,
-        ..TransientConfig::default()
+    let (preload, duration) = match &motor {
+        StepMotor::Ring(_) => (a.preload_n.unwrap_or(260.0), a.duration_s.unwrap_or(10e-3)),
+        StepMotor::Bar(b) => (a.preload_n.unwrap_or(b.preload_n), a.duration_s.unwrap_or(b.step_config().duration_s)),
+    };
+    let config = |v: f64, f: f64, p: f64| match &motor {
+        StepMotor::Ring(_) => Settings::Ring(TransientConfig {
+            duration_s: duration,
+            steps_per_period: a.steps_per_period,
+            nodes_per_wavelength: a.nodes_per_wavelength,
+            phase_difference_rad: p.to_radians(),
+            load_torque_nm: a.torque_nm,
+            voltage_v: v,
+            frequency_hz: f,
+            preload_n: preload,
+            record_every: a.record_every,
+            snapshot_times_s: a.snapshot_at_s.clone(),
+            tangential_stiffness_ratio: a
+                .tangential_stiffness_ratio
+                .unwrap_or(trum_core::dynamics::transient::DEFAULT_TANGENTIAL_STIFFNESS_RATIO),
+            ..TransientConfig::default()
+        }),
+        StepMotor::Bar(_) => Settings::Bar(BarStepConfig {
+            duration_s: duration,
+            steps_per_period: a.steps_per_period,
+            nodes: a.nodes_per_wavelength,
+            phase_difference_rad: p.to_radians(),
+            load_torque_nm: a.torque_nm,
+            moment_amplitude_nm: v,
+            frequency_hz: f,
+            preload_n: preload,
+            record_every: a.record_every,
+            snapshot_times_s: a.snapshot_at_s.clone(),
+        }),
     };
     // Bad settings are the user's error, not a status: check every point before running.
     for &(v, f, p) in &points {
@@ -195,15 +288,17 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
     );
     let runs: Vec<Run> = points
         .par_iter()
-        .map(|&(v, f, p)| Run {
-            voltage_v: v,
-            frequency_hz: f,
-            phase_deg: p,
-            result: step_response(&motor, &config(v, f, p)),
-            steady: steady_comparison(&motor, &config(v, f, p)),
+        .map(|&(v, f, p)| {
+            let (result, steady) = match (&motor, config(v, f, p)) {
+                (StepMotor::Ring(m), Settings::Ring(c)) => (step_response(m, &c), Some(steady_comparison(m, &c))),
+                (StepMotor::Bar(m), Settings::Bar(c)) => (bar_step_response(m, &c), None),
+                _ => unreachable!("the settings follow the motor"),
+            };
+            Run { drive: v, frequency_hz: f, phase_deg: p, result, steady }
         })
         .collect();
     spinner.finish_and_clear();
+    let (drive_name, drive_unit) = motor.drive_column();
     if single {
         if let Err(e) = &runs[0].result {
             bail!("{}", flag_message(e));
@@ -211,13 +306,18 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
     } else {
         for r in &runs {
             if let Err(e) = &r.result {
-                writeln!(err, "note: {} V, {} Hz, {} deg: {e}", r.voltage_v, r.frequency_hz, r.phase_deg)?;
+                writeln!(err, "note: {} {drive_unit}, {} Hz, {} deg: {e}", r.drive, r.frequency_hz, r.phase_deg)?;
             }
         }
     }
     if let Some(path) = &a.table {
-        write_atomic(path, ".csv", &table_csv(&runs), out)?;
+        write_atomic(path, ".csv", &table_csv(&runs, drive_name), out)?;
     }
+    // the Coulomb limit drawn and written beside the friction force: μ (ring), μ_s (bar-type)
+    let mu = match &motor {
+        StepMotor::Ring(m) => m.friction_layer.friction_coefficient,
+        StepMotor::Bar(b) => b.static_friction_coefficient,
+    };
     let to_stderr =
         [&a.output, &a.table, &a.snapshots].iter().any(|p| p.as_deref().is_some_and(|p| p.as_os_str() == "-"));
     if let (true, Ok(resp)) = (single, &runs[0].result) {
@@ -225,13 +325,17 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
             write_atomic(path, ".csv", &series_csv(resp), out)?;
         }
         if let Some(path) = &a.snapshots {
-            write_atomic(path, ".csv", &snapshots_csv(resp, motor.friction_layer.friction_coefficient), out)?;
+            write_atomic(path, ".csv", &snapshots_csv(resp, mu), out)?;
         }
         if let Some(path) = &a.plot {
-            write_figure(path, &speed_plot(resp, &runs[0], &motor, a), err)?;
+            let name = match &motor {
+                StepMotor::Ring(m) => m.name.as_str(),
+                StepMotor::Bar(b) => b.name.as_str(),
+            };
+            write_figure(path, &speed_plot(resp, &runs[0], name, drive_unit, preload, a.torque_nm), err)?;
         }
         if let Some(path) = &a.snapshot_plot {
-            write_figure(path, &snapshot_plot(resp, motor.friction_layer.friction_coefficient), err)?;
+            write_figure(path, &snapshot_plot(resp, mu), err)?;
         }
     }
     if a.json {
@@ -245,29 +349,44 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
                 for (n, v, _, _) in quantities(r) {
                     q.insert(n.into(), crate::data::num(v));
                 }
-                serde_json::json!({
-                    "voltage_v": r.voltage_v,
-                    "frequency_hz": r.frequency_hz,
-                    "phase_difference_deg": r.phase_deg,
-                    "preload_n": a.preload_n,
-                    "torque_nm": a.torque_nm,
-                    "status": status(&r.result),
-                    "steady_status": r.steady.status.to_string(),
-                    "quantities": q,
-                })
+                let mut run = serde_json::Map::new();
+                run.insert(drive_name.into(), crate::data::num(r.drive));
+                run.insert("frequency_hz".into(), crate::data::num(r.frequency_hz));
+                run.insert("phase_difference_deg".into(), crate::data::num(r.phase_deg));
+                run.insert("preload_n".into(), crate::data::num(preload));
+                run.insert("torque_nm".into(), crate::data::num(a.torque_nm));
+                run.insert("status".into(), status(&r.result).into());
+                // (no steady solver for a bar-type motor)
+                run.insert(
+                    "steady_status".into(),
+                    r.steady.as_ref().map_or(serde_json::Value::Null, |s| s.status.to_string().into()),
+                );
+                run.insert("quantities".into(), q.into());
+                serde_json::Value::Object(run)
             })
             .collect();
-        let doc = serde_json::json!({ "motor": motor.name, "runs": list });
+        let name = match &motor {
+            StepMotor::Ring(m) => m.name.as_str(),
+            StepMotor::Bar(b) => b.name.as_str(),
+        };
+        let doc = serde_json::json!({ "motor": name, "runs": list });
         writeln!(out, "{}", serde_json::to_string_pretty(&doc)?)?;
         return Ok(0);
     }
     let summary: &mut dyn Write = if to_stderr { err } else { out };
+    let settings = Shown { preload_n: preload, duration_s: duration };
     if single {
-        print_single(&runs[0], &motor, a, summary)?;
+        print_single(&runs[0], &motor, a, &settings, summary)?;
     } else {
-        print_sweep(&runs, summary)?;
+        print_sweep(&runs, drive_name, summary)?;
     }
     Ok(0)
+}
+
+/// The resolved defaults shown in the summary.
+struct Shown {
+    preload_n: f64,
+    duration_s: f64,
 }
 
 /// The core names config fields; say which command-line flag they come from.
@@ -278,6 +397,8 @@ fn flag_message(e: &TransientError) -> String {
                 "phase_difference_rad" => "--phase-difference-deg".to_string(),
                 "snapshot_times_s" => "--snapshot-at-s".to_string(),
                 "load_torque_nm" => "--torque-nm".to_string(),
+                "moment_amplitude_nm" => "--moment-nm".to_string(),
+                "nodes" => "--nodes-per-wavelength".to_string(),
                 n => format!("--{}", n.replace('_', "-")),
             };
             format!("{flag} = {value}: {reason}")
@@ -288,29 +409,47 @@ fn flag_message(e: &TransientError) -> String {
     }
 }
 
-fn print_single(r: &Run, motor: &Motor, a: &StepArgs, out: &mut dyn Write) -> Result<()> {
+fn print_single(r: &Run, motor: &StepMotor, a: &StepArgs, shown: &Shown, out: &mut dyn Write) -> Result<()> {
     let Ok(resp) = &r.result else { return Ok(()) };
-    let source = motor.preset.as_deref().map(|p| format!(" (preset {p})")).unwrap_or_default();
-    writeln!(out, "motor    {}{source}", motor.name)?;
+    let (name, preset) = match motor {
+        StepMotor::Ring(m) => (m.name.as_str(), m.preset.as_deref()),
+        StepMotor::Bar(b) => (b.name.as_str(), b.preset.as_deref()),
+    };
+    let source = preset.map(|p| format!(" (preset {p})")).unwrap_or_default();
+    writeln!(out, "motor    {name}{source}")?;
+    let (_, unit) = motor.drive_column();
     writeln!(
         out,
-        "drive    {} V, {} Hz, phase {} deg, preload {} N, load {} N·m",
-        fmt_sig(r.voltage_v, 6),
+        "drive    {} {unit}, {} Hz, phase {} deg, preload {} N, load {} N·m",
+        fmt_sig(r.drive, 6),
         fmt_sig(r.frequency_hz, 6),
         fmt_sig(r.phase_deg, 6),
-        fmt_sig(a.preload_n, 6),
+        fmt_sig(shown.preload_n, 6),
         fmt_sig(a.torque_nm, 6)
     )?;
+    let contact = match motor {
+        StepMotor::Ring(_) => format!(
+            "{} nodes per wavelength, k_t/k_f = {}",
+            a.nodes_per_wavelength,
+            fmt_sig(
+                a.tangential_stiffness_ratio
+                    .unwrap_or(trum_core::dynamics::transient::DEFAULT_TANGENTIAL_STIFFNESS_RATIO),
+                6
+            )
+        ),
+        StepMotor::Bar(_) => format!("rigid-disc stator, {} contact nodes", a.nodes_per_wavelength),
+    };
     writeln!(
         out,
-        "model    {} s, {} steps ({} per period), {} nodes per wavelength, k_t/k_f = {}",
-        fmt_sig(a.duration_s, 6),
+        "model    {} s, {} steps ({} per period), {contact}",
+        fmt_sig(shown.duration_s, 6),
         resp.steps,
         a.steps_per_period,
-        a.nodes_per_wavelength,
-        fmt_sig(a.tangential_stiffness_ratio, 6)
     )?;
-    writeln!(out, "status   {} (steady solver: {})", status(&r.result), r.steady.status)?;
+    match &r.steady {
+        Some(st) => writeln!(out, "status   {} (steady solver: {})", status(&r.result), st.status)?,
+        None => writeln!(out, "status   {} (bar-type motor: no steady solver)", status(&r.result))?,
+    }
     writeln!(out)?;
     let rows: Vec<Vec<String>> =
         quantities(r).into_iter().map(|(n, v, u, m)| vec![n.into(), fmt_sig(v, 6), u.into(), m.into()]).collect();
@@ -327,16 +466,16 @@ fn print_single(r: &Run, motor: &Motor, a: &StepArgs, out: &mut dyn Write) -> Re
     Ok(())
 }
 
-fn print_sweep(runs: &[Run], out: &mut dyn Write) -> Result<()> {
+fn print_sweep(runs: &[Run], drive_name: &str, out: &mut dyn Write) -> Result<()> {
     let picked = ["final_speed_rpm", "delay_s", "rise_time_s", "overshoot", "settling_time_s", "steady_speed_rpm"];
     let mut header =
-        vec!["voltage_v".to_string(), "frequency_hz".into(), "phase_difference_deg".into(), "status".into()];
+        vec![drive_name.to_string(), "frequency_hz".into(), "phase_difference_deg".into(), "status".into()];
     header.extend(picked.iter().map(|s| s.to_string()));
     let rows: Vec<Vec<String>> = runs
         .iter()
         .map(|r| {
             let q = quantities(r);
-            let mut row = vec![fmt_sig(r.voltage_v, 6), fmt_sig(r.frequency_hz, 6), fmt_sig(r.phase_deg, 6)];
+            let mut row = vec![fmt_sig(r.drive, 6), fmt_sig(r.frequency_hz, 6), fmt_sig(r.phase_deg, 6)];
             row.push(status(&r.result).into());
             row.extend(picked.iter().map(|p| q.iter().find(|x| x.0 == *p).map_or("-".into(), |x| fmt_sig(x.1, 5))));
             row
@@ -349,8 +488,8 @@ fn print_sweep(runs: &[Run], out: &mut dyn Write) -> Result<()> {
     Ok(())
 }
 
-fn table_csv(runs: &[Run]) -> String {
-    let mut s = String::from("voltage_v,frequency_hz,phase_difference_deg,status");
+fn table_csv(runs: &[Run], drive_name: &str) -> String {
+    let mut s = format!("{drive_name},frequency_hz,phase_difference_deg,status");
     if let Some(r) = runs.first() {
         for q in quantities(r) {
             s.push(',');
@@ -361,7 +500,7 @@ fn table_csv(runs: &[Run]) -> String {
     for r in runs {
         s.push_str(&format!(
             "{},{},{},{}",
-            csv_number(r.voltage_v),
+            csv_number(r.drive),
             csv_number(r.frequency_hz),
             csv_number(r.phase_deg),
             status(&r.result)
@@ -420,7 +559,7 @@ fn snapshots_csv(r: &StepResponse, mu: f64) -> String {
     s
 }
 
-fn speed_plot(resp: &StepResponse, r: &Run, motor: &Motor, a: &StepArgs) -> LinePlot {
+fn speed_plot(resp: &StepResponse, r: &Run, name: &str, drive_unit: &str, preload_n: f64, torque_nm: f64) -> LinePlot {
     let t = &resp.series;
     let line = |y: &[f64], color, label: &str, stroke| Line {
         label: Some(label.into()),
@@ -432,9 +571,8 @@ fn speed_plot(resp: &StepResponse, r: &Run, motor: &Motor, a: &StepArgs) -> Line
         line(&t.speed_rpm, RGBColor(170, 170, 170), "rotor speed", Stroke::Solid),
         line(&t.speed_period_mean_rpm, series_color(0, 3), "mean over a drive period", Stroke::Solid),
     ];
-    if r.steady.speed_rpm.is_finite() {
+    if let Some(v) = r.steady.map(|s| s.speed_rpm).filter(|v| v.is_finite()) {
         let (t0, t1) = (t.time_s.first().copied().unwrap_or(0.0), t.time_s.last().copied().unwrap_or(0.0));
-        let v = r.steady.speed_rpm;
         lines.push(Line {
             label: Some("steady-state solver".into()),
             color: series_color(2, 3),
@@ -443,14 +581,14 @@ fn speed_plot(resp: &StepResponse, r: &Run, motor: &Motor, a: &StepArgs) -> Line
         });
     }
     LinePlot {
-        title: format!("{}: rotor speed after switch-on (stick-slip contact)", motor.name),
+        title: format!("{name}: rotor speed after switch-on (stick-slip contact)"),
         subtitle: format!(
-            "drive voltage {} V, drive frequency {} kHz, phase {}°, preload {} N, load torque {} N·m",
-            fmt_sig(r.voltage_v, 6),
+            "drive {} {drive_unit}, drive frequency {} kHz, phase {}°, preload {} N, load torque {} N·m",
+            fmt_sig(r.drive, 6),
             fmt_sig(r.frequency_hz / 1e3, 6),
             fmt_sig(r.phase_deg, 6),
-            fmt_sig(a.preload_n, 6),
-            fmt_sig(a.torque_nm, 6)
+            fmt_sig(preload_n, 6),
+            fmt_sig(torque_nm, 6)
         ),
         x: "time_s".into(),
         y: "speed_rpm".into(),

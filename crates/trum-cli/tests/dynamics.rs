@@ -359,6 +359,8 @@ fn step_sweep_over_phase_table() {
     let rev = runs[0]["quantities"]["final_speed_rpm"].as_f64().expect("speed");
     assert!(fwd > 0.0 && rev < 0.0 && (fwd + rev).abs() < 0.05 * fwd, "{fwd} {rev}");
     let (h, rows) = csv_rows(&std::fs::read_to_string(&table).expect("table"));
+    // -90 deg is motion the other way: status ok, negative speed, the forward run's delay
+    assert_eq!((rows[0][3].as_str(), rows[2][3].as_str()), ("ok", "ok"));
     assert_eq!(&h[..4], ["voltage_v", "frequency_hz", "phase_difference_deg", "status"]);
     let col = |name: &str| h.iter().position(|c| c == name).expect("column");
     let speed: Vec<f64> = rows.iter().map(|r| num(&r[col("final_speed_rpm")])).collect();
@@ -367,6 +369,8 @@ fn step_sweep_over_phase_table() {
     assert!(speed[1].abs() < 1e-3 * speed[2], "{speed:?}");
     assert_eq!(rows[1][3], "not_moving");
     assert_eq!(rows[1][col("delay_s")], "", "no metrics for a standing wave: empty, not NaN");
+    let delay = |i: usize| num(&rows[i][col("delay_s")]);
+    assert!((delay(0) - delay(2)).abs() < 1e-6 * delay(2), "{} vs {}", delay(0), delay(2));
 }
 
 #[test]
@@ -440,4 +444,64 @@ fn identify_hertz_takes_the_motors_feedback_gain() {
     // without a motor the gain must be given
     let e = fails(&["identify-hertz", "--data", p(&data), "--frequency-hz", "40950", "--voltage-v", "200"]);
     assert!(e.contains("--feedback-gain-v-per-m is needed"), "{e}");
+
+/// `trum step --motor bar36`: the bar-type motor at the paper's conditions by default
+/// (0.25 N m, 36.7 kHz, 90 deg), the same numbers as trum-core, a moment sweep with the
+/// drive column named for the moment, and clear errors for ring-only flags and commands.
+#[test]
+fn step_runs_the_bar_type_motor_and_ring_commands_refuse_it() {
+    use trum_core::dynamics::bar_type::bar_step_response;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let series = dir.path().join("s.csv");
+    let out = ok(&["step", "--motor", "bar36", "--duration-s", "0.01", "-o", p(&series)]);
+    assert!(out.contains("drive    0.25 N m, 36700 Hz, phase 90 deg, preload 40 N"), "{out}");
+    assert!(out.contains("status   ok (bar-type motor: no steady solver)"), "{out}");
+    let bar = trum_core::presets::find_bar("bar36").expect("preset").motor();
+    let core = bar_step_response(
+        &bar,
+        &trum_core::dynamics::bar_type::BarStepConfig { duration_s: 0.01, ..bar.step_config() },
+    )
+    .expect("core");
+    let value = |name: &str| {
+        let line = out.lines().find(|l| l.starts_with(&format!("{name} "))).expect("quantity printed");
+        num(line.split_whitespace().nth(1).expect("value"))
+    };
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-5 * b.abs();
+    assert!(close(value("final_speed_rpm"), core.averages.speed_rpm));
+    assert!(close(value("rise_to_final_s"), core.metrics.rise_to_final_s.expect("rise")));
+    let (h, rows) = csv_rows(&std::fs::read_to_string(&series).expect("series"));
+    assert_eq!(h[0], "time_s");
+    assert_eq!(rows.len(), core.series.time_s.len());
+
+    let table = dir.path().join("t.csv");
+    ok(&["step", "--motor", "bar36", "--moment-nm", "0.15:0.35:2", "--duration-s", "0.01", "--table", p(&table)]);
+    let (h, rows) = csv_rows(&std::fs::read_to_string(&table).expect("table"));
+    assert_eq!(&h[..4], ["moment_nm", "frequency_hz", "phase_difference_deg", "status"]);
+    let col = |name: &str| h.iter().position(|c| c == name).expect("column");
+    let delay: Vec<f64> = rows.iter().map(|r| num(&r[col("delay_s")])).collect();
+    assert!(delay[1] < delay[0], "a larger moment starts sooner: {delay:?}");
+    assert_eq!(rows[0][col("steady_speed_rpm")], "", "no steady solver for a bar-type motor");
+
+    let e = fails(&["step", "--motor", "bar36", "--voltage-v", "100"]);
+    assert!(e.contains("--moment-nm"), "{e}");
+    let e = fails(&["step", "--motor", "bar36", "--moment-nm", "-1"]);
+    assert!(e.contains("--moment-nm = -1: must be finite and > 0"), "{e}");
+    let e = fails(&["step", "--motor", "trum60a", "--moment-nm", "0.2"]);
+    assert!(e.contains("--voltage-v"), "{e}");
+    let map = dir.path().join("m.csv");
+    let e = fails(&["map", "--motor", "bar36", "-o", p(&map)]);
+    assert!(e.contains("bar-type") && e.contains("trum step"), "{e}");
+    assert!(!map.exists());
+    // a bar-type motor file: overrides on the preset, read by step, refused by point
+    let file = dir.path().join("bar.toml");
+    std::fs::write(&file, "preset = \"bar36\"\n[stator]\nquality_factor = -5\n").expect("write");
+    let e = fails(&["step", "--motor", p(&file)]);
+    assert!(e.contains("line 3") && e.contains("stator.quality_factor"), "{e}");
+    std::fs::write(&file, "preset = \"bar36\"\n[drive]\npreload_n = 30\n").expect("write");
+    let out = ok(&["step", "--motor", p(&file), "--duration-s", "0.005", "--nodes-per-wavelength", "64"]);
+    assert!(out.contains("preload 30 N"), "{out}");
+    let e = fails(&["point", "--motor", p(&file), "--preload-n", "30"]);
+    assert!(e.contains("bar-type motor file"), "{e}");
+    let shown = ok(&["presets", "show", "bar36"]);
+    assert!(shown.contains("kind = \"bar\"") && shown.contains("natural_frequency_hz = 36500.0"), "{shown}");
 }

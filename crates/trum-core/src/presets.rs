@@ -6,6 +6,7 @@
 //! figures the presets are checked against are in `tests/data/papers/` and
 //! `tests/papers.rs`; `crates/trum-core/examples/fit_presets.rs` recalibrates them.
 
+use crate::dynamics::bar_type::BarMotor;
 use crate::error::ParamError;
 use crate::params::*;
 
@@ -134,16 +135,72 @@ pub static PRESETS: &[Preset] = &[
     },
 ];
 
-/// Looks up a preset by name; the error lists the valid names.
+/// A bar-type motor preset ([`crate::dynamics::bar_type`]): its name, description and
+/// annotated bar-type motor file. Only the step response runs these motors.
+#[derive(Clone, Debug)]
+pub struct BarPreset {
+    /// Name used on the command line (`bar36`).
+    pub name: &'static str,
+    /// One-line description.
+    pub summary: &'static str,
+    /// Sources.
+    pub sources: &'static str,
+    /// The annotated, complete bar-type motor file (`crates/trum-core/presets/NAME.toml`).
+    pub toml: &'static str,
+}
+
+impl BarPreset {
+    /// The motor. The embedded files are checked by the tests of this module.
+    pub fn motor(&self) -> BarMotor {
+        let mut m = BarMotor::from_toml_str(self.toml, &format!("presets/{}.toml", self.name))
+            .unwrap_or_else(|e| panic!("built-in preset file is invalid: {e}"));
+        m.preset = Some(self.name.to_string());
+        m
+    }
+
+    /// Provenance of one value: the comment beside `section.key` in the preset file.
+    pub fn note(&self, dotted: &str) -> Option<&'static str> {
+        Preset { name: self.name, summary: self.summary, sources: self.sources, toml: self.toml }.note(dotted)
+    }
+
+    /// The preset as a commented bar-type motor file that reads back to the same motor.
+    pub fn to_toml(&self) -> String {
+        let header = format!(
+            "trum bar-type motor file: preset '{}'\n{}\nSources: {}\nEvery value is SI; the comment gives its provenance.\n",
+            self.name, self.summary, self.sources
+        );
+        self.motor().to_toml_annotated(&header, &|k| self.note(k).map(str::to_string))
+    }
+}
+
+/// All bar-type presets.
+pub static BAR_PRESETS: &[BarPreset] = &[BarPreset {
+    name: "bar36",
+    summary: "A bar-type motor (rigid-disc stator, 36.5 kHz, Q 200) at the conditions of the bar-type transient paper's simulation",
+    sources: "Transient analysis of bar-type ultrasonic motors (section IV): natural frequency, Q, drive moment and frequency, 256 contact nodes; the rest assumed",
+    toml: include_str!("../presets/bar36.toml"),
+}];
+
+/// Looks up a bar-type preset by name.
+pub fn find_bar(name: &str) -> Option<&'static BarPreset> {
+    BAR_PRESETS.iter().find(|p| p.name == name)
+}
+
+/// Looks up a preset by name; the error lists the valid names, and says so when the
+/// name is a bar-type preset (which only the step response runs).
 pub fn find(name: &str) -> Result<&'static Preset, ParamError> {
     PRESETS.iter().find(|p| p.name == name).ok_or_else(|| ParamError {
         source_name: "presets".into(),
         line: None,
         key: "preset".into(),
-        reason: format!(
-            "unknown preset '{name}'; valid presets are: {}",
-            PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
-        ),
+        reason: if find_bar(name).is_some() {
+            format!("'{name}' is a bar-type motor: only the step response (`trum step`, Python `trum.step`) runs it; the ring-motor presets are: {}", PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", "))
+        } else {
+            format!(
+                "unknown preset '{name}'; valid presets are: {}",
+                PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
+            )
+        },
     })
 }
 
@@ -195,6 +252,26 @@ mod tests {
                 let dotted = format!("effects.{}", e.name());
                 assert!(p.note(&dotted).is_some_and(|n| n.len() > 20), "{}: {dotted} says not why", p.name);
             }
+        }
+    }
+
+    /// Every bar-type preset file parses, every key has a provenance comment naming the
+    /// paper or saying it is assumed, and `to_toml` reads back to the same motor; its
+    /// name is refused by the ring-motor lookup with a message saying what runs it.
+    #[test]
+    fn bar_presets_are_annotated_round_trip_and_are_refused_by_ring_commands() {
+        for p in BAR_PRESETS {
+            let m = p.motor();
+            for (sec, key, _, _) in crate::dynamics::bar_type::BAR_KEYS {
+                let dotted = format!("{sec}.{key}");
+                let note = p.note(&dotted).unwrap_or_else(|| panic!("{}: {dotted} has no provenance", p.name));
+                assert!(note.starts_with("paper") || note.starts_with("assumed: "), "{}: {dotted}: {note}", p.name);
+            }
+            let back = BarMotor::from_toml_str(&p.to_toml(), "show").expect("reads back");
+            assert_eq!(BarMotor { preset: m.preset.clone(), ..back }, m);
+            let e = find(p.name).expect_err("not a ring preset");
+            assert!(e.reason.contains("bar-type") && e.reason.contains("trum step"), "{e}");
+            assert!(PRESETS.iter().all(|r| r.name != p.name));
         }
     }
 

@@ -7,10 +7,13 @@ use crate::{detached, input_err, raise, PyMotor};
 use numpy::{PyArray, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use trum_core::dynamics::bar_type::{bar_step_response, BarMotor, BarStepConfig};
 use trum_core::dynamics::hertz::{
     identify_beta, BetaIdentificationInput, HertzError, HertzOscillator, OperatingPoint, ResponseMethod,
 };
-use trum_core::dynamics::transient::{steady_comparison, step_response, TransientConfig, TransientError};
+use trum_core::dynamics::transient::{
+    steady_comparison, step_response, SteadyComparison, StepResponse, TransientConfig, TransientError,
+};
 use trum_core::layout::{
     response_rows, response_status, response_summary, ResponseCell, ResponseRow, RESPONSE_COLUMNS,
 };
@@ -238,6 +241,8 @@ fn argument(name: &str) -> &str {
         "phase_difference_rad" => "phase_difference_deg",
         "snapshot_times_s" => "snapshot_at_s",
         "load_torque_nm" => "torque_nm",
+        "moment_amplitude_nm" => "moment_nm",
+        "nodes" => "nodes_per_wavelength",
         n => n,
     }
 }
@@ -286,14 +291,103 @@ pub fn step<'py>(
         ..TransientConfig::default()
     };
     let (r, steady) = detached(py, || (step_response(m, &cfg), steady_comparison(m, &cfg)))?;
-    let r = r.map_err(|e| match e {
+    let r = r.map_err(|e| transient_err(py, e, phase_difference_deg))?;
+    response_dict(py, r, Some(steady), m.friction_layer.friction_coefficient)
+}
+
+/// A core error of a step run as the Python exception, naming the argument.
+fn transient_err(py: Python<'_>, e: TransientError, phase_difference_deg: f64) -> PyErr {
+    match e {
         TransientError::InvalidConfig { name, value, reason } => {
             let shown = if name == "phase_difference_rad" { phase_difference_deg } else { value };
             input_err(py, format!("{} = {shown}: {reason}", argument(name)))
         }
         TransientError::Diverged { .. } => raise(py, "TrumError", e.to_string(), &[]),
         e => input_err(py, e.to_string()),
-    })?;
+    }
+}
+
+/// `spec` as a bar-type motor: a bar-type preset name, or a motor file with `kind = "bar"`
+/// or a bar-type `preset`; `None` otherwise.
+fn bar_motor(py: Python<'_>, spec: &str) -> PyResult<Option<BarMotor>> {
+    if let Some(p) = trum_core::presets::find_bar(spec) {
+        return Ok(Some(p.motor()));
+    }
+    let path = std::path::Path::new(spec);
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| input_err(py, format!("cannot read '{spec}': {e}")))?;
+    if !BarMotor::is_bar_file(&text) {
+        return Ok(None);
+    }
+    BarMotor::from_toml_str(&text, spec).map(Some).map_err(|e| crate::param_err(py, &e))
+}
+
+/// True when `spec` names a bar-type motor (preset or file).
+#[pyfunction]
+pub fn is_bar_motor(py: Python<'_>, spec: &str) -> PyResult<bool> {
+    Ok(bar_motor(py, spec)?.is_some())
+}
+
+/// The `[drive]` defaults of a bar-type motor: moment, frequency, phase, preload, duration.
+#[pyfunction]
+pub fn bar_defaults(py: Python<'_>, spec: &str) -> PyResult<Vec<(&'static str, f64)>> {
+    let m = bar_motor(py, spec)?.ok_or_else(|| input_err(py, format!("'{spec}' is not a bar-type motor")))?;
+    let c = m.step_config();
+    Ok(vec![
+        ("moment_nm", m.moment_amplitude_nm),
+        ("frequency_hz", m.frequency_hz),
+        ("phase_difference_deg", m.phase_difference_deg),
+        ("preload_n", m.preload_n),
+        ("duration_s", c.duration_s),
+    ])
+}
+
+/// Step response of a bar-type motor ([BarTransient] eq. 1-5, docs/DYNAMICS.md), `spec` a
+/// bar-type preset name or motor file. The same dict as [`step`], with `steady` `None`.
+#[pyfunction]
+#[pyo3(signature = (spec, moment_nm, frequency_hz, phase_difference_deg, preload_n, torque_nm, duration_s,
+    steps_per_period, nodes_per_wavelength, record_every, snapshot_at_s))]
+#[allow(clippy::too_many_arguments)]
+pub fn bar_step<'py>(
+    py: Python<'py>,
+    spec: &str,
+    moment_nm: f64,
+    frequency_hz: f64,
+    phase_difference_deg: f64,
+    preload_n: f64,
+    torque_nm: f64,
+    duration_s: f64,
+    steps_per_period: usize,
+    nodes_per_wavelength: usize,
+    record_every: usize,
+    snapshot_at_s: Vec<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = bar_motor(py, spec)?.ok_or_else(|| input_err(py, format!("'{spec}' is not a bar-type motor")))?;
+    let cfg = BarStepConfig {
+        duration_s,
+        steps_per_period,
+        nodes: nodes_per_wavelength,
+        phase_difference_rad: phase_difference_deg.to_radians(),
+        load_torque_nm: torque_nm,
+        moment_amplitude_nm: moment_nm,
+        frequency_hz,
+        preload_n,
+        record_every,
+        snapshot_times_s: snapshot_at_s,
+    };
+    let r = detached(py, || bar_step_response(&m, &cfg))?.map_err(|e| transient_err(py, e, phase_difference_deg))?;
+    response_dict(py, r, None, m.static_friction_coefficient)
+}
+
+/// The dict of a step run; `mu` is the Coulomb limit written beside the friction force.
+fn response_dict<'py>(
+    py: Python<'py>,
+    r: StepResponse,
+    steady: Option<SteadyComparison>,
+    mu: f64,
+) -> PyResult<Bound<'py, PyDict>> {
     let series = PyDict::new(py);
     let t = r.series;
     for (k, v) in [
@@ -315,6 +409,8 @@ pub fn step<'py>(
             ("peak_speed_rpm", Some(mt.peak_speed_rpm)),
             ("delay_s", mt.delay_s),
             ("rise_time_s", mt.rise_time_s),
+            ("rise_to_final_s", mt.rise_to_final_s),
+            ("peak_time_s", mt.peak_time_s),
             ("overshoot", mt.overshoot),
             ("settling_time_s", mt.settling_time_s),
         ],
@@ -332,16 +428,21 @@ pub fn step<'py>(
             ("stick_fraction", a.stick_fraction),
         ],
     )?;
-    let st = float_dict(
-        py,
-        &[
-            ("speed_rpm", steady.speed_rpm),
-            ("contact_torque_nm", steady.contact_torque_nm),
-            ("amplitude_m", steady.amplitude_m),
-        ],
-    )?;
-    st.set_item("status", steady.status.as_str())?;
-    let mu = m.friction_layer.friction_coefficient;
+    let st = match steady {
+        Some(steady) => {
+            let st = float_dict(
+                py,
+                &[
+                    ("speed_rpm", steady.speed_rpm),
+                    ("contact_torque_nm", steady.contact_torque_nm),
+                    ("amplitude_m", steady.amplitude_m),
+                ],
+            )?;
+            st.set_item("status", steady.status.as_str())?;
+            Some(st)
+        }
+        None => None,
+    };
     let mut snaps = Vec::with_capacity(r.snapshots.len());
     for s in &r.snapshots {
         let d = PyDict::new(py);

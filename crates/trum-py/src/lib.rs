@@ -632,6 +632,9 @@ fn _trum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dynamics::hertz_response, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::hertz_identify, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::step, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::bar_step, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::is_bar_motor, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::bar_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(diagnosis::diagnose_csv, m)?)?;
     m.add_function(wrap_pyfunction!(diagnosis::calibrate_csv, m)?)?;
     m.add("STATUS_NAMES", STATUS_NAMES.to_vec())?;

@@ -143,9 +143,33 @@ def test_step_settles_near_the_steady_solver_and_reverses():
     np.testing.assert_allclose(np.abs(f[slip]), lim[slip], rtol=1e-9)
     back = trum.step(BASE, phase_difference_deg=-90.0, **FAST)
     assert back.averages["speed_rpm"] == pytest.approx(-r.averages["speed_rpm"], rel=1e-6)
+    # -90 deg is motion the other way: ok, negative speed, the same delay
+    assert back.status == "ok" and back.metrics["final_speed_rpm"] < 0
+    assert back.metrics["delay_s"] == pytest.approx(r.metrics["delay_s"], rel=1e-6)
     standing = trum.step(BASE, phase_difference_deg=0.0, **FAST)
     assert standing.status == "not_moving" and standing.metrics["delay_s"] is None
     assert abs(standing.averages["speed_rpm"]) < 1e-3 * r.averages["speed_rpm"]
+
+
+def test_step_runs_the_bar_type_motor_at_the_papers_conditions():
+    r = trum.step("bar36", duration_s=10e-3, nodes_per_wavelength=128)
+    # the bar-type transient paper: rises in about 2 ms with overshoot (docs/DYNAMICS.md)
+    assert r.status == "ok" and r.steady is None and np.isnan(r.speed_difference())
+    assert 1.5e-3 < r.metrics["rise_to_final_s"] < 2.5e-3 < r.metrics["peak_time_s"]
+    assert r.metrics["overshoot"] > 0.05 and r.averages["speed_rpm"] > 100
+    stronger = trum.step("bar36", moment_nm=0.4, duration_s=10e-3, nodes_per_wavelength=128)
+    assert stronger.metrics["delay_s"] < r.metrics["delay_s"]
+    assert stronger.metrics["overshoot"] > r.metrics["overshoot"]
+    back = trum.step("bar36", phase_difference_deg=-90, duration_s=10e-3, nodes_per_wavelength=128)
+    assert back.status == "ok" and back.averages["speed_rpm"] == pytest.approx(-r.averages["speed_rpm"], rel=1e-6)
+    with pytest.raises(trum.InputError, match="moment_nm"):
+        trum.step("bar36", voltage_v=100)
+    with pytest.raises(trum.InputError, match=r"moment_nm = -1: must be finite and > 0"):
+        trum.step("bar36", moment_nm=-1)
+    with pytest.raises(trum.InputError, match="voltage_v"):
+        trum.step("trum60a", moment_nm=0.2)
+    with pytest.raises(trum.ParameterError, match="bar-type"):
+        trum.Motor("bar36")
 
 
 def test_step_errors():

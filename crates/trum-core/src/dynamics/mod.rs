@@ -7,8 +7,13 @@
 //!   (feedback) voltage (eq. 5-9) and a fixed-step RK4 time simulation with constant
 //!   frequency and slow linear sweeps. The spec names this effect `hertz_softening`.
 //!
+//! * [`transient`]: the step response with a discretised stick-slip contact (ring motor).
+//! * [`bar_type`]: the bar-type motor (rigid-disc stator driven by a moment) on the same
+//!   integrator and contact step.
+//!
 //! Equations, deviations from the printed forms and the test tolerances are collected in
 //! `docs/DYNAMICS.md`, section "Hertzian oscillator".
 
+pub mod bar_type;
 pub mod hertz;
 pub mod transient;

@@ -46,7 +46,7 @@ use crate::solve::{solve, OperatingPoint, Status};
 use thiserror::Error;
 
 mod metrics;
-mod sim;
+pub(crate) mod sim;
 #[cfg(test)]
 mod tests;
 
@@ -240,12 +240,19 @@ impl Snapshot {
 pub struct StepMetrics {
     /// Final speed: mean over the averaging window at the end of the run [rpm].
     pub final_speed_rpm: f64,
-    /// Largest period-averaged speed [rpm].
+    /// Largest period-averaged speed in the direction of the final speed (the most
+    /// negative one when the rotor turns backwards) [rpm].
     pub peak_speed_rpm: f64,
     /// Delay time: first time the speed reaches 50 % of the final speed [s].
     pub delay_s: Option<f64>,
     /// Rise time from 10 % to 90 % of the final speed [s].
     pub rise_time_s: Option<f64>,
+    /// 0-100 % rise time: first time the speed reaches the final speed [s] (the rise
+    /// time of an underdamped response in Ogata's definitions; `None` without overshoot
+    /// when the speed never reaches it).
+    pub rise_to_final_s: Option<f64>,
+    /// Peak time: when the speed reaches its largest value [s].
+    pub peak_time_s: Option<f64>,
     /// Overshoot (peak − final)/final, ≥ 0 [-].
     pub overshoot: Option<f64>,
     /// Time after which the speed stays within ±2 % of the final speed [s]
@@ -254,8 +261,9 @@ pub struct StepMetrics {
 }
 
 impl StepMetrics {
-    /// `ok`; `not_moving` (no positive final speed, so no metrics, e.g. a standing wave);
-    /// `not_settled` (still outside the ±2 % band at the end of the run).
+    /// `ok` (moving, in either direction: a negative final speed is rotation the other
+    /// way); `not_moving` (the rotor is at rest at the end, so no metrics, e.g. a standing
+    /// wave); `not_settled` (still outside the ±2 % band at the end of the run).
     pub fn status(&self) -> &'static str {
         if self.delay_s.is_none() {
             "not_moving"
@@ -350,16 +358,35 @@ impl TransientConfig {
 pub fn step_response(motor: &Motor, cfg: &TransientConfig) -> Result<StepResponse, TransientError> {
     cfg.validate()?;
     motor.validate("motor", None).map_err(|e| TransientError::InvalidMotor(e.to_string()))?;
-    let out = sim::run(motor, cfg)?;
-    let metrics = step_metrics(&out.series.time_s, &out.series.speed_period_mean_rpm, out.averages.speed_rpm);
-    Ok(StepResponse {
+    let plant = sim::ring_plant(motor, cfg);
+    Ok(response(sim::run(&plant)?, &plant))
+}
+
+/// Fraction of the stator surface's peak tangential speed below which a settled rotor
+/// counts as at rest (`not_moving`): a standing wave leaves the rotor at rounding-error
+/// speeds, a travelling wave drives it at a sizeable fraction of the surface speed.
+pub const REST_SPEED_FRACTION: f64 = 1e-3;
+
+/// The metrics of a run's period-averaged speed. A final speed of either sign is motion
+/// (a reversed travelling wave turns the rotor backwards); one below
+/// [`REST_SPEED_FRACTION`] of the surface speed ω·h0·k·A/R0 is rest.
+pub(crate) fn response(out: sim::RunOutput, plant: &sim::Plant) -> StepResponse {
+    let k = plant.n_waves / plant.r0;
+    let surface_rpm = crate::stator::angular_frequency(plant.frequency_hz) * plant.h0 * k * out.averages.amplitude_m
+        / plant.r0
+        * crate::solve::RAD_S_TO_RPM;
+    let v = out.averages.speed_rpm;
+    let moving = v.abs() > REST_SPEED_FRACTION * surface_rpm;
+    let mut metrics = step_metrics(&out.series.time_s, &out.series.speed_period_mean_rpm, if moving { v } else { 0.0 });
+    metrics.final_speed_rpm = v;
+    StepResponse {
         series: out.series,
         metrics,
         averages: out.averages,
         snapshots: out.snapshots,
         time_step_s: out.time_step_s,
         steps: out.steps,
-    })
+    }
 }
 
 /// The steady-state solver's answer at the operating point of a run, in the terms of

@@ -289,13 +289,13 @@ class Snapshot:
 
 @dataclass(frozen=True)
 class StepResult:
-    """Result of :func:`step`."""
+    """Result of :func:`step`. ``steady`` is ``None`` for a bar-type motor (no steady solver)."""
 
     series: Dict[str, np.ndarray]
     metrics: Dict[str, Optional[float]]
-    status: str  # 'ok', 'not_moving' or 'not_settled'
+    status: str  # 'ok' (moving, either way: a negative speed turns backwards), 'not_moving' or 'not_settled'
     averages: Dict[str, float]
-    steady: Dict[str, Any]
+    steady: Optional[Dict[str, Any]]
     snapshots: List[Snapshot] = field(default_factory=list)
     time_step_s: float = 0.0
     steps: int = 0
@@ -304,7 +304,10 @@ class StepResult:
     motor: str = ""
 
     def speed_difference(self) -> float:
-        """(settled transient speed − steady-solver speed) / steady-solver speed."""
+        """(settled transient speed − steady-solver speed) / steady-solver speed (NaN
+        without a steady solver)."""
+        if self.steady is None:
+            return float("nan")
         return (self.averages["speed_rpm"] - self.steady["speed_rpm"]) / self.steady["speed_rpm"]
 
     def to_pandas(self) -> Any:
@@ -352,49 +355,81 @@ def _require_name(motor: Any) -> str:
 def step(
     motor: Union[Motor, str],
     *,
-    voltage_v: float = 200.0,
-    frequency_hz: float = 43e3,
-    phase_difference_deg: float = 90.0,
-    preload_n: float = 260.0,
+    voltage_v: Optional[float] = None,
+    moment_nm: Optional[float] = None,
+    frequency_hz: Optional[float] = None,
+    phase_difference_deg: Optional[float] = None,
+    preload_n: Optional[float] = None,
     torque_nm: float = 0.0,
-    duration_s: float = 10e-3,
+    duration_s: Optional[float] = None,
     steps_per_period: int = 64,
     nodes_per_wavelength: int = 256,
-    tangential_stiffness_ratio: float = 300.0,
+    tangential_stiffness_ratio: Optional[float] = None,
     record_every: int = 16,
     snapshot_at_s: Sequence[float] = (),
 ) -> StepResult:
     """Step response of the rotor speed with the stick-slip contact ([BarTransient]): the drive
-    switches on at t = 0. Returns the time series, the metrics (delay, rise time,
-    overshoot, settling time; ``None`` where undefined, e.g. a standing wave at 0°), the
-    settled averages, the steady-state solver at the same point and the contact
-    snapshots at ``snapshot_at_s``. The GIL is released while it runs."""
+    switches on at t = 0. Returns the time series, the metrics (delay, rise times,
+    peak time, overshoot, settling time; ``None`` where undefined, e.g. a standing wave at
+    0°), the settled averages, the steady-state solver at the same point and the contact
+    snapshots at ``snapshot_at_s``. A negative final speed (e.g. at −90°) is rotation the
+    other way, status ``ok``. The GIL is released while it runs.
+
+    ``motor``: a ring motor (``trum.Motor`` or preset name; driven by ``voltage_v``,
+    default 200 V at 43 kHz, 260 N, 10 ms) or a bar-type motor (preset name such as
+    ``"bar36"`` or a bar-type motor file path; driven by ``moment_nm``, every default from
+    the motor's ``[drive]``: 0.25 N·m at 36.7 kHz, 40 N, 15 ms for ``bar36``)."""
     for name, v in (("steps_per_period", steps_per_period), ("nodes_per_wavelength", nodes_per_wavelength),
                     ("record_every", record_every)):
         if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 0:
             raise InputError(f"{name}: expected a whole number, got {v!r}")
-    m = motor if isinstance(motor, Motor) else Motor(_require_name(motor))
-    # A paper preset may carry effects its paper's model includes (docs/PRESETS.md); the
-    # transient model has none of them, so it runs on the preset's baseline and says so,
-    # as `trum step` does. Effects a user switched on are still refused.
-    if m.preset_name is not None and m.active_effects and m.active_effects == Motor(m.preset_name).active_effects:
-        warnings.warn(
-            f"the transient model has no unmodelled effects: {m.preset_name} runs without its "
-            f"{', '.join(m.active_effects)}",
-            stacklevel=2,
+    snaps_at = [float(t) for t in snapshot_at_s]
+    if isinstance(motor, str) and _trum.is_bar_motor(motor):
+        if voltage_v is not None:
+            raise InputError("voltage_v: a bar-type motor is driven by a moment; give moment_nm")
+        if tangential_stiffness_ratio is not None:
+            raise InputError(
+                "tangential_stiffness_ratio: a bar-type motor file sets contact.tangential_stiffness_n_per_m2"
+            )
+        dflt = dict(_trum.bar_defaults(motor))
+        pick = lambda v, k: float(dflt[k] if v is None else v)  # noqa: E731
+        d = _trum.bar_step(
+            motor, pick(moment_nm, "moment_nm"), pick(frequency_hz, "frequency_hz"),
+            pick(phase_difference_deg, "phase_difference_deg"), pick(preload_n, "preload_n"), float(torque_nm),
+            pick(duration_s, "duration_s"), int(steps_per_period), int(nodes_per_wavelength), int(record_every),
+            snaps_at,
         )
-        m = m.with_effects("none")
-    d = _trum.step(
-        _motor(m), float(voltage_v), float(frequency_hz), float(phase_difference_deg), float(preload_n),
-        float(torque_nm), float(duration_s), int(steps_per_period), int(nodes_per_wavelength),
-        float(tangential_stiffness_ratio), int(record_every), [float(t) for t in snapshot_at_s],
-    )
+        cond = {"moment_nm": pick(moment_nm, "moment_nm"), "frequency_hz": pick(frequency_hz, "frequency_hz"),
+                "preload_n": pick(preload_n, "preload_n"), "torque_nm": float(torque_nm)}
+        name = motor
+    else:
+        if moment_nm is not None:
+            raise InputError("moment_nm drives a bar-type motor; a ring motor is driven by voltage_v")
+        m = motor if isinstance(motor, Motor) else Motor(_require_name(motor))
+        # A paper preset may carry effects its paper's model includes (docs/PRESETS.md); the
+        # transient model has none of them, so it runs on the preset's baseline and says so,
+        # as `trum step` does. Effects a user switched on are still refused.
+        if m.preset_name is not None and m.active_effects and m.active_effects == Motor(m.preset_name).active_effects:
+            warnings.warn(
+                f"the transient model has no unmodelled effects: {m.preset_name} runs without its "
+                f"{', '.join(m.active_effects)}",
+                stacklevel=2,
+            )
+            m = m.with_effects("none")
+        opt = lambda v, default: float(default if v is None else v)  # noqa: E731
+        d = _trum.step(
+            _motor(m), opt(voltage_v, 200.0), opt(frequency_hz, 43e3), opt(phase_difference_deg, 90.0),
+            opt(preload_n, 260.0), float(torque_nm), opt(duration_s, 10e-3), int(steps_per_period),
+            int(nodes_per_wavelength), opt(tangential_stiffness_ratio, 300.0), int(record_every), snaps_at,
+        )
+        cond = {"voltage_v": opt(voltage_v, 200.0), "frequency_hz": opt(frequency_hz, 43e3),
+                "preload_n": opt(preload_n, 260.0), "torque_nm": float(torque_nm)}
+        name = m.name
     snaps = []
     for s in d["snapshots"]:
         s = dict(s)
         s["state"] = np.array(s["state"], dtype=object)
         snaps.append(Snapshot(**s))
-    cond = {"voltage_v": float(voltage_v), "frequency_hz": float(frequency_hz), "preload_n": float(preload_n),
-            "torque_nm": float(torque_nm)}
-    return StepResult(dict(d["series"]), dict(d["metrics"]), d["status"], dict(d["averages"]), dict(d["steady"]),
-                      snaps, d["time_step_s"], d["steps"], cond, m.name)
+    steady = None if d["steady"] is None else dict(d["steady"])
+    return StepResult(dict(d["series"]), dict(d["metrics"]), d["status"], dict(d["averages"]), steady,
+                      snaps, d["time_step_s"], d["steps"], cond, name)

@@ -12,6 +12,7 @@ _LABELS: Dict[str, Tuple[str, str, float]] = {
     "preload_n": ("Preload", "N", 1.0),
     "torque_nm": ("Load torque", "N·m", 1.0),
     "voltage_v": ("Drive voltage", "V", 1.0),
+    "moment_nm": ("Drive moment", "N·m", 1.0),
     "frequency_hz": ("Drive frequency", "kHz", 1e-3),
     "elapsed_s": ("Time since switch-on", "s", 1.0),
     "speed_rpm": ("Speed", "rpm", 1.0),

@@ -117,6 +117,21 @@ def step(
     record_every: int,
     snapshot_at_s: Sequence[float],
 ) -> Dict[str, Any]: ...
+def bar_step(
+    spec: str,
+    moment_nm: float,
+    frequency_hz: float,
+    phase_difference_deg: float,
+    preload_n: float,
+    torque_nm: float,
+    duration_s: float,
+    steps_per_period: int,
+    nodes_per_wavelength: int,
+    record_every: int,
+    snapshot_at_s: Sequence[float],
+) -> Dict[str, Any]: ...
+def is_bar_motor(spec: str) -> bool: ...
+def bar_defaults(spec: str) -> List[Tuple[str, float]]: ...
 def diagnose_csv(
     motor: Motor,
     data: bytes,

@@ -81,6 +81,12 @@ fn standing_wave_does_not_turn_the_rotor_and_minus_90_reverses() {
     assert!(standing.averages.amplitude_m > 0.5 * fwd.averages.amplitude_m, "the stator still vibrates");
     assert!(rel(-back.averages.speed_rpm, v) < 1e-6, "{} vs {v}", back.averages.speed_rpm);
     assert!(standing.metrics.delay_s.is_none());
+    assert_eq!(standing.metrics.status(), "not_moving");
+    // the reversed wave is motion the other way, with the forward run's step figures
+    assert_eq!(back.metrics.status(), fwd.metrics.status());
+    assert!(back.metrics.final_speed_rpm < -50.0 && back.metrics.peak_speed_rpm < back.metrics.final_speed_rpm);
+    let (d_back, d_fwd) = (back.metrics.delay_s.expect("delay"), fwd.metrics.delay_s.expect("delay"));
+    assert!((d_back - d_fwd).abs() < 1e-3 * d_fwd, "{d_back} vs {d_fwd}");
 }
 
 /// Trends of the bar-type transient paper Fig. 3-5: speed grows with voltage and near resonance; the
@@ -200,6 +206,21 @@ fn metrics_match_second_order_closed_forms() {
     let ts = m.settling_time_s.expect("ts");
     assert!(ts < 4.0 / (zeta * wn) && ts > 2.0 / (zeta * wn), "{ts}");
     assert!(m.rise_time_s.expect("rise") > 0.0);
+    // 0-100 % rise t_r = (π − acos ζ)/ω_d and peak time t_p = π/ω_d (Ogata §5-3)
+    let tr = (std::f64::consts::PI - zeta.acos()) / wd;
+    assert!((m.rise_to_final_s.expect("tr") - tr).abs() < 2e-7, "{:?} vs {tr}", m.rise_to_final_s);
+    let tp = std::f64::consts::PI / wd;
+    assert!((m.peak_time_s.expect("tp") - tp).abs() < 2e-7, "{:?} vs {tp}", m.peak_time_s);
+    // the mirrored history (a rotor turning backwards) has the same figures and a negative peak
+    let neg: Vec<f64> = y.iter().map(|v| -v).collect();
+    let b = step_metrics(&t, &neg, -100.0);
+    assert_eq!(
+        (b.delay_s, b.rise_time_s, b.rise_to_final_s, b.peak_time_s),
+        (m.delay_s, m.rise_time_s, m.rise_to_final_s, m.peak_time_s)
+    );
+    assert_eq!(b.overshoot, m.overshoot);
+    assert_eq!((b.final_speed_rpm, b.peak_speed_rpm), (-100.0, -m.peak_speed_rpm));
+    assert_eq!(b.status(), "ok");
     let none = step_metrics(&t, &y, 0.0);
     assert!(none.delay_s.is_none() && none.settling_time_s.is_none() && none.overshoot.is_none());
     assert!(step_metrics(&[], &[], 1.0).delay_s.is_none());
