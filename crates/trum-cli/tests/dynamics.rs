@@ -444,6 +444,7 @@ fn identify_hertz_takes_the_motors_feedback_gain() {
     // without a motor the gain must be given
     let e = fails(&["identify-hertz", "--data", p(&data), "--frequency-hz", "40950", "--voltage-v", "200"]);
     assert!(e.contains("--feedback-gain-v-per-m is needed"), "{e}");
+}
 
 /// `trum step --motor bar36`: the bar-type motor at the paper's conditions by default
 /// (0.25 N m, 36.7 kHz, 90 deg), the same numbers as trum-core, a moment sweep with the
