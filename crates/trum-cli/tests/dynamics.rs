@@ -447,7 +447,7 @@ fn identify_hertz_takes_the_motors_feedback_gain() {
 }
 
 /// `trum step --motor bar36`: the bar-type motor at the paper's conditions by default
-/// (0.25 N m, 36.7 kHz, 90 deg), the same numbers as trum-core, a moment sweep with the
+/// (0.25 N·m, 36.7 kHz, 90 deg), the same numbers as trum-core, a moment sweep with the
 /// drive column named for the moment, and clear errors for ring-only flags and commands.
 #[test]
 fn step_runs_the_bar_type_motor_and_ring_commands_refuse_it() {
@@ -455,7 +455,7 @@ fn step_runs_the_bar_type_motor_and_ring_commands_refuse_it() {
     let dir = tempfile::tempdir().expect("tempdir");
     let series = dir.path().join("s.csv");
     let out = ok(&["step", "--motor", "bar36", "--duration-s", "0.01", "-o", p(&series)]);
-    assert!(out.contains("drive    0.25 N m, 36700 Hz, phase 90 deg, preload 40 N"), "{out}");
+    assert!(out.contains("drive    0.25 N·m, 36700 Hz, phase 90 deg, preload 40 N"), "{out}");
     assert!(out.contains("status   ok (bar-type motor: no steady solver)"), "{out}");
     let bar = trum_core::presets::find_bar("bar36").expect("preset").motor();
     let core = bar_step_response(
