@@ -99,6 +99,8 @@ struct Run {
 
 /// The motor of a run: a ring motor (driven by a voltage, with a steady solver) or a
 /// bar-type motor (driven by a moment).
+// one value per command run: the size of the larger variant costs nothing
+#[allow(clippy::large_enum_variant)]
 enum StepMotor {
     Ring(Motor),
     Bar(BarMotor),

@@ -6,7 +6,7 @@ use crate::{detached, input_err, PyMotor};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use trum_core::bench::observations;
-use trum_core::calibrate::{baseline_params_with, calibrate_refitting_bounds, rescale_uncertainties, FitOptions};
+use trum_core::calibrate::{rescale_uncertainties, Calibration, FitOptions};
 use trum_core::diagnose::json::{to_json, Provenance};
 use trum_core::diagnose::{diagnose, DiagnoseOptions};
 use trum_core::measurements::{parse_measurements_with, PlausibleRanges};
@@ -63,10 +63,12 @@ pub fn calibrate_csv<'py>(
     let pm = motor.get().clone();
     let m = pm.inner.clone();
     let out = detached(py, move || -> Result<_, String> {
-        let meas = parse_measurements(&data, &source).map_err(|e| e.to_string())?;
+        let meas = parse_measurements_with(&data, &source, &PlausibleRanges::default()).map_err(|e| e.to_string())?;
         let bench = observations(&meas, &m);
-        let params = baseline_params_with(&m, &bench.rows, &Default::default());
-        let mut cal = calibrate_refitting_bounds(&m, &bench.rows, &params, &FitOptions::default())
+        let mut cal = Calibration::builder(&m, &bench.rows)
+            .options(&FitOptions::default())
+            .refit_bounds(true)
+            .run()
             .map_err(|e| format!("{source}: {e}"))?;
         rescale_uncertainties(&mut cal, &bench.rows);
         Ok((cal, bench.rows.len(), meas.warnings.clone()))
