@@ -229,7 +229,7 @@ def test_tables_and_reprs(motor):
     pd = pytest.importorskip("pandas")
     d = trum.map(motor, preload_n=[150, 250, 350], torque_nm=trum.linspace(0, 0.6, 7), voltage_v=200, frequency_hz=43e3)
     df = d.to_pandas()
-    assert df.shape == (21, 5 + len(trum.QUANTITY_NAMES)) and str(df["status"].dtype) == "category"
+    assert df.shape == (21, 6 + len(trum.QUANTITY_NAMES)) and str(df["status"].dtype) == "category"
     assert d.shape == (3, 1, 1, 7) and d.swept == ["preload_n", "torque_nm"]
     assert d.fixed == {"voltage_v": 200.0, "frequency_hz": 43e3}
     text = repr(d)
@@ -262,7 +262,7 @@ def test_optimize(motor):
     t = o.table
     assert o.within_limits and list(t["warnings"]) == [""] * 8
     capped = motor.with_params({"limits.max_voltage_v": 150})
-    c = trum.optimize(capped, preload_n=(150, 500, 8), torque_samples=8)
+    c = trum.optimize(capped, preload_n=trum.linspace(150, 500, 8), torque_samples=8)
     assert not c.within_limits and all(w == "max_voltage_v" for w in c.table["warnings"])
     assert len(t["preload_n"]) == 8 and o.optimum_preload_n in t["preload_n"]
     assert o.region_n[0] <= o.optimum_preload_n <= o.region_n[1]

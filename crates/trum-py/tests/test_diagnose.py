@@ -93,7 +93,7 @@ def test_bad_input_is_a_clear_error(tmp_path):
         trum.diagnose(RING, tmp_path / "missing.csv")
     with pytest.raises(trum.InputError, match="is a directory"):
         trum.diagnose(RING, tmp_path)
-    with pytest.raises(TypeError, match="a path, bytes, an open file or a pandas DataFrame"):
+    with pytest.raises(TypeError, match="path, bytes or text, an open file or a pandas DataFrame"):
         trum.diagnose(RING, 42)
     bad = tmp_path / "bad.csv"
     bad.write_text("preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n100,150,42000,0,106\n200,150,42000,0,nan\n")

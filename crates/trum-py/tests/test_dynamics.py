@@ -47,14 +47,14 @@ def test_resonance_of_a_motor_has_its_modal_parameters():
     m = trum.Motor("trum60a")
     f_r = m["stator.resonance_frequency_hz"]
     r = trum.resonance(motor=m, voltage_v=1.0, preload_n=250.0, method="harmonic_balance",
-                       frequency_hz=(f_r - 200, f_r + 200, 2001))
+                       frequency_hz=trum.linspace(f_r - 200, f_r + 200, 2001))
     c = r.curves[0]
     assert c.linear_resonance_hz == pytest.approx(f_r, rel=1e-12)
     force = m["stator.force_factor_n_per_v"] * 1.0 + trum.hertz_defaults()["dynamic_contact_coefficient"] * 250.0
     assert c.amplitude_m.max() == pytest.approx(force / (m["stator.modal_damping_ns_per_m"] * 2 * np.pi * f_r), rel=1e-4)
     # overrides on top of the motor, and the preset name works too
     o = trum.resonance(motor="trum60a", oscillator={"damping_ns_per_m": 50.0}, voltage_v=1.0, preload_n=250.0,
-                       method="harmonic_balance", frequency_hz=(f_r - 200, f_r + 200, 2001))
+                       method="harmonic_balance", frequency_hz=trum.linspace(f_r - 200, f_r + 200, 2001))
     assert o.curves[0].amplitude_m.max() == pytest.approx(0.5 * c.amplitude_m.max(), rel=1e-3)
 
 
