@@ -5,7 +5,7 @@
 # them into one file (run ids prefixed with the voltage) and times `trum diagnose`.
 #   bash benches/diagnose_1000.sh            # release build, then the timed run
 #   SEED_OFFSET=10 bash benches/diagnose_1000.sh   # noise seeds 11-18, motor seed 11
-#   FLEET=1 bash benches/diagnose_1000.sh    # the design before stop 28: each campaign
+#   FLEET=1 bash benches/diagnose_1000.sh    # a fleet instead: each campaign
 #                                            # its own motor (motor seed = noise seed)
 #   EFFECT=voltage_sag=150 SEED_OFFSET=40 bash benches/diagnose_1000.sh
 #                                            # another injected effect (EFFECT=none: none)
