@@ -3,7 +3,8 @@
 # each `trum plot` kind as PNG and SVG, the resonance and step-response plots, and the
 # charts of a diagnosis report. SVGs (the plots' and the report's inline charts) are also
 # rendered to PNG with rsvg-convert when it is installed (Debian: librsvg2-bin), so that
-# what a browser shows can be checked as an image too.
+# what a browser shows can be checked as an image too; with Chromium installed (Debian:
+# chromium) the HTML report and every SVG are also screenshotted by the headless browser.
 #   scripts/render-plots.sh [OUT_DIR]        (default: out/pictures)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -40,5 +41,15 @@ for i, svg in enumerate(re.findall(r"<svg.*?</svg>", html, flags=re.S)):
 EOF
 else
   echo "rsvg-convert not found: SVGs are not rendered to PNG (apt-get install librsvg2-bin)"
+fi
+# the report and the SVG plots as a browser shows them: screenshots by headless Chromium
+BROWSER=$(command -v chromium || command -v chromium-browser || command -v google-chrome || true)
+if [ -n "$BROWSER" ]; then
+  shot() { "$BROWSER" --headless --disable-gpu --no-sandbox --hide-scrollbars --window-size="$2" \
+      --screenshot="$3" "file://$1" > /dev/null 2>&1; }
+  shot "$OUT/report.html" 1200,4200 "$OUT/report.browser.png"
+  for f in "$OUT"/*.svg; do shot "$f" 1100,800 "${f%.svg}.browser.png"; done
+else
+  echo "no Chromium found: the report and SVGs are not screenshotted in a browser (apt-get install chromium)"
 fi
 echo "pictures in $OUT"
