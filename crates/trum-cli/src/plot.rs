@@ -611,6 +611,26 @@ fn finite_range(v: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     })
 }
 
+/// Axis titles in words with units and tick labels on a chart's mesh, or no labels at all
+/// for an unlabelled picture.
+fn label_mesh<X, Y, DB>(mesh: &mut plotters::chart::MeshStyle<'_, '_, X, Y, DB>, x: &str, y: &str, look: Look)
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+    DB: DrawingBackend,
+{
+    if look.labels {
+        mesh.x_desc(axis_label(x))
+            .y_desc(axis_label(y))
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .label_style(look.font(15.0))
+            .axis_desc_style(look.font(17.0));
+    } else {
+        mesh.x_labels(0).y_labels(0);
+    }
+}
+
 fn tick(v: &f64) -> String {
     crate::format::fmt_sig(*v, 4)
 }
@@ -720,16 +740,7 @@ fn draw_lines<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, plot: &LinePlot
     let mut mesh = chart.configure_mesh();
     let grid_line = RGBColor(225, 225, 225).stroke_width(look.px(1.0));
     mesh.light_line_style(WHITE.mix(0.0)).bold_line_style(grid_line).axis_style(BLACK.stroke_width(look.px(1.0)));
-    if look.labels {
-        mesh.x_desc(axis_label(&plot.x))
-            .y_desc(axis_label(&plot.y))
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .label_style(look.font(15.0))
-            .axis_desc_style(look.font(17.0));
-    } else {
-        mesh.x_labels(0).y_labels(0);
-    }
+    label_mesh(&mut mesh, &plot.x, &plot.y, look);
     mesh.draw().map_err(de)?;
     let mut legend = false;
     for line in &plot.lines {
@@ -924,16 +935,7 @@ fn heat_map<DB: DrawingBackend>(
     let mut chart = cb.build_cartesian_2d(ex[0]..ex[ex.len() - 1], ey[0]..ey[ey.len() - 1]).map_err(de)?;
     let mut mesh = chart.configure_mesh();
     mesh.disable_mesh();
-    if look.labels {
-        mesh.x_desc(axis_label(&spec.x))
-            .y_desc(axis_label(&spec.y))
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .label_style(look.font(15.0))
-            .axis_desc_style(look.font(17.0));
-    } else {
-        mesh.x_labels(0).y_labels(0);
-    }
+    label_mesh(&mut mesh, &spec.x, &spec.y, look);
     mesh.draw().map_err(de)?;
     let invalid = RGBColor(215, 215, 215);
     chart
@@ -1060,16 +1062,7 @@ fn efficiency_plane<DB: DrawingBackend>(
     let mut chart = cb.build_cartesian_2d(x0..x1, y0..y1).map_err(de)?;
     let mut mesh = chart.configure_mesh();
     mesh.disable_mesh();
-    if look.labels {
-        mesh.x_desc(axis_label("torque_nm"))
-            .y_desc(axis_label("speed_rpm"))
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .label_style(look.font(15.0))
-            .axis_desc_style(look.font(17.0));
-    } else {
-        mesh.x_labels(0).y_labels(0);
-    }
+    label_mesh(&mut mesh, "torque_nm", "speed_rpm", look);
     mesh.draw().map_err(de)?;
     let zspan = if zr.1 > zr.0 { zr.1 - zr.0 } else { 1.0 };
     let xy = |c: (f64, f64, f64)| (c.0 * fx, c.1 * fy);
