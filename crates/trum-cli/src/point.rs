@@ -22,12 +22,12 @@ pub struct PointArgs {
     /// Load torque [N·m].
     #[arg(long, default_value_t = 0.0)]
     torque_nm: f64,
-    /// Drive voltage amplitude per phase, zero-to-peak [V].
-    #[arg(long, default_value_t = 200.0)]
-    voltage_v: f64,
-    /// Drive frequency [Hz].
-    #[arg(long, default_value_t = 43_000.0)]
-    frequency_hz: f64,
+    /// Drive voltage amplitude per phase, zero-to-peak [V] (default: the motor's `[drive]`, else 200 V).
+    #[arg(long)]
+    voltage_v: Option<f64>,
+    /// Drive frequency [Hz] (default: the motor's `[drive]`, else 43 kHz).
+    #[arg(long)]
+    frequency_hz: Option<f64>,
     /// Time since the drive was switched on [s] (only thermal quantities and `thermal_drift` use it).
     #[arg(long, default_value_t = 0.0)]
     elapsed_s: f64,
@@ -38,11 +38,12 @@ pub struct PointArgs {
 
 pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
     let (motor, _) = a.motor.load()?;
+    let drive = crate::optimize::motor_drive(&a.motor.motor)?;
     let op = OperatingPoint {
         preload_n: a.preload_n,
         torque_nm: a.torque_nm,
-        voltage_v: a.voltage_v,
-        frequency_hz: a.frequency_hz,
+        voltage_v: a.voltage_v.or(drive.map(|d| d.voltage_v)).unwrap_or(DEFAULT_VOLTAGE_V),
+        frequency_hz: a.frequency_hz.or(drive.map(|d| d.frequency_hz)).unwrap_or(DEFAULT_FREQUENCY_HZ),
         elapsed_s: a.elapsed_s,
     };
     if let Some(reason) = op.invalid_reason() {
@@ -51,6 +52,8 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
     let s = solve(&motor, &op);
     let valid = s.status.is_valid();
     let limit_notes = motor.limits.describe(&LimitedQuantities::of_point(motor.thermal.ambient_c, &op, &s), s.warnings);
+    let loaded_stall = loaded_stall(&motor, &op, &s);
+    let notes: Vec<String> = clamps_before_stall(loaded_stall, s.stall_torque_nm).into_iter().collect();
     let inputs: [(&str, f64, &str); 5] = [
         ("preload_n", op.preload_n, "N"),
         ("torque_nm", op.torque_nm, "N·m"),
@@ -82,12 +85,22 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
             "warnings": s.warnings.keys().collect::<Vec<_>>(),
             "warning_details": limit_notes,
             "quantities": q,
+            "notes": notes,
+            "loaded_stall_torque_nm": if loaded_stall.is_finite() { json!(loaded_stall) } else { Value::Null },
             "units": units,
         });
         writeln!(out, "{}", serde_json::to_string_pretty(&doc)?)?;
     } else {
         let preset = motor.preset.as_deref().map(|p| format!(" (preset {p})")).unwrap_or_default();
         writeln!(out, "motor    {}{}", motor.name, preset)?;
+        if drive.is_some() && (a.voltage_v.is_none() || a.frequency_hz.is_none()) {
+            writeln!(
+                out,
+                "drive    {} V, {} Hz (the motor's [drive] where not given)",
+                fmt_sig(op.voltage_v, 6),
+                fmt_sig(op.frequency_hz, 6)
+            )?;
+        }
         writeln!(out, "effects  {}", motor.effects)?;
         writeln!(out, "status   {}{}", s.status, status_note(s.status, s.full_contact))?;
         if limit_notes.is_empty() {
@@ -95,6 +108,9 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
         }
         for (i, note) in limit_notes.iter().enumerate() {
             writeln!(out, "{}{note}", if i == 0 { "warning  " } else { "         " })?;
+        }
+        for note in &notes {
+            writeln!(out, "note     {note}")?;
         }
         writeln!(out)?;
         let mut rows = Vec::new();
@@ -105,6 +121,12 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
             let v = if valid { (qu.get)(&s) } else { f64::NAN };
             rows.push(vec![qu.name.to_string(), fmt_sig(v, 6), qu.unit.to_string(), qu.doc.to_string()]);
         }
+        rows.push(vec![
+            "loaded_stall_torque_nm".to_string(),
+            fmt_sig(loaded_stall, 6),
+            "N·m".to_string(),
+            "load torque at which the loaded motor stops (stall or clamp) at this preload and drive".to_string(),
+        ]);
         write_table(out, &["quantity", "value", "unit", "meaning"], &[Align::Left, Align::Right, Align::Left], &rows)?;
     }
     if !valid {
@@ -113,6 +135,34 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
         return Ok(1);
     }
     Ok(0)
+}
+
+/// Drive of a motor without a `[drive]` table, when the command line gives none.
+const DEFAULT_VOLTAGE_V: f64 = 200.0;
+const DEFAULT_FREQUENCY_HZ: f64 = 43_000.0;
+
+/// The load at which the loaded motor stops at the point's preload and drive
+/// (`criterion::loaded_stall_torque_nm`, about 30 solves), or NaN where the rotor does not
+/// run at no load. `stall_torque_nm` is the rotor-at-rest torque at the point's own
+/// amplitude; under load the amplitude falls, and near clamping the motor stops far below it.
+fn loaded_stall(motor: &trum_core::Motor, op: &OperatingPoint, s: &trum_core::Solution) -> f64 {
+    if !s.status.is_valid() {
+        return f64::NAN;
+    }
+    let p = trum_core::solve::Prepared::new(motor);
+    trum_core::criterion::loaded_stall_torque_nm(&p, motor, op.preload_n, op.voltage_v, op.frequency_hz)
+}
+
+/// A warning when the loaded motor stops more than 5 % below the rotor-at-rest torque at
+/// the point's amplitude: the stator clamps under load before the rotor stalls.
+fn clamps_before_stall(loaded_nm: f64, at_rest_nm: f64) -> Option<String> {
+    (loaded_nm.is_finite() && at_rest_nm.is_finite() && loaded_nm < 0.95 * at_rest_nm).then(|| {
+        format!(
+            "the loaded motor stops at {} N·m (loaded_stall_torque_nm): the amplitude falls under load, so the stator clamps before the load reaches the rotor-at-rest torque {} N·m (stall_torque_nm)",
+            fmt_sig(loaded_nm, 4),
+            fmt_sig(at_rest_nm, 4)
+        )
+    })
 }
 
 /// The status's meaning in brackets, as `trum_core::layout::status_meaning` words it.

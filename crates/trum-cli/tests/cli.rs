@@ -644,3 +644,59 @@ fn decode_png(bytes: &[u8]) -> (u32, u32, Vec<u8>) {
     buf.truncate(info.buffer_size());
     (info.width, info.height, buf)
 }
+
+/// Near clamping the loaded motor stops far below the rotor-at-rest torque at the no-load
+/// amplitude (generic60 at 26.87 N, 6.63 V, 40 456.6 Hz: 0.181 N·m at rest, clamped from
+/// about 0.06 N·m). `trum point` reports where the loaded motor stops, says why it differs,
+/// and that torque is where the point's own status turns from running to stopped.
+#[test]
+fn point_reports_the_loaded_stall_torque_where_the_status_turns() {
+    let at = |t: f64| {
+        let out = ok(&[
+            "point",
+            "--motor",
+            "generic60",
+            "--preload-n",
+            "26.87",
+            "--voltage-v",
+            "6.63",
+            "--frequency-hz",
+            "40456.6",
+            "--torque-nm",
+            &t.to_string(),
+            "--json",
+        ]);
+        out.parse::<serde_json::Value>().expect("JSON")
+    };
+    let v = at(0.0);
+    let loaded = v["loaded_stall_torque_nm"].as_f64().expect("loaded stall torque");
+    let at_rest = v["quantities"]["stall_torque_nm"].as_f64().expect("stall torque");
+    assert!(loaded < 0.5 * at_rest, "loaded {loaded} against at rest {at_rest}");
+    let note = v["notes"][0].as_str().expect("a note");
+    assert!(note.contains("loaded_stall_torque_nm") && note.contains("clamps"), "{note}");
+    assert_eq!(at(0.98 * loaded)["status"], "ok");
+    let beyond = at(1.02 * loaded);
+    assert!(beyond["status"] == "clamped" || beyond["status"] == "stall", "{}", beyond["status"]);
+}
+
+#[test]
+fn point_runs_at_the_motors_drive_unless_given() {
+    let out = ok(&["point", "--motor", "trum60a", "--preload-n", "250"]);
+    assert!(out.contains("the motor's [drive]"), "{out}");
+    let v = |extra: &[&str]| {
+        let mut a = vec!["point", "--motor", "trum60a", "--preload-n", "250", "--json"];
+        a.extend_from_slice(extra);
+        ok(&a).parse::<serde_json::Value>().expect("JSON")
+    };
+    let drive = trum_core::presets::find("trum60a").expect("preset").drive().expect("a [drive] table");
+    let bare = v(&[]);
+    assert_eq!(bare["inputs"]["voltage_v"].as_f64(), Some(drive.voltage_v));
+    assert_eq!(bare["inputs"]["frequency_hz"].as_f64(), Some(drive.frequency_hz));
+    assert_eq!(v(&["--frequency-hz", "43000"])["inputs"]["frequency_hz"].as_f64(), Some(43000.0));
+    // a motor without [drive] keeps the documented 200 V, 43 kHz
+    let g = ok(&["point", "--motor", "generic60", "--preload-n", "250", "--json"])
+        .parse::<serde_json::Value>()
+        .expect("JSON");
+    assert_eq!(g["inputs"]["frequency_hz"].as_f64(), Some(43000.0));
+    assert_eq!(g["inputs"]["voltage_v"].as_f64(), Some(200.0));
+}
