@@ -41,7 +41,7 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         anyhow::bail!("-o - and --json - cannot both go to stdout");
     }
     let (motor, _) = a.motor.load()?;
-    let (_, bench) = read_data(&a.data, &motor, &a.plausible.ranges()?, err)?;
+    let (_, bench) = read_data(&a.data, &motor, &a.plausible.ranges(&a.motor.motor)?, err)?;
     let tolerances = crate::motor::load_tolerances(&a.motor.motor)?;
     // Check the output paths before the fit, so a typo or an input named as output fails at once.
     for p in [&a.output, &a.json].into_iter().flatten() {

@@ -19,10 +19,11 @@ pub struct PlausibleArgs {
 }
 
 impl PlausibleArgs {
-    /// The ranges in force: the defaults with every `--plausible` applied; a column given
-    /// twice is an error (which one was meant?).
-    pub fn ranges(&self) -> Result<PlausibleRanges> {
-        let mut r = PlausibleRanges::default();
+    /// The ranges in force: the defaults, then the `[plausible]` table of the motor file
+    /// `motor` (when it is a file), then every `--plausible`; a column given twice on the
+    /// command line is an error (which one was meant?).
+    pub fn ranges(&self, motor: &str) -> Result<PlausibleRanges> {
+        let mut r = crate::motor::load_plausible(motor)?;
         let mut seen: Vec<&str> = Vec::new();
         for spec in &self.plausible {
             let name = spec.split_once('=').map_or(spec.as_str(), |(n, _)| n.trim());

@@ -51,7 +51,7 @@ pub struct DiagnoseArgs {
 
 pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
     let (motor, _) = load_motor(&a.motor)?;
-    let (_, bench) = read_data(&a.data, &motor, &a.plausible.ranges()?, err)?;
+    let (_, bench) = read_data(&a.data, &motor, &a.plausible.ranges(&a.motor)?, err)?;
     crate::data::check_rows(&a.data, bench.rows.len(), a.max_rows, &crate::data::DIAGNOSE_ROW)?;
     // Check the output paths before the long run, so a typo fails at once.
     for p in [&a.json, &a.report].into_iter().flatten() {
