@@ -150,7 +150,8 @@ fn run_fleet(a: &DiagnoseArgs, files: &[String], out: &mut dyn Write, err: &mut 
 /// held-out errors and the calibrated baseline parameters.
 fn fleet_cells(d: &Diagnosis) -> Vec<(String, String)> {
     use crate::fleet::num;
-    let entry = d.ranking.iter().find(|r| r.effect == d.verdict).or_else(|| {
+    let of_verdict = d.ranking.iter().find(|r| trum_core::diagnose::same_set(&r.effect, &d.verdict));
+    let entry = of_verdict.or_else(|| {
         d.partial
             .as_ref()
             .filter(|_| d.verdict == "unexplained")
@@ -167,7 +168,8 @@ fn fleet_cells(d: &Diagnosis) -> Vec<(String, String)> {
         ("shrink_low".into(), opt(&|r| r.shrink_interval.0)),
         ("shrink_high".into(), opt(&|r| r.shrink_interval.1)),
         ("baseline_heldout_nrmse".into(), num(d.baseline_heldout_nrmse)),
-        ("remaining_heldout_nrmse".into(), num(after_nrmse(d).unwrap_or(d.baseline_heldout_nrmse))),
+        // the held-out gap the verdict leaves (the baseline's with `none` and `unexplained`)
+        ("remaining_heldout_nrmse".into(), num(of_verdict.map_or(d.baseline_heldout_nrmse, |r| r.heldout_nrmse_after))),
         ("noise_nrmse".into(), num(d.noise_nrmse)),
         ("readings".into(), d.n_readings.to_string()),
     ];
