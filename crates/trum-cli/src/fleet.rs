@@ -347,7 +347,7 @@ mod tests {
             .map(|f| format!("{root}/{f}"))
             .collect();
         assert_eq!(got, want);
-        let e = expand_data(&[format!("{root}/*.tsv")]).err().expect("no match is an error");
+        let e = expand_data(&[format!("{root}/*.tsv")]).expect_err("no match is an error");
         assert!(e.to_string().contains("no file matches this pattern"), "{e}");
         // a name that exists is a file even with a wildcard character in it
         std::fs::write(d.join("odd[1].csv"), "x").expect("write");
