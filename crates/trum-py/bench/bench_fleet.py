@@ -1,6 +1,6 @@
 """Benchmark: a diagnosis fleet on Dask, 1 → 2 worker processes (not part of the test suite).
 
-    python crates/trum-py/bench/bench_fleet.py [files] [repeats]
+    python crates/trum-py/bench/bench_fleet.py [files] [repeats] [--rayon]
 
 Writes ``files`` measurement files (default 16) into a temporary directory: campaigns of
 the ``trum60a`` design at nine preloads and three load torques (27 rows each), each motor
@@ -9,6 +9,12 @@ runs ``trum.diagnose_fleet`` on a ``LocalCluster`` of 1 and of 2 single-threaded
 processes (cluster start-up not timed; best of ``repeats``), checks that both tables are
 identical, and prints the wall times, files a second and the speed-up. On a machine with
 two idle cores the ideal speed-up is 2; other work on the cores lowers it.
+
+The workers run with ``RAYON_NUM_THREADS=1``: one diagnosis otherwise spreads its
+candidate fits over every core with rayon, so that a single worker process already
+keeps both cores busy and two processes oversubscribe them; one single-threaded process
+per core is the fleet's layout (docs/PYTHON.md). ``--rayon`` leaves rayon's default, to
+see what a file's own parallelism gives.
 """
 from __future__ import annotations
 
@@ -39,11 +45,11 @@ def write_fleet(directory: Path, n: int) -> None:
         (directory / f"motor{i:04d}.csv").write_text("\n".join(lines) + "\n")
 
 
-def timed(files: str, workers: int, repeats: int):
+def timed(files: str, workers: int, repeats: int, env: dict):
     from dask.distributed import Client, LocalCluster
 
     best, df = float("inf"), None
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None, env=env) as cluster, \
             Client(cluster) as client:
         trum.diagnose_fleet("trum60a", files, client=client).shape  # warm the workers (imports)
         for _ in range(repeats):
@@ -54,16 +60,18 @@ def timed(files: str, workers: int, repeats: int):
 
 
 def main() -> None:
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 16
-    repeats = int(sys.argv[2]) if len(sys.argv) > 2 else 2
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    env = {} if "--rayon" in sys.argv else {"RAYON_NUM_THREADS": "1"}
+    n = int(args[0]) if args else 16
+    repeats = int(args[1]) if len(args) > 1 else 2
     with tempfile.TemporaryDirectory() as tmp:
         write_fleet(Path(tmp), n)
         pattern = str(Path(tmp) / "*.csv")
-        t1, df1 = timed(pattern, 1, repeats)
-        t2, df2 = timed(pattern, 2, repeats)
+        t1, df1 = timed(pattern, 1, repeats, env)
+        t2, df2 = timed(pattern, 2, repeats, env)
     assert df1.equals(df2), "the table depends on the number of workers"
     ok = int((df1["status"] == "ok").sum())
-    print(f"{n} files ({ok} diagnosed), 27 rows each; best of {repeats}")
+    print(f"{n} files ({ok} diagnosed), 27 rows each; best of {repeats}; worker env {env or 'rayon default'}")
     print(f"1 worker : {t1:7.2f} s  {n / t1:6.2f} files/s")
     print(f"2 workers: {t2:7.2f} s  {n / t2:6.2f} files/s")
     print(f"speed-up : {t1 / t2:.2f}")
