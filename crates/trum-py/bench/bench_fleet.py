@@ -18,6 +18,7 @@ see what a file's own parallelism gives.
 """
 from __future__ import annotations
 
+import glob
 import sys
 import tempfile
 import time
@@ -51,7 +52,9 @@ def timed(files: str, workers: int, repeats: int, env: dict):
     best, df = float("inf"), None
     with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None, env=env) as cluster, \
             Client(cluster) as client:
-        trum.diagnose_fleet("trum60a", files, client=client).shape  # warm the workers (imports)
+        first = sorted(glob.glob(files))[:1]
+        client.run(lambda: __import__("trum"))  # every worker imports trum before the clock starts
+        trum.diagnose_fleet("trum60a", first, client=client)
         for _ in range(repeats):
             t0 = time.perf_counter()
             df = trum.diagnose_fleet("trum60a", files, client=client)
