@@ -58,7 +58,9 @@ where
     }
     // the summary path is checked (and refused when it is an input) before any work
     drop(crate::output::OutputTarget::create(run.summary, ".tmp")?);
-    let threads = crate::output::worker_threads(run.threads, "--threads", err)?.min(run.files.len().max(1));
+    // not capped at the number of files: a file's own diagnosis or fit spreads its work
+    // over the pool's idle threads (rayon steals across the nested parallel loops)
+    let threads = crate::output::worker_threads(run.threads, "--threads", err)?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start worker threads")?;
     let progress = Mutex::new((crate::output::Progress::new(run.files.len() as u64, "files", run.quiet), 0u64));
     let rows: Vec<Row> = pool.install(|| {
