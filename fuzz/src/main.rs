@@ -258,6 +258,12 @@ fn check_toml(input: &[u8]) -> Verdict {
     let text = String::from_utf8_lossy(input);
     let a = Motor::from_toml_str(&text, SRC_TOML);
     let b = Motor::from_toml_str_with_sweep(&text, SRC_TOML);
+    // the [plausible] reader: an error names the source, like the motor reader's
+    if let Err(e) = trum_core::params::plausible_from_toml_str(&text, SRC_TOML) {
+        if !e.to_string().starts_with(SRC_TOML) {
+            return Verdict::Violation(format!("[plausible] error does not name the source: {e}"));
+        }
+    }
     match (a, b) {
         (Err(e), b) => {
             let msg = e.to_string();

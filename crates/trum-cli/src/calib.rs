@@ -15,9 +15,18 @@ use trum_core::calibrate::{rescale_uncertainties, Calibration, FitOptions};
 pub struct CalibrateArgs {
     #[command(flatten)]
     motor: MotorArgs,
-    /// Measurement CSV (shared/spec/measurements.md; `trum synth` writes one).
-    #[arg(long, value_name = "FILE")]
-    data: String,
+    /// Measurement CSV (docs/MEASUREMENTS.md; `trum synth` writes one); several files, or a
+    /// pattern such as 'runs/*.csv', with --summary (a fleet: docs/CLI.md, "Fleets").
+    #[arg(long, value_name = "FILE", num_args = 1.., required = true)]
+    data: Vec<String>,
+    /// Calibrate to every --data file on its own (in parallel) and write one summary row
+    /// per file to this CSV (`-`: stdout).
+    #[arg(long, value_name = "FLEET.csv")]
+    summary: Option<PathBuf>,
+    /// Worker threads of a fleet run (default: RAYON_NUM_THREADS or every core; never
+    /// more than the cores).
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
     #[command(flatten)]
     plausible: crate::data::PlausibleArgs,
     /// Most measurement rows to calibrate to (docs/CLI.md, "Limits"): more are refused
@@ -40,15 +49,20 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     if to_stdout(&a.output) && to_stdout(&a.json) {
         anyhow::bail!("-o - and --json - cannot both go to stdout");
     }
+    let files = crate::fleet::expand_data(&a.data)?;
+    if a.summary.is_some() || files.len() > 1 {
+        return run_fleet(a, &files, out, err);
+    }
+    let data = &files[0];
     let (motor, _) = a.motor.load()?;
-    let (_, bench) = read_data(&a.data, &motor, &a.plausible.ranges()?, err)?;
+    let (_, bench) = read_data(data, &motor, &a.plausible.ranges(&a.motor.motor)?, err)?;
     let tolerances = crate::motor::load_tolerances(&a.motor.motor)?;
     // Check the output paths before the fit, so a typo or an input named as output fails at once.
     for p in [&a.output, &a.json].into_iter().flatten() {
         drop(crate::output::OutputTarget::create(p, ".tmp")?);
     }
-    crate::data::check_rows(&a.data, bench.rows.len(), a.max_rows, &crate::data::CALIBRATE_ROW)?;
-    refuse_unsolvable(&motor, &bench, &a.data)?;
+    crate::data::check_rows(data, bench.rows.len(), a.max_rows, &crate::data::CALIBRATE_ROW)?;
+    refuse_unsolvable(&motor, &bench, data)?;
     let spinner = crate::diagnose::spinner(
         &format!(
             "calibrating the baseline parameters to {} rows (about {})",
@@ -62,7 +76,7 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         .options(&FitOptions::default())
         .refit_bounds(true)
         .run();
-    let mut cal = cal.map_err(|e| anyhow!("{}: {e}", a.data));
+    let mut cal = cal.map_err(|e| anyhow!("{data}: {e}"));
     if let Ok(cal) = &mut cal {
         rescale_uncertainties(cal, &bench.rows);
     }
@@ -72,7 +86,7 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     if let Some(path) = &a.json {
         let doc = json!({
             "motor": { "name": motor.name, "source": a.motor.motor, "effects": motor.effects.to_string() },
-            "data": a.data,
+            "data": data,
             "n_rows": bench.rows.len(),
             "n_readings": cal.n_readings,
             "chi2": num(cal.chi2),
@@ -91,15 +105,60 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         write_atomic(path, ".json", &(serde_json::to_string_pretty(&doc)? + "\n"), out)?;
     }
     if let Some(path) = &a.output {
-        write_atomic(path, ".toml", &calibrated_toml(&cal, &motor, &a.data, chi2_per), out)?;
+        write_atomic(path, ".toml", &calibrated_toml(&cal, &motor, data, chi2_per), out)?;
     }
     if !to_stdout(&a.output) && !to_stdout(&a.json) {
-        print_table(&cal, &motor, &a.data, chi2_per, out)?;
+        print_table(&cal, &motor, data, chi2_per, out)?;
     }
     for w in &cal.warnings {
         writeln!(err, "warning: {w}")?;
     }
     Ok(0)
+}
+
+/// `--data` with many files and `--summary`: one calibration per file, in parallel; the
+/// summary's columns after `chi2_per_reading` are each fitted parameter and its standard
+/// error (`std_error.NAME`).
+fn run_fleet(a: &CalibrateArgs, files: &[String], out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
+    let Some(summary) = &a.summary else {
+        anyhow::bail!(
+            "--data names {} measurement files: give --summary FLEET.csv (or --summary - for stdout) for one \
+             table over them (docs/CLI.md, \"Fleets\")",
+            files.len()
+        );
+    };
+    if a.output.is_some() || a.json.is_some() {
+        anyhow::bail!("-o and --json describe one measurement file; with --summary the fleet table has a row per file");
+    }
+    let (motor, _) = a.motor.load()?;
+    let plausible = a.plausible.ranges(&a.motor.motor)?;
+    let tolerances = crate::motor::load_tolerances(&a.motor.motor)?;
+    let run = crate::fleet::FleetRun { files, summary, threads: a.threads, quiet: a.quiet };
+    crate::fleet::run(&run, &["readings", "chi2_per_reading", "evaluations"], out, err, |file| {
+        use crate::fleet::num;
+        let (m, bench) = crate::data::read_data_quietly(file, &motor, &plausible)?;
+        crate::data::check_rows(file, bench.rows.len(), a.max_rows, &crate::data::CALIBRATE_ROW)?;
+        refuse_unsolvable(&motor, &bench, file)?;
+        let mut cal = Calibration::builder(&motor, &bench.rows)
+            .tolerances(&tolerances)
+            .options(&FitOptions::default())
+            .refit_bounds(true)
+            .run()
+            .map_err(|e| anyhow!("{file}: {e}"))?;
+        rescale_uncertainties(&mut cal, &bench.rows);
+        let mut cells: Vec<(String, String)> = vec![
+            ("readings".into(), cal.n_readings.to_string()),
+            ("chi2_per_reading".into(), num(cal.chi2 / cal.n_readings.max(1) as f64)),
+            ("evaluations".into(), cal.evaluations.to_string()),
+        ];
+        for p in &cal.params {
+            cells.push((p.name.clone(), num(p.value)));
+            cells.push((format!("std_error.{}", p.name), num(p.std_error)));
+        }
+        let mut warnings = m.warnings.clone();
+        warnings.extend(cal.warnings.iter().cloned());
+        Ok(crate::fleet::Outcome { rows: bench.rows.len(), cells, warnings })
+    })
 }
 
 /// Refuses data at which the nominal motor has no solution at a single row (preloads of

@@ -19,10 +19,11 @@ pub struct PlausibleArgs {
 }
 
 impl PlausibleArgs {
-    /// The ranges in force: the defaults with every `--plausible` applied; a column given
-    /// twice is an error (which one was meant?).
-    pub fn ranges(&self) -> Result<PlausibleRanges> {
-        let mut r = PlausibleRanges::default();
+    /// The ranges in force: the defaults, then the `[plausible]` table of the motor file
+    /// `motor` (when it is a file), then every `--plausible`; a column given twice on the
+    /// command line is an error (which one was meant?).
+    pub fn ranges(&self, motor: &str) -> Result<PlausibleRanges> {
+        let mut r = crate::motor::load_plausible(motor)?;
         let mut seen: Vec<&str> = Vec::new();
         for spec in &self.plausible {
             let name = spec.split_once('=').map_or(spec.as_str(), |(n, _)| n.trim());
@@ -76,6 +77,17 @@ pub fn read_data(
     plausible: &PlausibleRanges,
     err: &mut dyn Write,
 ) -> Result<(Measurements, BenchData)> {
+    crate::output::note_input(Path::new(path), &format!("--data '{path}'"));
+    let (m, bench) = read_data_quietly(path, motor, plausible)?;
+    for w in &m.warnings {
+        writeln!(err, "warning: {w}")?;
+    }
+    Ok((m, bench))
+}
+
+/// [`read_data`] with the warnings left in `Measurements::warnings` and the file not
+/// recorded as an input (a fleet run records its files before its worker threads read them).
+pub fn read_data_quietly(path: &str, motor: &Motor, plausible: &PlausibleRanges) -> Result<(Measurements, BenchData)> {
     let p = Path::new(path);
     if p.is_dir() {
         bail!("--data '{path}' is a directory, not a measurement file");
@@ -83,13 +95,9 @@ pub fn read_data(
     if !p.exists() {
         bail!("measurement file '{path}' does not exist");
     }
-    crate::output::note_input(p, &format!("--data '{path}'"));
     let bytes = std::fs::read(p).with_context(|| format!("cannot read measurement file '{path}'"))?;
     // MeasurementError's message names the file, line and column; show it unchanged.
     let m = parse_measurements_with(&bytes, path, plausible).map_err(|e| anyhow!("{e}"))?;
-    for w in &m.warnings {
-        writeln!(err, "warning: {w}")?;
-    }
     let bench = observations(&m, motor);
     Ok((m, bench))
 }

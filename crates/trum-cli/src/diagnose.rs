@@ -25,9 +25,18 @@ pub struct DiagnoseArgs {
     /// Nominal motor: a TOML motor file or a preset name.
     #[arg(long, value_name = "MOTOR.toml|PRESET")]
     motor: String,
-    /// Measurement CSV (layout: docs/MEASUREMENTS.md).
-    #[arg(long, value_name = "DATA.csv")]
-    data: String,
+    /// Measurement CSV (layout: docs/MEASUREMENTS.md); several files, or a pattern such
+    /// as 'runs/*.csv', with --summary (a fleet: docs/CLI.md, "Fleets").
+    #[arg(long, value_name = "DATA.csv", num_args = 1.., required = true)]
+    data: Vec<String>,
+    /// Diagnose every --data file (in parallel) and write one summary row per file to
+    /// this CSV (`-`: stdout) instead of one file's summary.
+    #[arg(long, value_name = "FLEET.csv")]
+    summary: Option<PathBuf>,
+    /// Worker threads of a fleet run (default: RAYON_NUM_THREADS or every core; never
+    /// more than the cores).
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
     #[command(flatten)]
     plausible: crate::data::PlausibleArgs,
     /// Most measurement rows to diagnose (docs/CLI.md, "Limits"): more are refused before
@@ -50,9 +59,14 @@ pub struct DiagnoseArgs {
 }
 
 pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
+    let files = crate::fleet::expand_data(&a.data)?;
+    if a.summary.is_some() || files.len() > 1 {
+        return run_fleet(a, &files, out, err);
+    }
+    let data = &files[0];
     let (motor, _) = load_motor(&a.motor)?;
-    let (_, bench) = read_data(&a.data, &motor, &a.plausible.ranges()?, err)?;
-    crate::data::check_rows(&a.data, bench.rows.len(), a.max_rows, &crate::data::DIAGNOSE_ROW)?;
+    let (_, bench) = read_data(data, &motor, &a.plausible.ranges(&a.motor)?, err)?;
+    crate::data::check_rows(data, bench.rows.len(), a.max_rows, &crate::data::DIAGNOSE_ROW)?;
     // Check the output paths before the long run, so a typo fails at once.
     for p in [&a.json, &a.report].into_iter().flatten() {
         drop(crate::output::OutputTarget::create(p, ".tmp")?);
@@ -66,21 +80,101 @@ pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     };
     let d = diagnose(&motor, &bench.rows, &bench.groups, &opts);
     spinner.finish_and_clear();
-    let d = d.map_err(|e| anyhow!("cannot diagnose '{}': {e}", a.data))?;
+    let d = d.map_err(|e| anyhow!("cannot diagnose '{data}': {e}"))?;
     let json_stdout = a.json.as_ref().is_some_and(|p| p.as_os_str() == "-");
     if let Some(p) = &a.json {
-        let src = Provenance { motor_name: &motor.name, motor_source: &a.motor, data: &a.data, lines: &bench.lines };
+        let src = Provenance { motor_name: &motor.name, motor_source: &a.motor, data, lines: &bench.lines };
         let doc = to_json(&d, &src);
         write_atomic(p, ".json", &(serde_json::to_string_pretty(&doc)? + "\n"), out)?;
     }
     if let Some(p) = &a.report {
-        let html = crate::report::html(&d, &motor, &a.data, &bench);
+        let html = crate::report::html(&d, &motor, data, &bench);
         write_atomic(p, ".html", &html, out)?;
     }
     if !json_stdout {
-        write_summary(&d, &motor, &a.data, out)?;
+        write_summary(&d, &motor, data, out)?;
     }
     Ok(0)
+}
+
+/// The columns of a diagnosis fleet's summary (docs/CLI.md, "Fleets"), before the
+/// calibrated baseline parameters.
+const FLEET_COLUMNS: [&str; 12] = [
+    "verdict",
+    "complete",
+    "confounded_with",
+    "partial",
+    "evidence",
+    "shrink",
+    "shrink_low",
+    "shrink_high",
+    "baseline_heldout_nrmse",
+    "remaining_heldout_nrmse",
+    "noise_nrmse",
+    "readings",
+];
+
+/// `--data` with many files and `--summary`: one diagnosis per file, in parallel.
+fn run_fleet(a: &DiagnoseArgs, files: &[String], out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
+    let Some(summary) = &a.summary else {
+        anyhow::bail!(
+            "--data names {} measurement files: give --summary FLEET.csv (or --summary - for stdout) for one \
+             table over them (docs/CLI.md, \"Fleets\")",
+            files.len()
+        );
+    };
+    if a.json.is_some() || a.report.is_some() {
+        anyhow::bail!(
+            "--json and --report describe one measurement file; with --summary the fleet table has a row per file"
+        );
+    }
+    let (motor, _) = load_motor(&a.motor)?;
+    let plausible = a.plausible.ranges(&a.motor)?;
+    let opts = DiagnoseOptions {
+        exact_cv: a.exact_cv,
+        tolerances: crate::motor::load_tolerances(&a.motor)?,
+        ..DiagnoseOptions::default()
+    };
+    let run = crate::fleet::FleetRun { files, summary, threads: a.threads, quiet: a.quiet };
+    crate::fleet::run(&run, &FLEET_COLUMNS, out, err, |file| {
+        let (m, bench) = crate::data::read_data_quietly(file, &motor, &plausible)?;
+        crate::data::check_rows(file, bench.rows.len(), a.max_rows, &crate::data::DIAGNOSE_ROW)?;
+        let d = diagnose(&motor, &bench.rows, &bench.groups, &opts)
+            .map_err(|e| anyhow!("cannot diagnose '{file}': {e}"))?;
+        Ok(crate::fleet::Outcome { rows: bench.rows.len(), cells: fleet_cells(&d), warnings: m.warnings.clone() })
+    })
+}
+
+/// One diagnosis as the fleet summary's cells: the verdict, how much of the held-out gap
+/// it closes (the partial effect's share with `unexplained`; empty with `none`), the
+/// held-out errors and the calibrated baseline parameters.
+fn fleet_cells(d: &Diagnosis) -> Vec<(String, String)> {
+    use crate::fleet::num;
+    let of_verdict = d.ranking.iter().find(|r| trum_core::diagnose::same_set(&r.effect, &d.verdict));
+    let entry = of_verdict.or_else(|| {
+        d.partial
+            .as_ref()
+            .filter(|_| d.verdict == "unexplained")
+            .and_then(|p| d.ranking.iter().find(|r| &r.effect == p))
+    });
+    let opt = |f: &dyn Fn(&trum_core::diagnose::RankEntry) -> f64| entry.map(|r| num(f(r))).unwrap_or_default();
+    let mut cells: Vec<(String, String)> = vec![
+        ("verdict".into(), d.verdict.clone()),
+        ("complete".into(), d.complete.to_string()),
+        ("confounded_with".into(), d.confounded_with.join(";")),
+        ("partial".into(), d.partial.clone().unwrap_or_default()),
+        ("evidence".into(), opt(&|r| r.evidence)),
+        ("shrink".into(), opt(&|r| r.shrink)),
+        ("shrink_low".into(), opt(&|r| r.shrink_interval.0)),
+        ("shrink_high".into(), opt(&|r| r.shrink_interval.1)),
+        ("baseline_heldout_nrmse".into(), num(d.baseline_heldout_nrmse)),
+        // the held-out gap the verdict leaves (the baseline's with `none` and `unexplained`)
+        ("remaining_heldout_nrmse".into(), num(of_verdict.map_or(d.baseline_heldout_nrmse, |r| r.heldout_nrmse_after))),
+        ("noise_nrmse".into(), num(d.noise_nrmse)),
+        ("readings".into(), d.n_readings.to_string()),
+    ];
+    cells.extend(d.baseline_params.iter().map(|(k, v)| (k.clone(), num(*v))));
+    cells
 }
 
 /// A spinner with the elapsed time and `message` on stderr while a long step runs whose

@@ -31,7 +31,7 @@ pub const INPUT_COLUMNS: [&str; 6] = ["line", "preload_n", "voltage_v", "frequen
 pub fn run(a: &EstimateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
     let (motor, _) = a.motor.load()?;
     let est = Estimator::new(&motor).map_err(|e| anyhow!("--motor {}: {e}", a.motor.motor))?;
-    let (m, _) = read_data(&a.data, &motor, &a.plausible.ranges()?, err)?;
+    let (m, _) = read_data(&a.data, &motor, &a.plausible.ranges(&a.motor.motor)?, err)?;
     if !m.has(Column::FeedbackV) {
         bail!(
             "{}: no 'feedback_v' column; the estimator reads the wave amplitude from the feedback-electrode voltage (docs/MEASUREMENTS.md)",

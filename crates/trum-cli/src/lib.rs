@@ -13,6 +13,7 @@ mod calib;
 mod data;
 mod diagnose;
 mod estimate;
+mod fleet;
 mod format;
 mod grid;
 mod info;

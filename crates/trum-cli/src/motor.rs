@@ -93,6 +93,18 @@ pub fn load_tolerances(spec: &str) -> Result<std::collections::BTreeMap<String, 
     trum_core::params::tolerances_from_toml_str(&text, spec).map_err(|e| anyhow!("{e}"))
 }
 
+/// The plausible ranges of the measured columns for `--motor` (docs/MEASUREMENTS.md,
+/// "Plausible ranges"): the defaults with the motor file's `[plausible]` table applied
+/// (the defaults alone for a preset).
+pub fn load_plausible(spec: &str) -> Result<trum_core::measurements::PlausibleRanges> {
+    let path = Path::new(spec);
+    if !path.is_file() {
+        return Ok(Default::default());
+    }
+    let text = read_text(path, spec)?;
+    trum_core::params::plausible_from_toml_str(&text, spec).map_err(|e| anyhow!("{e}"))
+}
+
 /// `"; did you mean 'radial_friction'?"` when the effect named in `spec` is not known.
 pub fn effect_hint(spec: &str) -> String {
     let name = spec.split([':', '=']).next().unwrap_or("").trim();

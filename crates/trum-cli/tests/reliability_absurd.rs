@@ -160,3 +160,37 @@ fn a_calibrated_motor_file_reads_back_whatever_the_names_in_it() {
     assert_eq!(o.status.code(), Some(0), "the calibrated file does not read back: {}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("Motör \"q\" \\ # [x]"));
 }
+
+/// A motor file's `[plausible]` table replaces the default ranges for calibrate, diagnose
+/// and estimate; `--plausible` wins over it; a bad entry names the file, line and key.
+#[test]
+fn the_motor_files_plausible_table_sets_ranges_and_the_flag_wins() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    write(d, "fast.csv", None, &["250,150,42000,0,15000"]);
+    std::fs::write(d.join("m.toml"), "preset = \"trum60a\"\n\n[plausible]\nspeed_rpm = [0, 20000]\n").expect("write");
+    let o = trum(d, &["calibrate", "--motor", "trum60a", "--data", "fast.csv", "--json", "-"]);
+    assert_eq!(o.status.code(), Some(1), "the default range let 15000 rev/min through");
+    assert!(stderr(&o).contains("line 10, column 'speed_rpm'"), "{}", stderr(&o));
+    let o = trum(d, &["calibrate", "--motor", "m.toml", "--data", "fast.csv", "--json", "-"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let doc: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON");
+    assert_eq!(doc["n_rows"], 9);
+    // the command line wins over the file
+    let o = trum(d, &["calibrate", "--motor", "m.toml", "--data", "fast.csv", "--plausible", "speed_rpm=0:1e4"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("0 to 10000 rpm"), "{}", stderr(&o));
+    // a misspelt column and an empty range name the key and its line
+    for (entry, words) in [
+        ("speedrpm = [0, 2e4]", "key 'plausible.speedrpm': unknown key `speedrpm`"),
+        ("speed_rpm = [2e4, 0]", "key 'plausible.speed_rpm': the low end 20000 is above the high end 0"),
+    ] {
+        std::fs::write(d.join("bad.toml"), format!("preset = \"trum60a\"\n\n[plausible]\n{entry}\n")).expect("write");
+        for cmd in ["calibrate", "diagnose"] {
+            let o = trum(d, &[cmd, "--motor", "bad.toml", "--data", "fast.csv"]);
+            assert_eq!(o.status.code(), Some(1), "{cmd} {entry}");
+            let e = stderr(&o);
+            assert!(e.contains("bad.toml: line 4,") && e.contains(words), "{cmd} {entry}: {e}");
+        }
+    }
+}

@@ -242,6 +242,41 @@ struct MotorFile {
     tolerances: Option<toml::Table>,
     drive: Option<DrivePatch>,
     limits: Option<LimitsPatch>,
+    plausible: Option<crate::measurements::PlausibleTable>,
+}
+
+/// Reads the `[plausible]` table of a motor file: the plausible range of each measured
+/// column that calibration and the diagnosis accept from this motor's bench
+/// (docs/MEASUREMENTS.md, "Plausible ranges"), as `speed_rpm = [0, 20000]` (inclusive;
+/// `inf`/`-inf` for no bound at that end) or `speed_rpm = "any"`. Returns the default
+/// ranges with the table's applied (the defaults alone without a table). Unknown keys and
+/// bad values are errors naming the file, line and key.
+pub fn plausible_from_toml_str(
+    text: &str,
+    source_name: &str,
+) -> Result<crate::measurements::PlausibleRanges, ParamError> {
+    let file: MotorFile = match toml::from_str(text) {
+        Ok(f) => f,
+        // the motor reader words a TOML error with its key and line
+        Err(e) => {
+            return Err(Motor::from_toml_str(text, source_name).err().unwrap_or_else(|| ParamError {
+                source_name: source_name.into(),
+                line: e.span().map(|s| line_of_offset(text, s.start)),
+                key: "plausible".into(),
+                reason: e.message().trim().to_string(),
+            }))
+        }
+    };
+    let mut ranges = crate::measurements::PlausibleRanges::default();
+    if let Some(table) = &file.plausible {
+        table.apply(&mut ranges, |key, reason| ParamError {
+            source_name: source_name.into(),
+            line: line_of_key(text, "plausible", key),
+            key: format!("plausible.{key}"),
+            reason,
+        })?;
+    }
+    Ok(ranges)
 }
 
 /// Reads the `[tolerances]` table of a motor file: how well each uncertain baseline

@@ -15,10 +15,12 @@ use trum_core::measurements::{parse_measurements_with, PlausibleRanges};
 /// `motor`. Returns the JSON document as text and the reader's warnings. Bad files raise
 /// `trum.InputError` naming the file, line and column; data that cannot support a
 /// held-out test raise `trum.InputError` too. `plausible` replaces columns' plausible
-/// ranges (`COLUMN=LOW:HIGH` or `COLUMN=any`, as the CLI's `--plausible`). The work runs
+/// ranges (`COLUMN=LOW:HIGH` or `COLUMN=any`, as the CLI's `--plausible`), after the
+/// `[plausible]` table of `plausible_toml` (a TOML file's text and name). The work runs
 /// with the GIL released.
 #[pyfunction]
-#[pyo3(signature = (motor, data, source, motor_source, exact_cv = false, plausible = Vec::new()))]
+#[pyo3(signature = (motor, data, source, motor_source, exact_cv = false, plausible = Vec::new(), plausible_toml = None))]
+#[allow(clippy::too_many_arguments)]
 pub fn diagnose_csv(
     py: Python<'_>,
     motor: &Bound<'_, PyMotor>,
@@ -27,12 +29,10 @@ pub fn diagnose_csv(
     motor_source: String,
     exact_cv: bool,
     plausible: Vec<String>,
+    plausible_toml: Option<(String, String)>,
 ) -> PyResult<(String, Vec<String>)> {
     let m = motor.get().inner.clone();
-    let mut ranges = PlausibleRanges::default();
-    for spec in &plausible {
-        ranges.parse_assignment(spec).map_err(|e| input_err(py, format!("plausible '{spec}': {e}")))?;
-    }
+    let ranges = plausible_ranges(py, &plausible, plausible_toml.as_ref())?;
     let out = detached(py, move || -> Result<(String, Vec<String>), String> {
         let meas = parse_measurements_with(&data, &source, &ranges).map_err(|e| e.to_string())?;
         let bench = observations(&meas, &m);
@@ -45,25 +45,45 @@ pub fn diagnose_csv(
     out.map_err(|e| input_err(py, e))
 }
 
+/// The plausible ranges in force: the defaults, then the `[plausible]` table of the TOML
+/// text `toml` (text, source name) when given, then every `COLUMN=LOW:HIGH` spec. A bad
+/// table or spec raises `trum.InputError` naming the file, line and key (or the spec).
+fn plausible_ranges(py: Python<'_>, specs: &[String], toml: Option<&(String, String)>) -> PyResult<PlausibleRanges> {
+    let mut ranges = match toml {
+        Some((text, source)) => {
+            trum_core::params::plausible_from_toml_str(text, source).map_err(|e| input_err(py, e.to_string()))?
+        }
+        None => PlausibleRanges::default(),
+    };
+    for spec in specs {
+        ranges.parse_assignment(spec).map_err(|e| input_err(py, format!("plausible '{spec}': {e}")))?;
+    }
+    Ok(ranges)
+}
+
 /// Calibrates the uncertain baseline parameters of `motor` to the measurement CSV `data`
 /// (its bytes; `source` names it in messages), as `trum calibrate` does: a maximum a
 /// posteriori fit with each parameter's tolerance as its prior, bounds refitted once, and
 /// standard errors against relative parameter changes. Returns a dict: `motor` (the
 /// calibrated motor), `params` (rows of name, nominal, value, std_error, at_bound,
 /// identifiable), `chi2`, `chi2_per_reading`, `n_rows`, `n_readings`, `evaluations`,
-/// `warnings` (the fit's) and `notes` (the reader's). The GIL is released while it runs.
+/// `warnings` (the fit's) and `notes` (the reader's). `plausible` and `plausible_toml` set
+/// the plausible ranges as for [`diagnose_csv`]. The GIL is released while it runs.
 #[pyfunction]
-#[pyo3(signature = (motor, data, source))]
+#[pyo3(signature = (motor, data, source, plausible = Vec::new(), plausible_toml = None))]
 pub fn calibrate_csv<'py>(
     py: Python<'py>,
     motor: &Bound<'py, PyMotor>,
     data: Vec<u8>,
     source: String,
+    plausible: Vec<String>,
+    plausible_toml: Option<(String, String)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let pm = motor.get().clone();
     let m = pm.inner.clone();
+    let ranges = plausible_ranges(py, &plausible, plausible_toml.as_ref())?;
     let out = detached(py, move || -> Result<_, String> {
-        let meas = parse_measurements_with(&data, &source, &PlausibleRanges::default()).map_err(|e| e.to_string())?;
+        let meas = parse_measurements_with(&data, &source, &ranges).map_err(|e| e.to_string())?;
         let bench = observations(&meas, &m);
         let mut cal = Calibration::builder(&m, &bench.rows)
             .options(&FitOptions::default())

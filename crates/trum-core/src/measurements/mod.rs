@@ -33,6 +33,7 @@ use columns::Access;
 pub use columns::{Column, ColumnSpec, Range, ABSOLUTE_ZERO_C, COLUMNS};
 pub use error::{MeasurementError, MeasurementErrorKind, MisnameReason, NumberIssue};
 pub use plausible::PlausibleRanges;
+pub(crate) use plausible::PlausibleTable;
 pub use read::{parse_measurements, parse_measurements_with};
 
 /// A header column that is not part of the layout, kept with its raw cells and otherwise

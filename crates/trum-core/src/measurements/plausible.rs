@@ -91,3 +91,89 @@ pub(super) fn describe(column: Column, (lo, hi): (f64, f64)) -> String {
         (false, false) => "any value".into(),
     }
 }
+
+/// The `[plausible]` table of a motor file: a plausible range per measured column, as
+/// `speed_rpm = [0, 20000]` (inclusive; `inf` or `-inf` for no bound at that end) or
+/// `speed_rpm = "any"` (no check). Unknown keys are refused by serde, naming the key and
+/// the valid ones; the values are checked by [`PlausibleTable::apply`]. Every numeric
+/// column of [`COLUMNS`] is a field (a test keeps the two in step).
+#[derive(Debug, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct PlausibleTable {
+    preload_n: Option<toml::Value>,
+    voltage_v: Option<toml::Value>,
+    frequency_hz: Option<toml::Value>,
+    torque_nm: Option<toml::Value>,
+    speed_rpm: Option<toml::Value>,
+    input_power_w: Option<toml::Value>,
+    current_a: Option<toml::Value>,
+    efficiency: Option<toml::Value>,
+    feedback_v: Option<toml::Value>,
+    temperature_c: Option<toml::Value>,
+    ambient_c: Option<toml::Value>,
+    elapsed_s: Option<toml::Value>,
+    speed_std_rpm: Option<toml::Value>,
+}
+
+impl PlausibleTable {
+    fn entries(&self) -> [(&'static str, &Option<toml::Value>); 13] {
+        [
+            ("preload_n", &self.preload_n),
+            ("voltage_v", &self.voltage_v),
+            ("frequency_hz", &self.frequency_hz),
+            ("torque_nm", &self.torque_nm),
+            ("speed_rpm", &self.speed_rpm),
+            ("input_power_w", &self.input_power_w),
+            ("current_a", &self.current_a),
+            ("efficiency", &self.efficiency),
+            ("feedback_v", &self.feedback_v),
+            ("temperature_c", &self.temperature_c),
+            ("ambient_c", &self.ambient_c),
+            ("elapsed_s", &self.elapsed_s),
+            ("speed_std_rpm", &self.speed_std_rpm),
+        ]
+    }
+
+    /// Replaces the ranges of `ranges` the table sets. `err(key, reason)` builds the error
+    /// for a bad value (the caller knows the file and finds the key's line).
+    pub(crate) fn apply<E>(&self, ranges: &mut PlausibleRanges, err: impl Fn(&str, String) -> E) -> Result<(), E> {
+        for (name, value) in self.entries() {
+            let Some(value) = value else { continue };
+            let column = Column::from_name(name).filter(|c| c.is_numeric()).ok_or_else(|| {
+                err(name, "not a numeric measurement column (a bug: the table and the column list disagree)".into())
+            })?;
+            let (lo, hi) = range_of_value(value).map_err(|m| err(name, m))?;
+            ranges.set(column, lo, hi);
+        }
+        Ok(())
+    }
+}
+
+/// `[LOW, HIGH]` or `"any"` as a range; the message says what the key accepts.
+fn range_of_value(value: &toml::Value) -> Result<(f64, f64), String> {
+    const EXPECTED: &str = "expected [LOW, HIGH] (inclusive; inf or -inf for no bound at an end) or \"any\"";
+    let number = |v: &toml::Value| match v {
+        toml::Value::Integer(i) => Some(*i as f64),
+        toml::Value::Float(x) => Some(*x),
+        _ => None,
+    };
+    match value {
+        toml::Value::String(s) if s.trim().eq_ignore_ascii_case("any") => Ok((f64::NEG_INFINITY, f64::INFINITY)),
+        toml::Value::Array(a) if a.len() == 2 => {
+            let (Some(lo), Some(hi)) = (number(&a[0]), number(&a[1])) else {
+                return Err(format!("{EXPECTED}, got {value}"));
+            };
+            if lo.is_nan() || hi.is_nan() {
+                return Err("nan is not a bound (inf or -inf for no bound at an end)".into());
+            }
+            if lo > hi {
+                return Err(format!("the low end {lo} is above the high end {hi}"));
+            }
+            if lo == f64::INFINITY || hi == f64::NEG_INFINITY {
+                return Err(format!("[{lo}, {hi}] holds no number"));
+            }
+            Ok((lo, hi))
+        }
+        _ => Err(format!("{EXPECTED}, got {value}")),
+    }
+}

@@ -522,3 +522,65 @@ fn ten_thousand_unknown_columns_give_one_short_warning_in_linear_time() {
     assert_eq!(m.warnings.len(), 1);
     assert!(m.warnings[0].len() < 300 && m.warnings[0].contains("and 9990 more"), "{}", m.warnings[0]);
 }
+
+/// A motor file's `[plausible]` table replaces the ranges it names (the others keep their
+/// defaults), and the reader then accepts what the defaults refuse.
+#[test]
+fn plausible_table_of_a_motor_file_sets_the_ranges_it_names() {
+    let text =
+        "preset = \"trum60a\"\n\n[plausible]\nspeed_rpm = [0, 20000]\ntemperature_c = \"any\"\npreload_n = [1, inf]\n";
+    let r = crate::params::plausible_from_toml_str(text, "m.toml").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(r.get(Column::SpeedRpm), (0.0, 20_000.0));
+    assert_eq!(r.get(Column::TemperatureC), (f64::NEG_INFINITY, f64::INFINITY));
+    assert_eq!(r.get(Column::PreloadN), (1.0, f64::INFINITY));
+    let d = PlausibleRanges::default();
+    assert_eq!(r.get(Column::VoltageV), d.get(Column::VoltageV));
+    assert_eq!(r.get(Column::FrequencyHz), d.get(Column::FrequencyHz));
+    let csv = "preload_n,voltage_v,frequency_hz,torque_nm,speed_rpm\n250,150,42000,0,15000\n";
+    assert!(parse_measurements(csv.as_bytes(), "t.csv").is_err(), "15000 rev/min passes the default range");
+    assert!(parse_measurements_with(csv.as_bytes(), "t.csv", &r).is_ok());
+    // the motor reader accepts the table (it is not an unknown section) and ignores it
+    let m = crate::Motor::from_toml_str(text, "m.toml").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(m.preset.as_deref(), Some("trum60a"));
+    // no table: the defaults
+    assert_eq!(crate::params::plausible_from_toml_str("preset = \"trum60a\"\n", "m.toml").ok(), Some(d));
+}
+
+/// Every numeric column of the layout is a key of `[plausible]` (the serde table and the
+/// column list agree), and the text column is not.
+#[test]
+fn every_numeric_column_is_a_plausible_key() {
+    let mut text = String::from("preset = \"trum60a\"\n[plausible]\n");
+    for c in COLUMNS.iter().filter(|c| c.column.is_numeric()) {
+        text.push_str(&format!("{} = \"any\"\n", c.name));
+    }
+    let r = crate::params::plausible_from_toml_str(&text, "m.toml").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(r, PlausibleRanges::unlimited());
+    let e = crate::params::plausible_from_toml_str("[plausible]\nrun_id = \"any\"\n", "m.toml")
+        .err()
+        .unwrap_or_else(|| panic!("run_id accepted"));
+    assert_eq!((e.key.as_str(), e.line), ("plausible.run_id", Some(2)), "{e}");
+}
+
+/// Bad `[plausible]` entries are errors naming the file, the line and the key.
+#[test]
+fn bad_plausible_entries_name_file_line_and_key() {
+    for (entry, key, words) in [
+        ("speedrpm = [0, 1]", "plausible.speedrpm", "unknown key `speedrpm`"),
+        ("speed_rpm = [2e4, 0]", "plausible.speed_rpm", "low end 20000 is above the high end 0"),
+        ("speed_rpm = [0, nan]", "plausible.speed_rpm", "nan is not a bound"),
+        ("speed_rpm = [0]", "plausible.speed_rpm", "expected [LOW, HIGH]"),
+        ("speed_rpm = \"some\"", "plausible.speed_rpm", "expected [LOW, HIGH]"),
+        ("speed_rpm = 100", "plausible.speed_rpm", "expected [LOW, HIGH]"),
+        ("speed_rpm = [inf, inf]", "plausible.speed_rpm", "holds no number"),
+    ] {
+        let text = format!("preset = \"trum60a\"\n# ranges of this bench\n[plausible]\n{entry}\n");
+        let e = crate::params::plausible_from_toml_str(&text, "bench.toml")
+            .err()
+            .unwrap_or_else(|| panic!("{entry} accepted"));
+        let msg = e.to_string();
+        assert_eq!(e.key, key, "{entry}: {msg}");
+        assert_eq!(e.line, Some(4), "{entry}: {msg}");
+        assert!(msg.starts_with("bench.toml: line 4, key '") && msg.contains(words), "{entry}: {msg}");
+    }
+}

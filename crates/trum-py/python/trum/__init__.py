@@ -29,6 +29,7 @@ from ._motor import Motor
 from ._axes import linspace
 from ._api import MapResult, Optimum, map, optimize
 from ._diagnosis import Calibration, Diagnosis, calibrate, diagnose
+from ._fleet import CALIBRATE_FLEET_COLUMNS, DIAGNOSE_FLEET_COLUMNS, calibrate_fleet, diagnose_fleet
 from ._estimate import ESTIMATE_COLUMNS, ESTIMATE_STATUS_NAMES, estimate
 from ._dynamics import (
     HertzIdentification,
@@ -58,6 +59,10 @@ __all__ = [
     "diagnose",
     "calibrate",
     "Calibration",
+    "diagnose_fleet",
+    "calibrate_fleet",
+    "DIAGNOSE_FLEET_COLUMNS",
+    "CALIBRATE_FLEET_COLUMNS",
     "estimate",
     "ESTIMATE_COLUMNS",
     "ESTIMATE_STATUS_NAMES",

@@ -54,15 +54,65 @@ def _read_data(data: DataLike) -> Tuple[bytes, str]:
 
 
 def _plausible_specs(plausible: Optional[Mapping[str, Any]]) -> List[str]:
-    """``{"speed_rpm": (0, 2e4), "preload_n": None}`` as the CLI's ``--plausible`` specs."""
+    """``{"speed_rpm": (0, 2e4), "preload_n": None}`` as the CLI's ``--plausible`` specs
+    (an infinite end is no bound there, as ``None`` is)."""
     specs = []
     for col, rng in (plausible or {}).items():
         if rng is None:
             specs.append(f"{col}=any")
         else:
             lo, hi = rng
-            specs.append(f"{col}={'' if lo is None else repr(float(lo))}:{'' if hi is None else repr(float(hi))}")
+            end = lambda x: "" if x is None or np.isinf(float(x)) else repr(float(x))  # noqa: E731
+            specs.append(f"{col}={end(lo)}:{end(hi)}")
     return specs
+
+
+Plausible = Union[None, Mapping[str, Any], str, "os.PathLike[str]"]
+
+
+class _PlausibleToml:
+    """A ``[plausible]`` TOML file already read: its text and name (what travels to a
+    Dask worker, which may not see the client's files)."""
+
+    __slots__ = ("text", "source")
+
+    def __init__(self, text: str, source: str) -> None:
+        self.text, self.source = text, source
+
+    def __reduce__(self) -> Any:
+        return (_PlausibleToml, (self.text, self.source))
+
+
+def _plausible_args(plausible: Plausible) -> Tuple[List[str], Optional[Tuple[str, str]]]:
+    """``plausible=`` as the extension takes it: the specs of a mapping, or the text and
+    name of a TOML file whose ``[plausible]`` table sets the ranges (a motor file)."""
+    if plausible is None:
+        return [], None
+    if isinstance(plausible, _PlausibleToml):
+        return [], (plausible.text, plausible.source)
+    if isinstance(plausible, (str, os.PathLike)):
+        source = os.fspath(plausible)
+        try:
+            with open(source, "rb") as f:
+                raw = f.read()
+        except FileNotFoundError:
+            raise InputError(f"plausible: TOML file '{source}' does not exist") from None
+        except OSError as e:
+            raise InputError(f"plausible: cannot read TOML file '{source}': {e.strerror}") from None
+        try:
+            return [], (raw.decode("utf-8"), source)
+        except UnicodeDecodeError as e:
+            line = 1 + raw[: e.start].count(b"\n")
+            raise InputError(
+                f"{source}: line {line}: byte 0x{raw[e.start]:02X} at offset {e.start} is not valid UTF-8; "
+                "save the file as UTF-8"
+            ) from None
+    if isinstance(plausible, Mapping):
+        return _plausible_specs(plausible), None
+    raise TypeError(
+        "plausible: expected a mapping {column: (low, high) or None} or the path of a TOML file with a "
+        f"[plausible] table, got {type(plausible).__name__}"
+    )
 
 
 class Diagnosis(dict):
@@ -143,7 +193,7 @@ def diagnose(
     data: DataLike,
     *,
     exact_cv: bool = False,
-    plausible: Optional[Mapping[str, Any]] = None,
+    plausible: Plausible = None,
 ) -> Diagnosis:
     """Where the calibrated baseline misses the measurements, which unmodelled effect
     causes it, and how far the held-out gap shrinks once it is added.
@@ -161,12 +211,14 @@ def diagnose(
     A value outside its column's plausible range (docs/MEASUREMENTS.md) is such an error;
     ``plausible={"speed_rpm": (0, 2e4), "preload_n": None}`` replaces ranges when the
     values are real (``None`` for no bound at all; ``None`` at either end of a pair for
-    no bound there).
+    no bound there); ``plausible="motor.toml"`` reads them from the ``[plausible]`` table
+    of a TOML file, such as the motor file (docs/MOTOR_FILE.md).
     """
     m = _motor(motor)
     raw, source = _read_data(data)
     motor_source = motor if isinstance(motor, str) else (m.preset or m.name)
-    text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv), _plausible_specs(plausible))
+    specs, toml = _plausible_args(plausible)
+    text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv), specs, toml)
     for w in notes:
         warnings.warn(w, stacklevel=2)
     return Diagnosis(json.loads(text))
@@ -205,7 +257,7 @@ class Calibration:
                 f"{self.chi2_per_reading:.3g} over {self.n_readings} readings; {len(self.warnings)} warnings>")
 
 
-def calibrate(motor: Union[Motor, str], data: DataLike) -> Calibration:
+def calibrate(motor: Union[Motor, str], data: DataLike, *, plausible: Plausible = None) -> Calibration:
     """Calibrates the uncertain baseline parameters of ``motor`` to measurements, as
     ``trum calibrate`` does (a maximum a posteriori fit, each parameter's tolerance as its
     prior; docs/DIAGNOSIS.md). ``data`` is a measurement table in the layout of
@@ -214,10 +266,13 @@ def calibrate(motor: Union[Motor, str], data: DataLike) -> Calibration:
     ``.to_pandas()`` the parameter table). The reader's notes (ignored columns) come as
     ``warnings.warn``; a bad file raises ``trum.InputError`` naming the file, line and
     column. A motor file's ``[tolerances]`` table is not read here: the default tolerances
-    apply. The GIL is released while it runs."""
+    apply. ``plausible`` replaces plausible ranges as in :func:`diagnose` (a mapping, or
+    the path of a TOML file with a ``[plausible]`` table). The GIL is released while it
+    runs."""
     m = _motor(motor)
     raw, source = _read_data(data)
-    d = _trum.calibrate_csv(m, raw, source)
+    specs, toml = _plausible_args(plausible)
+    d = _trum.calibrate_csv(m, raw, source, specs, toml)
     for w in d["notes"]:
         warnings.warn(w, stacklevel=2)
     return Calibration(d)

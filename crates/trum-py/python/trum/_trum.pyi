@@ -139,8 +139,15 @@ def diagnose_csv(
     motor_source: str,
     exact_cv: bool = False,
     plausible: List[str] = ...,
+    plausible_toml: Optional[Tuple[str, str]] = None,
 ) -> Tuple[str, List[str]]: ...
-def calibrate_csv(motor: Motor, data: bytes, source: str) -> Dict[str, Any]: ...
+def calibrate_csv(
+    motor: Motor,
+    data: bytes,
+    source: str,
+    plausible: List[str] = ...,
+    plausible_toml: Optional[Tuple[str, str]] = None,
+) -> Dict[str, Any]: ...
 
 def estimate_rows(
     motor: Motor,
