@@ -148,6 +148,9 @@ pub(super) fn settle(
 /// 0.075 N·m, 194 V, 41.56 kHz). Below the ratio the band is under 1e-10 of W.
 const MAX_WARM_ELASTICITY: f64 = 1e3;
 
+/// A pass's state solve `state(d, rise, guess, top)` ([`settle_with`]).
+type WarmState<'a> = dyn Fn(&Drive, f64, Option<&Solution>, Option<WarmTop>) -> Solution + 'a;
+
 /// [`settle`] whose state solve (`state(d, rise, guess, top)`) may start its amplitude
 /// descent from `top`, a proven upper bound of the largest fixed point under `d`, instead
 /// of the cold bound Θ·V/(ω·c).
@@ -167,7 +170,7 @@ fn settle_with(
     guess: Option<&Solution>,
     (thermal, sag): (bool, bool),
     rise0: f64,
-    state: &dyn Fn(&Drive, f64, Option<&Solution>, Option<WarmTop>) -> Solution,
+    state: &WarmState,
 ) -> (Solution, f64, bool) {
     let mut d = Drive::at(p, op);
     let mut rise = rise0;
