@@ -19,9 +19,17 @@ fn one_point(c: &mut Criterion) {
     g.bench_function("cold_prepared/trum60a", |b| b.iter(|| solve_prepared(black_box(&p), &m, black_box(&op), None)));
     let guess = solve(&m, &OperatingPoint::new(249.0, 0.29, 200.0, 43e3));
     g.bench_function("warm/trum60a", |b| b.iter(|| solve_prepared(black_box(&p), &m, black_box(&op), Some(&guess))));
+    // The preset as shipped carries its calibrated preload_stiffening (a multi-branch
+    // descent); the effect-free motor is the baseline, and each effect below is alone on it.
+    let mut bare = m.clone();
+    bare.effects.parse_assignment("none").expect("effect");
+    g.bench_function("cold/trum60a-no-effects", |b| b.iter(|| solve(black_box(&bare), black_box(&op))));
     let mut r = m.clone();
     r.effects.parse_assignment("radial_friction=1").expect("effect");
     g.bench_function("cold/trum60a+radial_friction", |b| b.iter(|| solve(black_box(&r), black_box(&op))));
+    let mut sag = bare.clone();
+    sag.effects.parse_assignment("voltage_sag=150").expect("effect");
+    g.bench_function("cold/trum60a-no-effects+voltage_sag", |b| b.iter(|| solve(black_box(&sag), black_box(&op))));
     g.finish();
 }
 

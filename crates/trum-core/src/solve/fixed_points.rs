@@ -22,7 +22,7 @@ use crate::stator;
 /// secant step is therefore kept inside that interval ([`bracketed_secant`]): unbounded,
 /// it is faster but can leave it.
 pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
-    solve_effects_with(p, op, guess, true, |d, g| solve_drive(p, d, op, g))
+    solve_effects_with(p, op, guess, true, |d, g, top| solve_drive_below(p, d, op, g, top))
 }
 
 /// The clamped state of `p` at `op` (W = 0) with the effects' fixed point solved on it,
@@ -31,10 +31,11 @@ pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&So
 /// to slightly changed motors (the descent to W = 0 is the costliest solve there is: 10-80
 /// trials).
 pub(crate) fn solve_clamped(p: &Prepared, op: &OperatingPoint) -> Solution {
-    solve_effects_with(p, op, None, false, |d, _| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0))
+    solve_effects_with(p, op, None, false, |d, _, _| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0))
 }
 
-/// [`solve_effects`] with `drive(d, guess)` solving the amplitude under drive `d`;
+/// [`solve_effects`] with `drive(d, guess, top)` solving the amplitude under drive `d`
+/// (`top`: a proven upper bound of its largest fixed point, [`settle_with`]);
 /// `branches`: `drive` is the amplitude solve, whose lower (stalled) branch is searched
 /// where the electrode voltage jumps ([`settle_lower_branch`]).
 fn solve_effects_with(
@@ -42,14 +43,14 @@ fn solve_effects_with(
     op: &OperatingPoint,
     guess: Option<&Solution>,
     branches: bool,
-    drive: impl Fn(&Drive, Option<&Solution>) -> Solution,
+    drive: impl Fn(&Drive, Option<&Solution>, Option<WarmTop>) -> Solution,
 ) -> Solution {
     let (thermal, sag) = iterated(p, op);
     if !thermal && !sag {
-        return drive(&Drive::at(p, op), guess);
+        return drive(&Drive::at(p, op), guess, None);
     }
-    let direct = |d: &Drive, _: f64, g: Option<&Solution>| drive(d, g);
-    let (mut s, mut rise, mut settled) = settle(p, op, guess, (thermal, sag), 0.0, &direct);
+    let direct_warm = |d: &Drive, _: f64, g: Option<&Solution>, top: Option<WarmTop>| drive(d, g, top);
+    let (mut s, mut rise, mut settled) = settle_with(p, op, guess, (thermal, sag), 0.0, &direct_warm);
     if branches && sag && !thermal && !settled {
         if let Some(stalled) = settle_lower_branch(p, op, &s, 0.0).or_else(|| settle_on_amplitude(p, op, 0.0)) {
             (s, settled) = (stalled, true);
@@ -84,7 +85,7 @@ fn solve_effects_with(
             let inner_settled = std::cell::Cell::new(true);
             let unsettled = std::cell::Cell::new(0);
             let inner = |_: &Drive, r: f64, g: Option<&Solution>| {
-                let (mut s, _, mut ok) = settle(p, op, g, (false, true), r, &direct);
+                let (mut s, _, mut ok) = settle_with(p, op, g, (false, true), r, &direct_warm);
                 if lower && !ok {
                     if let Some(l) = settle_lower_branch(p, op, &s, r).or_else(|| settle_on_amplitude(p, op, r)) {
                         (s, ok) = (l, true);
@@ -132,16 +133,52 @@ pub(super) fn settle(
     p: &Prepared,
     op: &OperatingPoint,
     guess: Option<&Solution>,
-    (thermal, sag): (bool, bool),
+    flags: (bool, bool),
     rise0: f64,
     state: &dyn Fn(&Drive, f64, Option<&Solution>) -> Solution,
+) -> (Solution, f64, bool) {
+    settle_with(p, op, guess, flags, rise0, &|d, r, g, _| state(d, r, g))
+}
+
+/// Largest ratio of relative amplitude change to relative electrode-voltage change between
+/// passes at which a pass starts from the previous amplitude ([`settle_with`]). The ratio
+/// is 1/r'(W) at the fixed point: near a fold of the amplitude map r' is tiny, the
+/// descent's tolerance 1e-13 on r leaves W uncertain to 1e-13/r', and a descent from
+/// another top lands elsewhere in that band (1e-9 apart at trum60-qut, 150 Ω, 640 N,
+/// 0.075 N·m, 194 V, 41.56 kHz). Below the ratio the band is under 1e-10 of W.
+const MAX_WARM_ELASTICITY: f64 = 1e3;
+
+/// A pass's state solve `state(d, rise, guess, top)` ([`settle_with`]).
+type WarmState<'a> = dyn Fn(&Drive, f64, Option<&Solution>, Option<WarmTop>) -> Solution + 'a;
+
+/// [`settle`] whose state solve (`state(d, rise, guess, top)`) may start its amplitude
+/// descent from `top`, a proven upper bound of the largest fixed point under `d`, instead
+/// of the cold bound Θ·V/(ω·c).
+///
+/// The electrode voltage enters a trial only through G(W) = Θ·V/|Z(W)|: the impedance Z
+/// depends on W and the drive's other inputs, not on V. So a pass of the electrode voltage
+/// alone (the temperature rise fixed) at V₂ ≤ V₁ has G₂ = (V₂/V₁)·G₁ ≤ G₁ at every W, and
+/// the previous pass's amplitude W₁, the largest fixed point of G₁ (G₁(W) < W above it),
+/// bounds the largest fixed point of G₂ from above. Late passes move V by a hair, so the
+/// descent from W₁ needs 1-3 trials instead of a descent from the cold bound (about six).
+/// Where V rises, the previous state is not a solved amplitude (clamped, unconverged), or
+/// the amplitude is ill-conditioned ([`MAX_WARM_ELASTICITY`]; the first pass, without two
+/// states to tell), the pass descends from the cold bound.
+fn settle_with(
+    p: &Prepared,
+    op: &OperatingPoint,
+    guess: Option<&Solution>,
+    (thermal, sag): (bool, bool),
+    rise0: f64,
+    state: &WarmState,
 ) -> (Solution, f64, bool) {
     let mut d = Drive::at(p, op);
     let mut rise = rise0;
     if rise != 0.0 {
         d.warm(p, rise);
     }
-    let mut s = state(&d, rise, guess);
+    let mut s = state(&d, rise, guess, None);
+    let mut older: Option<(f64, f64)> = None;
     let mut settled = false;
     // (x, G(x)) of the previous pass, for the temperature rise and the electrode voltage
     let mut last_pass: Option<((f64, f64), (f64, f64))> = None;
@@ -163,6 +200,9 @@ pub(super) fn settle(
             bracketed_secant(rise, new_rise, last_pass.map(|l| l.0)),
             bracketed_secant(d.v, new_v, last_pass.map(|l| l.1)),
         );
+        if sag && !thermal {
+            next.1 = monotone_secant(d.v, new_v, last_pass.map(|l| l.1)).unwrap_or(next.1);
+        }
         last_pass = Some(((rise, new_rise), (d.v, new_v)));
         if thermal != sag && !done {
             let (x, gx) = if thermal { (rise, new_rise) } else { (d.v, new_v) };
@@ -194,12 +234,30 @@ pub(super) fn settle(
                 }
             }
         }
+        let v_prev = d.v;
         (rise, d.v) = next;
         if thermal {
             d.warm(p, rise);
         }
         let prev = s.clone();
-        s = state(&d, rise, Some(&prev).filter(|g| g.status.is_valid()));
+        // (W, V) of the state before `prev`: their ratio of relative changes is
+        // 1/r'(W) at the fixed point (W = V·Θ/|Z(W)|), how far the descent's tolerance
+        // on r leaves W uncertain
+        let well_conditioned = older.is_some_and(|(w0, v0): (f64, f64)| {
+            let elasticity = ((prev.amplitude_m - w0) / w0) / ((v_prev - v0) / v0);
+            elasticity.abs() <= MAX_WARM_ELASTICITY
+        });
+        let warm = sag
+            && !thermal
+            && well_conditioned
+            && d.v <= v_prev
+            && matches!(prev.status, Status::Ok | Status::Stall)
+            && prev.amplitude_m > 0.0
+            && prev.amplitude_m.is_finite();
+        let top =
+            warm.then_some(WarmTop { bound: prev.amplitude_m, predicted: None, contact_rad: None, stick_rad: None });
+        older = Some((prev.amplitude_m, v_prev));
+        s = state(&d, rise, Some(&prev).filter(|g| g.status.is_valid()), top);
         if done {
             settled = true;
             break;
@@ -209,6 +267,26 @@ pub(super) fn settle(
         }
     }
     (s, rise, settled)
+}
+
+/// Largest slope of the electrode voltage's pass map V ↦ G(V) at which
+/// [`monotone_secant`] extrapolates a monotone approach.
+const MAX_MONOTONE_SLOPE: f64 = 0.5;
+
+/// The secant root of x − G(x) through this pass (`x`, `gx`) and the last one, where the
+/// passes approach the fixed point from one side (G rises with x, slope in (0,
+/// [`MAX_MONOTONE_SLOPE`]]): the step goes on in the passes' own direction, at most twice
+/// as far as the plain pass. A sagging drive's passes descend from the set voltage at a
+/// ratio of about 0.02 (trum60a, 150 Ω): plain passes need seven or eight to reach the
+/// 1e-12 tolerance, the secant four or five. An overshoot past the fixed point is at most
+/// the secant's error, and the passes after it alternate ([`bracketed_secant`]). `None`
+/// where the passes alternate or the slope is out of that range.
+fn monotone_secant(x: f64, gx: f64, last: Option<(f64, f64)>) -> Option<f64> {
+    let (x0, g0) = last?;
+    let slope = (gx - g0) / (x - x0);
+    let monotone = (gx - x) * (g0 - x0) > 0.0 && (x - x0) * (gx - x) > 0.0;
+    let next = x + (gx - x) / (1.0 - slope);
+    (monotone && slope > 0.0 && slope <= MAX_MONOTONE_SLOPE && next.is_finite()).then_some(next)
 }
 
 /// A consistent state on a lower branch of the amplitude map where the electrode
