@@ -3,7 +3,9 @@
     python benches/compare_python.py            # or: bash benches/compare_python.sh
 
 Three implementations of the baseline steady state (docs/MODEL.md; no effects) solve the
-same operating points of the trum60a preset (200 V, 43 kHz, preload x load torque):
+same operating points of an effect-free TRUM60A (tests/data/motors/trum60a_baseline.toml;
+the shipped preset switches `preload_stiffening` on, which the Python versions do not
+model), 200 V, 43 kHz, preload x load torque:
 
 * ``scipy``: per point, the way a user writes it — ``scipy.optimize.brentq`` for the
   contact angle, for the stick angle and for the amplitude, inside a Python loop;
@@ -56,10 +58,17 @@ COMPARED = [
 ]
 
 
-def motor_params(trum_bin, preset):
-    """Constants of a preset, read from `trum presets show` (the same numbers trum uses)."""
-    text = subprocess.run([trum_bin, "presets", "show", preset], check=True, capture_output=True, text=True).stdout
-    t = tomllib.loads(text)
+def motor_params(trum_bin, motor):
+    """Constants of a motor file, or of a preset read from `trum presets show` (the same
+    numbers trum uses). The motor must have no effects: the Python versions model none."""
+    if os.path.exists(motor):
+        with open(motor, "rb") as f:
+            t = tomllib.load(f)
+    else:
+        text = subprocess.run([trum_bin, "presets", "show", motor], check=True, capture_output=True, text=True).stdout
+        t = tomllib.loads(text)
+    if t.get("effects"):
+        sys.exit(f"{motor} switches effects on ({', '.join(t['effects'])}); the Python versions model none")
     g, fl, st, el, ro = t["geometry"], t["friction_layer"], t["stator"], t["electrical"], t["rotor"]
     n = g["wave_number"]
     return dict(
@@ -273,7 +282,8 @@ def rel_err(a, b, scale):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--preset", default="trum60a")
+    ap.add_argument("--motor", default=os.path.join(ROOT, "tests", "data", "motors", "trum60a_baseline.toml"),
+                    help="an effect-free motor file (every key given) or preset")
     ap.add_argument("--grid", type=int, nargs=2, default=[200, 100], metavar=("NF", "NT"),
                     help="preload x torque points for numpy and trum (default 200 x 100)")
     ap.add_argument("--scipy-points", type=int, default=2000, help="points the per-point SciPy version solves")
@@ -281,13 +291,13 @@ def main():
     a = ap.parse_args()
     import trum
 
-    P = motor_params(a.trum_bin, a.preset)
+    P = motor_params(a.trum_bin, a.motor)
     V, f = 200.0, 43e3
     nf, nt = a.grid
     F, T = np.meshgrid(np.linspace(100.0, 500.0, nf), np.linspace(0.0, 1.2, nt), indexing="ij")
     F, T = F.ravel(), T.ravel()
     n = F.size
-    motor = trum.Motor(a.preset)
+    motor = trum.Motor.from_toml(a.motor) if os.path.exists(a.motor) else trum.Motor(a.motor)
 
     def best_of(k, fn):
         ts = []
@@ -300,10 +310,10 @@ def main():
     t_trum, res = best_of(5, lambda: motor.solve(preload_n=F, torque_nm=T, voltage_v=V, frequency_hz=f, parallel=False))
     # The same points as a grid (what a user making a map calls): rows along the torque
     # axis are warm-started sweeps; the grid's order is the meshgrid's above.
-    t_map, res_map = best_of(5, lambda: trum.map(motor, preload_n=(100.0, 500.0, nf), torque_nm=(0.0, 1.2, nt),
+    t_map, res_map = best_of(5, lambda: trum.map(motor, preload_n=trum.linspace(100.0, 500.0, nf), torque_nm=trum.linspace(0.0, 1.2, nt),
                                                  voltage_v=V, frequency_hz=f, parallel=False))
     # ... and on every core (the default): the same numbers, rows start cold whatever the threads
-    t_par, res_par = best_of(5, lambda: trum.map(motor, preload_n=(100.0, 500.0, nf), torque_nm=(0.0, 1.2, nt),
+    t_par, res_par = best_of(5, lambda: trum.map(motor, preload_n=trum.linspace(100.0, 500.0, nf), torque_nm=trum.linspace(0.0, 1.2, nt),
                                                  voltage_v=V, frequency_hz=f, parallel=True))
     t_np, (st_np, out_np) = best_of(3, lambda: numpy_points(P, F, T, V, f))
     # SciPy: an evenly spread subset of the same points (the whole grid would take minutes).
@@ -348,7 +358,7 @@ def main():
             ok = False
 
     per = lambda t, k: t / k * 1e6
-    print(f"{a.preset}, {V:g} V, {f:g} Hz, preload 100-500 N x torque 0-1.2 N m; statuses: "
+    print(f"{os.path.basename(a.motor)}, {V:g} V, {f:g} Hz, preload 100-500 N x torque 0-1.2 N m; statuses: "
           + ", ".join(f"{s} {int((st_trum == s).sum())}" for s in (OK, STALL, CLAMPED)))
     tp = per(t_trum, n)
     tm = per(t_map, n)
