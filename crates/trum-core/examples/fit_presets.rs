@@ -270,7 +270,7 @@ fn plausible_range(m: &Motor, v: f64, hzs: &[f64], preloads: &[f64]) -> Vec<Targ
         plausible("largest steady temperature rise below the top preload [K]", tmax, (1.0, 60.0), 0.3),
         plausible("largest input power at the top preload [W]", pedge, (1.0, 20.0), 0.1),
         plausible("largest steady temperature rise at the top preload [K]", tedge, (1.0, 80.0), 0.3),
-        plausible("points of the range not running or stalled [-]", bad as f64, (0.0, 0.0), 0.5),
+        plausible("points of the range not running or stalled [-]", bad as f64, (0.0, 0.0), 0.1),
     ]
 }
 /// Sun, Yin, Liu and Zhang 2021 (TRUM-60), at 150 V and 42 kHz.
@@ -374,6 +374,11 @@ fn main() {
     let scan: usize = args.iter().find_map(|a| a.strip_prefix("--scan=")).map_or(400, |s| s.parse().expect("n"));
     let iters: usize = args.iter().find_map(|a| a.strip_prefix("--iterations=")).map_or(150, |s| s.parse().expect("n"));
     let mut base = trum_core::presets::preset(name).expect("preset");
+    // `--set=KEY=VALUE` (repeatable): try a value without editing the preset file
+    for kv in args.iter().filter_map(|a| a.strip_prefix("--set=")) {
+        let (k, v) = kv.split_once('=').expect("--set=KEY=VALUE");
+        set(&mut base, k, v.parse().expect("--set value: a number"));
+    }
     if get(&base, "effects.preload_stiffening.stiffness_scale").is_nan() {
         // the fit starts from the full projection of the contact stiffness on the mode
         base.effects.parse_assignment("preload_stiffening:stiffness_scale=1,modal_fraction=1").expect("effect");
