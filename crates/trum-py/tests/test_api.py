@@ -32,7 +32,8 @@ def test_from_dict_forms(motor):
     assert flat.overrides() == {"stator.modal_damping_ns_per_m": 12.0}
     fx = trum.Motor.from_dict({"preset": "trum60a", "effects": {"radial_friction": 0.5}})
     assert fx == motor.with_effects("radial_friction=0.5") == motor.with_effects(radial_friction=0.5)
-    # (the preset carries its paper's contact stiffening; the added effect joins it)
+    # (the preset carries its paper's effects; the added one joins them, replacing the
+    # preset's strength of the same effect)
     assert fx.active_effects == {**motor.active_effects, "radial_friction": {"radial_velocity_ratio": 0.5}}
     assert "preload_stiffening" in motor.active_effects
     hs = {"beta_n_per_m3": 1e19, "preload_gain_per_n": 0.001}

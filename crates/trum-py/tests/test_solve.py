@@ -40,11 +40,10 @@ def test_known_values_match_cli_snapshot(motor):
     # `trum point --motor trum60a --preload-n 250 --torque-nm 0.3` (the CLI's snapshot
     # crates/trum-cli/tests/snapshots/point_trum60a_250n_0.3nm.txt, 6 significant digits).
     r = motor.solve(preload_n=250.0, torque_nm=0.3, voltage_v=200.0, frequency_hz=43000.0)
-    expect = dict(speed_rpm=206.944, speed_rad_s=21.6711, efficiency=0.109038, output_power_w=6.50134,
-                  input_power_w=59.6247, stall_torque_nm=1.68659, amplitude_m=4.40871e-6,
-                  contact_angle_deg=27.0226, driving_angle_deg=10.19, driving_ratio=0.377091,
-                  contact_half_angle_rad=2.12235, stick_half_angle_rad=0.800318, contact_length_m=0.0123804,
-                  crest_speed_m_s=0.816776)
+    expect = dict(speed_rpm=66.7943, speed_rad_s=6.99468, efficiency=0.219263, output_power_w=2.09841,
+                  input_power_w=9.57026, stall_torque_nm=1.6211, amplitude_m=1.26498e-6, contact_angle_deg=24.4176,
+                  driving_angle_deg=9.13774, driving_ratio=0.374227, contact_half_angle_rad=1.91776,
+                  stick_half_angle_rad=0.717677, contact_length_m=0.0111869, crest_speed_m_s=0.24373)
     assert r.status.item() == "ok"
     for q, v in expect.items():
         assert r[q].item() == pytest.approx(v, rel=6e-6), q
