@@ -9,7 +9,8 @@
 #   bash benches/make_rows.sh N OUT.csv
 #   EFFECT=none bash benches/make_rows.sh N OUT.csv       # no effect (default radial_friction=1)
 #   ERRATIC=0.3 bash benches/make_rows.sh N OUT.csv       # erratic speeds: every speed_rpm
-#                                                         # reading scattered by 30 % (normal)
+#                                                         # reading scattered by 30 % (normal,
+#                                                         # folded at zero)
 # Needs target/release/trum (cargo build --release -p trum-cli).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -48,7 +49,9 @@ done
                 # column 5 is speed_rpm: a normal scatter of the given relative size
                 if (erratic > 0 && $5 != "") {
                     z = sqrt(-2 * log(1 - rand())) * cos(6.283185307179586 * rand())
-                    $5 = $5 * (1 + erratic * z)
+                    s = $5 * (1 + erratic * z)
+                    # (a speed reading is never negative: a scatter below zero reads its size)
+                    $5 = s < 0 ? -s : s
                 }
                 print
             }

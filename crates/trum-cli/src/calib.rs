@@ -22,7 +22,7 @@ pub struct CalibrateArgs {
     plausible: crate::data::PlausibleArgs,
     /// Most measurement rows to calibrate to (docs/CLI.md, "Limits"): more are refused
     /// before the fit with the estimated time and memory; raise this to run anyway.
-    #[arg(long, value_name = "N", default_value_t = 200_000)]
+    #[arg(long, value_name = "N", default_value_t = 2_000_000)]
     max_rows: usize,
     /// Most rows the fit sees: larger data are fitted on a systematic subsample of this many
     /// (one row in every n/N, in file order; a warning says so, and the χ² and the standard

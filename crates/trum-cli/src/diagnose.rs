@@ -32,7 +32,7 @@ pub struct DiagnoseArgs {
     plausible: crate::data::PlausibleArgs,
     /// Most measurement rows to diagnose (docs/CLI.md, "Limits"): more are refused before
     /// the run with the estimated time and memory; raise this to run anyway.
-    #[arg(long, value_name = "N", default_value_t = 10_000)]
+    #[arg(long, value_name = "N", default_value_t = 1_000_000)]
     max_rows: usize,
     /// Most rows the fits see: larger data are diagnosed on a systematic subsample of this
     /// many (one row in every n/N, in file order; a note says so, and the evidence and the

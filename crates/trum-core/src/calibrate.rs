@@ -1602,6 +1602,70 @@ pub(crate) mod tests {
         assert!(cal.warnings.is_empty(), "{:?}", cal.warnings);
     }
 
+    /// A systematic subsample: the middle row of each equal stretch, every index once, in
+    /// order; none below the limit.
+    #[test]
+    fn the_systematic_sample_spreads_over_the_file() {
+        assert_eq!(systematic_sample(10, 5), Some(vec![1, 3, 5, 7, 9]));
+        assert_eq!(systematic_sample(7, 3), Some(vec![1, 3, 5]));
+        assert_eq!(systematic_sample(5, 5), None);
+        assert_eq!(systematic_sample(1_000_000, 0), None);
+        let s = systematic_sample(1_000_003, 20_000).expect("sample");
+        assert_eq!(s.len(), 20_000);
+        assert!(s.windows(2).all(|w| w[1] > w[0] && w[1] - w[0] <= 51));
+        assert!(s[0] <= 25 && *s.last().expect("last") >= 1_000_003 - 26);
+    }
+
+    /// A fit of more rows than its limit sees a systematic subsample: the same optimum as
+    /// all rows (noise-free data of a perturbed friction and damping), a warning naming
+    /// the subsample, the subsample's readings counted, and standard errors larger than
+    /// all rows give by about the square root of the ratio (1.9 for 36 of 128 rows; a
+    /// grid's rows are not all alike, so within ±35 %).
+    #[test]
+    fn a_fit_of_many_rows_sees_a_subsample_and_says_so() {
+        let truth = reference_motor();
+        let preloads: Vec<f64> = (0..16).map(|i| 100.0 + 20.0 * i as f64).collect();
+        let mut rows = rows_on_grid(&truth, &preloads, &[0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7]);
+        // readings off the truth by a fixed pseudo-random pattern of unit noise, so that
+        // the standard errors rest on a χ² near the readings' count
+        for (i, r) in rows.iter_mut().enumerate() {
+            for (k, x) in r.readings.iter_mut().enumerate() {
+                x.1 += x.2 * (1.7 * (i * 3 + k) as f64).sin() * 1.4;
+            }
+        }
+        let mut start = truth.clone();
+        start.friction_layer.friction_coefficient *= 1.2;
+        start.stator.modal_damping_ns_per_m *= 0.8;
+        let params = vec![
+            fit_rel(&start, "friction_layer.friction_coefficient", 0.3, 3.0),
+            fit_rel(&start, "stator.modal_damping_ns_per_m", 0.2, 5.0),
+        ];
+        let fit = |max_rows: usize| {
+            let mut cal = Calibration::builder(&start, &rows)
+                .params(&params)
+                .options(&FitOptions::default())
+                .max_rows(max_rows)
+                .run()
+                .expect("fit");
+            rescale_uncertainties(&mut cal, &rows);
+            cal
+        };
+        let all = fit(0);
+        let part = fit(36);
+        assert_eq!(all.sample, None);
+        assert_eq!(part.sample, Some((36, 128)));
+        assert_eq!(part.n_readings, 36 * 3);
+        assert_eq!(all.n_readings, 128 * 3);
+        assert!(part.warnings[0].contains("subsample of 36 of the 128 rows"), "{:?}", part.warnings);
+        assert_eq!(part.fitted_rows(&rows).len(), 36);
+        for (a, p) in all.params.iter().zip(&part.params) {
+            let ratio = p.std_error / a.std_error;
+            assert!((ratio / (128.0f64 / 36.0).sqrt() - 1.0).abs() < 0.35, "{}: ratio {ratio}", a.name);
+            // the two optima agree within the subsample's standard error
+            assert!((p.value - a.value).abs() < 3.0 * p.std_error, "{}: {} vs {}", a.name, p.value, a.value);
+        }
+    }
+
     /// A torque transducer's zero offset is a nuisance the fit recovers: noise-free rows of
     /// the reference motor whose torque column reads the load plus 0.004 N·m (1.3 % of the
     /// largest load) give the offset back (within 2 % without a prior) while the contact

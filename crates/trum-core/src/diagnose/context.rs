@@ -248,3 +248,60 @@ pub(super) fn noise_scaled(
 pub(super) fn speed_std_clipped(rows: &[ObservedRow], estimated: bool) -> bool {
     estimated && rows.iter().flat_map(|r| &r.readings).any(|x| crate::noise::clipped_reading(x.0, x.1))
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
+mod tests {
+    use super::super::tests::quick;
+    use super::super::{diagnose, DiagnoseOptions};
+    use crate::effects::Effect;
+    use crate::synth::{synthesize, Campaign, SynthConfig};
+
+    /// Two preload-torque campaigns of one motor with a voltage sag (112 rows), diagnosed with
+    /// at most 56 rows fitted: the fits see one row in two, a note says so, the counts are
+    /// the input's rows and the subsample's readings, every held-out reading names its row
+    /// in the input with that row's measured value, and the sag is still found, with less
+    /// evidence than all rows give it.
+    #[test]
+    fn large_data_are_diagnosed_on_a_subsample_that_the_result_names() {
+        let nominal = crate::calibrate::tests::reference_motor();
+        let mut truth = nominal.clone();
+        truth.effects.set_strength(Effect::VoltageSag, 300.0);
+        // one motor (one motor seed) measured twice with different noise
+        let (mut rows, mut groups) = (Vec::new(), Vec::new());
+        for seed in [11, 12] {
+            let cfg = SynthConfig {
+                campaign: Campaign::PreloadTorque,
+                noise: 1.0,
+                seed,
+                motor_seed: Some(11),
+                ..SynthConfig::default()
+            };
+            for r in synthesize(&truth, &cfg).unwrap() {
+                rows.push(r.observed());
+                groups.push(format!("{seed}-{}", r.run_id));
+            }
+        }
+        let opts = DiagnoseOptions { max_fit_rows: 56, ..quick(false) };
+        let part = diagnose(&nominal, &rows, &groups, &opts).unwrap();
+        let all = diagnose(&nominal, &rows, &groups, &DiagnoseOptions { max_fit_rows: 0, ..opts.clone() }).unwrap();
+        assert_eq!(part.n_rows, 112);
+        assert_eq!(all.n_rows, 112);
+        let sample = crate::calibrate::systematic_sample(112, 56).unwrap();
+        let sampled_readings: usize = sample.iter().map(|&i| rows[i].readings.len()).sum();
+        assert_eq!(part.n_readings, sampled_readings);
+        assert!(part.notes.iter().any(|n| n.starts_with("112 rows: the fits see a systematic subsample of 56")));
+        assert!(!all.notes.iter().any(|n| n.contains("subsample")));
+        assert_eq!(part.heldout.len(), sampled_readings);
+        for h in &part.heldout {
+            assert!(sample.contains(&h.row), "row {}", h.row);
+            assert!(rows[h.row].readings.iter().any(|x| x.0 == h.observable && x.1 == h.measured));
+        }
+        for d in [&part, &all] {
+            assert_eq!(d.verdict, "voltage_sag", "{:?}", d.notes);
+        }
+        let evidence =
+            |d: &super::super::Diagnosis| d.ranking.iter().find(|r| r.effect == "voltage_sag").unwrap().evidence;
+        assert!(evidence(&part) > 5.0 && evidence(&part) < evidence(&all), "{} vs {}", evidence(&part), evidence(&all));
+    }
+}
