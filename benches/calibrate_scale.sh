@@ -6,8 +6,10 @@
 #   SIZES="10000 100000 1000000" bash benches/calibrate_scale.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release -q -p trum-cli
-T=target/release/trum
+# TRUM=path/to/trum times that binary instead of building target/release/trum
+if [ -z "${TRUM:-}" ]; then cargo build --release -q -p trum-cli; fi
+T=${TRUM:-target/release/trum}
+export TRUM="$T"
 MOTOR=tests/data/motors/ring60.toml
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT

@@ -37,7 +37,7 @@ impl PlausibleArgs {
 }
 
 /// The size model of `calibrate` and `diagnose`: time and memory a measurement row costs
-/// (docs/CLI.md, "Limits"). Both fit a systematic subsample of large data (20 000 and 256
+/// (docs/CLI.md, "Limits"). Both fit a systematic subsample of large data (20 000 and 160
 /// rows by default), so beyond a constant a row costs its reading, the bench model and one
 /// or two solves: 10^6 rows calibrated in 48 s and 0.70 GB, 10^5 rows diagnosed in 15-28 s
 /// and 98 MB on the loaded reference machine (docs/PERFORMANCE.md), erratic data no slower.

@@ -84,7 +84,7 @@ pub struct DiagnoseOptions {
 /// The default [`DiagnoseOptions::max_fit_rows`]: the size at which a diagnosis with all
 /// seven candidates stays near a second on two cores (docs/PERFORMANCE.md), and where a
 /// candidate that matters reaches an evidence of hundreds on nominal bench noise.
-pub const MAX_FIT_ROWS: usize = 256;
+pub const MAX_FIT_ROWS: usize = 160;
 
 impl Default for DiagnoseOptions {
     fn default() -> Self {
