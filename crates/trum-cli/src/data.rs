@@ -39,8 +39,9 @@ impl PlausibleArgs {
 /// The size model of `calibrate` and `diagnose`: time and memory a measurement row costs
 /// (docs/CLI.md, "Limits"). Both fit a systematic subsample of large data (20 000 and 160
 /// rows by default), so beyond a constant a row costs its reading, the bench model and one
-/// or two solves: 10^6 rows calibrated in 48 s and 0.70 GB, 10^5 rows diagnosed in 15-28 s
-/// and 98 MB on the loaded reference machine (docs/PERFORMANCE.md), erratic data no slower.
+/// or two solves: 10^6 rows calibrated in 8.8 s (48 s at load average 11) and 0.70 GB,
+/// 10^5 rows diagnosed in 1.4-2.5 s and 94 MB at load average 6 (docs/PERFORMANCE.md);
+/// the figures here are the loaded machine's, upper bounds.
 pub struct RowCost {
     /// Seconds a row, on the reference machine.
     pub seconds: f64,
@@ -53,7 +54,7 @@ pub struct RowCost {
 /// Calibration's row cost.
 pub const CALIBRATE_ROW: RowCost = RowCost { seconds: 5e-5, bytes: 7.2e2, what: "calibrate" };
 /// The diagnosis's row cost (beyond the subsample's fits, a few seconds whatever the size).
-pub const DIAGNOSE_ROW: RowCost = RowCost { seconds: 3e-4, bytes: 1e3, what: "diagnose" };
+pub const DIAGNOSE_ROW: RowCost = RowCost { seconds: 5e-5, bytes: 1e3, what: "diagnose" };
 
 /// Refuses more than `max_rows` rows before any work, with the estimate and the flag.
 pub fn check_rows(data: &str, rows: usize, max_rows: usize, cost: &RowCost) -> Result<()> {
