@@ -31,8 +31,13 @@ pub struct CalibrateArgs {
     plausible: crate::data::PlausibleArgs,
     /// Most measurement rows to calibrate to (docs/CLI.md, "Limits"): more are refused
     /// before the fit with the estimated time and memory; raise this to run anyway.
-    #[arg(long, value_name = "N", default_value_t = 200_000)]
+    #[arg(long, value_name = "N", default_value_t = 2_000_000)]
     max_rows: usize,
+    /// Most rows the fit sees: larger data are fitted on a systematic subsample of this many
+    /// (one row in every n/N, in file order; a warning says so, and the χ² and the standard
+    /// errors are the subsample's). 0: every row, at a cost that grows with them.
+    #[arg(long, value_name = "N", default_value_t = trum_core::calibrate::MAX_FIT_ROWS)]
+    fit_rows: usize,
     /// Write the calibrated motor file here (TOML; `-` for stdout instead of the table).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Option<PathBuf>,
@@ -75,6 +80,7 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         .tolerances(&tolerances)
         .options(&FitOptions::default())
         .refit_bounds(true)
+        .max_rows(a.fit_rows)
         .run();
     let mut cal = cal.map_err(|e| anyhow!("{data}: {e}"));
     if let Ok(cal) = &mut cal {
@@ -88,6 +94,7 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
             "motor": { "name": motor.name, "source": a.motor.motor, "effects": motor.effects.to_string() },
             "data": data,
             "n_rows": bench.rows.len(),
+            "n_rows_fitted": cal.sample.map_or(bench.rows.len(), |(m, _)| m),
             "n_readings": cal.n_readings,
             "chi2": num(cal.chi2),
             "chi2_per_reading": num(chi2_per),

@@ -38,9 +38,11 @@ impl PlausibleArgs {
 }
 
 /// The size model of `calibrate` and `diagnose`: time and memory a measurement row costs
-/// (docs/CLI.md, "Limits"). Calibration: 10^6 rows took 417 s and 5.4 GB; a diagnosis
-/// about 6 ms a row on clean data (1120 rows in 6.9 s, docs/PERFORMANCE.md) and up to
-/// 40 ms a row on erratic data, memory as calibration's several times over.
+/// (docs/CLI.md, "Limits"). Both fit a systematic subsample of large data (20 000 and 160
+/// rows by default), so beyond a constant a row costs its reading, the bench model and one
+/// or two solves: 10^6 rows calibrated in 8.8 s (48 s at load average 11) and 0.70 GB,
+/// 10^5 rows diagnosed in 1.4-2.5 s and 94 MB at load average 6 (docs/PERFORMANCE.md);
+/// the figures here are the loaded machine's, upper bounds.
 pub struct RowCost {
     /// Seconds a row, on the reference machine.
     pub seconds: f64,
@@ -51,9 +53,9 @@ pub struct RowCost {
 }
 
 /// Calibration's row cost.
-pub const CALIBRATE_ROW: RowCost = RowCost { seconds: 4.2e-4, bytes: 5.4e3, what: "calibrate" };
-/// The diagnosis's row cost (clean data; erratic data up to 7 times the time).
-pub const DIAGNOSE_ROW: RowCost = RowCost { seconds: 6e-3, bytes: 2e4, what: "diagnose" };
+pub const CALIBRATE_ROW: RowCost = RowCost { seconds: 5e-5, bytes: 7.2e2, what: "calibrate" };
+/// The diagnosis's row cost (beyond the subsample's fits, a few seconds whatever the size).
+pub const DIAGNOSE_ROW: RowCost = RowCost { seconds: 5e-5, bytes: 1e3, what: "diagnose" };
 
 /// Refuses more than `max_rows` rows before any work, with the estimate and the flag.
 pub fn check_rows(data: &str, rows: usize, max_rows: usize, cost: &RowCost) -> Result<()> {

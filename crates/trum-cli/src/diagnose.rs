@@ -41,8 +41,13 @@ pub struct DiagnoseArgs {
     plausible: crate::data::PlausibleArgs,
     /// Most measurement rows to diagnose (docs/CLI.md, "Limits"): more are refused before
     /// the run with the estimated time and memory; raise this to run anyway.
-    #[arg(long, value_name = "N", default_value_t = 10_000)]
+    #[arg(long, value_name = "N", default_value_t = 1_000_000)]
     max_rows: usize,
+    /// Most rows the fits see: larger data are diagnosed on a systematic subsample of this
+    /// many (one row in every n/N, in file order; a note says so, and the evidence and the
+    /// held-out figures are the subsample's). 0: every row, at a cost that grows with them.
+    #[arg(long, value_name = "N", default_value_t = trum_core::diagnose::MAX_FIT_ROWS)]
+    fit_rows: usize,
     /// Write the diagnosis as JSON here (`-`: JSON to stdout instead of the summary).
     #[arg(long, value_name = "OUT.json")]
     json: Option<PathBuf>,
@@ -75,6 +80,7 @@ pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
         spinner("diagnosing: calibrating the baseline and every candidate effect on held-out regions", a.quiet);
     let opts = DiagnoseOptions {
         exact_cv: a.exact_cv,
+        max_fit_rows: a.fit_rows,
         tolerances: crate::motor::load_tolerances(&a.motor)?,
         ..DiagnoseOptions::default()
     };

@@ -354,6 +354,9 @@ pub struct Calibration {
     pub(crate) abandoned: bool,
     /// The fit linearised at its optimum (for approximate leave-block-out refits).
     pub(crate) lin: Linearisation,
+    /// (rows fitted, rows given) when the fit saw a systematic subsample
+    /// ([`Calibrate::max_rows`]); `None` when it saw every row.
+    pub sample: Option<(usize, usize)>,
 }
 
 /// A fit linearised at its optimum: the start motor the parameters are applied to, the
@@ -872,6 +875,23 @@ pub struct Calibrate<'a> {
     added: &'a [Effect],
     start: Start,
     weights: Option<Vec<f64>>,
+    max_rows: usize,
+}
+
+/// The default [`Calibrate::max_rows`]: more rows are fitted on a systematic subsample of
+/// this many. At nominal bench noise 20 000 rows determine every baseline parameter to a
+/// small fraction of its tolerance (the model's own error is larger), and the fit takes
+/// seconds and about 100 MB (docs/PERFORMANCE.md).
+pub const MAX_FIT_ROWS: usize = 20_000;
+
+/// The indices of a systematic subsample of `m` of `n` rows: the middle row of each of `m`
+/// equal stretches in file order, so every run longer than n/m rows keeps its share and
+/// rows in random order give a random sample. `None` when `n` ≤ `m` or `m` is 0 (no limit).
+pub fn systematic_sample(n: usize, m: usize) -> Option<Vec<usize>> {
+    if m == 0 || n <= m {
+        return None;
+    }
+    Some((0..m).map(|j| ((2 * j + 1) * n / (2 * m)).min(n - 1)).collect())
 }
 
 impl Calibration {
@@ -889,6 +909,16 @@ impl Calibration {
             added: &[],
             start: Start::Fresh,
             weights: None,
+            max_rows: MAX_FIT_ROWS,
+        }
+    }
+
+    /// The rows this calibration was fitted to, out of the `rows` it was given: all of
+    /// them, or its systematic subsample ([`Calibration::sample`]).
+    pub fn fitted_rows(&self, rows: &[ObservedRow]) -> Vec<ObservedRow> {
+        match self.sample.and_then(|(m, n)| (n == rows.len()).then(|| systematic_sample(n, m)).flatten()) {
+            Some(idx) => idx.iter().map(|&i| rows[i].clone()).collect(),
+            None => rows.to_vec(),
         }
     }
 }
@@ -953,9 +983,54 @@ impl<'a> Calibrate<'a> {
         self
     }
 
+    /// Most rows the fit sees (default [`MAX_FIT_ROWS`]; 0: no limit): more are fitted on
+    /// a systematic subsample ([`systematic_sample`]) of this many, said in a warning; the
+    /// χ², the readings counted and the standard errors are then the subsample's (wider
+    /// than all rows would give, by about the square root of the ratio). Fixed weights
+    /// ([`Calibrate::weights`]) are one per reading of all rows: no subsample then.
+    pub fn max_rows(mut self, max_rows: usize) -> Self {
+        self.max_rows = max_rows;
+        self
+    }
+
     /// Runs the fit. Errors when there are fewer readings than parameters or a bound is
     /// invalid; a fit that does not converge still returns its best point with a warning.
     pub fn run(self) -> Result<Calibration, TrumError> {
+        let sample = if self.weights.is_none() { systematic_sample(self.rows.len(), self.max_rows) } else { None };
+        let Some(idx) = sample else {
+            let rows = self.rows;
+            return self.run_on(rows);
+        };
+        let picked: Vec<ObservedRow> = idx.iter().map(|&i| self.rows[i].clone()).collect();
+        let n = self.rows.len();
+        // the parameters from every row (which quantities were read, the load's range)
+        let owned;
+        let with_params = match (self.params, self.tolerances) {
+            (Some(_), _) => self.clone(),
+            (None, t) => {
+                owned = match t {
+                    Some(t) => baseline_params_with(self.motor, self.rows, t),
+                    None => baseline_params(self.motor, self.rows),
+                };
+                self.clone().params(&owned)
+            }
+        };
+        let mut cal = with_params.run_on(&picked)?;
+        cal.sample = Some((idx.len(), n));
+        cal.warnings.insert(
+            0,
+            format!(
+                "fitted to a systematic subsample of {} of the {n} rows (one in every {:.1}, in file order): the χ², \
+                 readings and standard errors are the subsample's",
+                idx.len(),
+                n as f64 / idx.len() as f64
+            ),
+        );
+        Ok(cal)
+    }
+
+    /// [`Calibrate::run`] on `rows` (all of them).
+    fn run_on(self, rows: &[ObservedRow]) -> Result<Calibration, TrumError> {
         let default_options;
         let opts = match self.options {
             Some(o) => o,
@@ -969,17 +1044,17 @@ impl<'a> Calibrate<'a> {
             Some(p) => p,
             None => {
                 owned = match self.tolerances {
-                    Some(t) => baseline_params_with(self.motor, self.rows, t),
-                    None => baseline_params(self.motor, self.rows),
+                    Some(t) => baseline_params_with(self.motor, rows, t),
+                    None => baseline_params(self.motor, rows),
                 };
                 &owned[..]
             }
         };
-        let first = fit(self.motor, self.rows, params, opts, self.added, self.weights, self.start)?;
+        let first = fit(self.motor, rows, params, opts, self.added, self.weights, self.start)?;
         if !self.refit_bounds || !first.params.iter().any(|p| p.at_bound) {
             return Ok(first);
         }
-        Ok(match fit(&first.motor, self.rows, params, opts, &[], None, Start::Fresh) {
+        Ok(match fit(&first.motor, rows, params, opts, &[], None, Start::Fresh) {
             Ok(again) if again.chi2 < first.chi2 => again,
             _ => first,
         })
@@ -1260,6 +1335,7 @@ fn fit(
         warnings,
         abandoned,
         lin,
+        sample: None,
     })
 }
 
@@ -1271,6 +1347,15 @@ fn fit(
 /// 0.7 of the prior's width) and a well-conditioned column. `trum calibrate` and Python's
 /// `trum.calibrate` report these.
 pub fn rescale_uncertainties(cal: &mut Calibration, rows: &[ObservedRow]) {
+    // (the rows the fit saw: with a subsample, its χ² and its standard errors are the
+    // subsample's)
+    let fitted;
+    let rows = if cal.sample.is_some() {
+        fitted = cal.fitted_rows(rows);
+        &fitted[..]
+    } else {
+        rows
+    };
     let n = cal.params.len();
     let r0 = residuals(&cal.motor, rows);
     let m = r0.len();
@@ -1515,6 +1600,70 @@ pub(crate) mod tests {
         // χ² itself, and the fit stops once that is below the decrement tolerance
         assert!(cal.chi2 < FIT_DECREMENT_TOL, "{}", cal.chi2);
         assert!(cal.warnings.is_empty(), "{:?}", cal.warnings);
+    }
+
+    /// A systematic subsample: the middle row of each equal stretch, every index once, in
+    /// order; none below the limit.
+    #[test]
+    fn the_systematic_sample_spreads_over_the_file() {
+        assert_eq!(systematic_sample(10, 5), Some(vec![1, 3, 5, 7, 9]));
+        assert_eq!(systematic_sample(7, 3), Some(vec![1, 3, 5]));
+        assert_eq!(systematic_sample(5, 5), None);
+        assert_eq!(systematic_sample(1_000_000, 0), None);
+        let s = systematic_sample(1_000_003, 20_000).expect("sample");
+        assert_eq!(s.len(), 20_000);
+        assert!(s.windows(2).all(|w| w[1] > w[0] && w[1] - w[0] <= 51));
+        assert!(s[0] <= 25 && *s.last().expect("last") >= 1_000_003 - 26);
+    }
+
+    /// A fit of more rows than its limit sees a systematic subsample: the same optimum as
+    /// all rows (noise-free data of a perturbed friction and damping), a warning naming
+    /// the subsample, the subsample's readings counted, and standard errors larger than
+    /// all rows give by about the square root of the ratio (1.9 for 36 of 128 rows; a
+    /// grid's rows are not all alike, so within ±35 %).
+    #[test]
+    fn a_fit_of_many_rows_sees_a_subsample_and_says_so() {
+        let truth = reference_motor();
+        let preloads: Vec<f64> = (0..16).map(|i| 100.0 + 20.0 * i as f64).collect();
+        let mut rows = rows_on_grid(&truth, &preloads, &[0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7]);
+        // readings off the truth by a fixed pseudo-random pattern of unit noise, so that
+        // the standard errors rest on a χ² near the readings' count
+        for (i, r) in rows.iter_mut().enumerate() {
+            for (k, x) in r.readings.iter_mut().enumerate() {
+                x.1 += x.2 * (1.7 * (i * 3 + k) as f64).sin() * 1.4;
+            }
+        }
+        let mut start = truth.clone();
+        start.friction_layer.friction_coefficient *= 1.2;
+        start.stator.modal_damping_ns_per_m *= 0.8;
+        let params = vec![
+            fit_rel(&start, "friction_layer.friction_coefficient", 0.3, 3.0),
+            fit_rel(&start, "stator.modal_damping_ns_per_m", 0.2, 5.0),
+        ];
+        let fit = |max_rows: usize| {
+            let mut cal = Calibration::builder(&start, &rows)
+                .params(&params)
+                .options(&FitOptions::default())
+                .max_rows(max_rows)
+                .run()
+                .expect("fit");
+            rescale_uncertainties(&mut cal, &rows);
+            cal
+        };
+        let all = fit(0);
+        let part = fit(36);
+        assert_eq!(all.sample, None);
+        assert_eq!(part.sample, Some((36, 128)));
+        assert_eq!(part.n_readings, 36 * 3);
+        assert_eq!(all.n_readings, 128 * 3);
+        assert!(part.warnings[0].contains("subsample of 36 of the 128 rows"), "{:?}", part.warnings);
+        assert_eq!(part.fitted_rows(&rows).len(), 36);
+        for (a, p) in all.params.iter().zip(&part.params) {
+            let ratio = p.std_error / a.std_error;
+            assert!((ratio / (128.0f64 / 36.0).sqrt() - 1.0).abs() < 0.35, "{}: ratio {ratio}", a.name);
+            // the two optima agree within the subsample's standard error
+            assert!((p.value - a.value).abs() < 3.0 * p.std_error, "{}: {} vs {}", a.name, p.value, a.value);
+        }
     }
 
     /// A torque transducer's zero offset is a nuisance the fit recovers: noise-free rows of

@@ -65,7 +65,10 @@ pub(super) fn fit(ctx: &Context) -> Result<Baseline, TrumError> {
         let plain: Vec<ObservedRow> =
             rows.iter().map(|r| ObservedRow { speed_std_clipped: false, ..r.clone() }).collect();
         let refs: Vec<&ObservedRow> = plain.iter().collect();
-        let best = noise_estimate(motor, &ctx.unscaled, ctx.groups, est);
+        let best = match &ctx.best_noise {
+            Some(b) => b.clone(),
+            None => noise_estimate(motor, &ctx.unscaled, &ctx.groups, est),
+        };
         noise_nrmse_best(rows, est, &best, &predict(&base_cal.motor, &refs), sc)
     };
     Ok(Baseline {

@@ -14,8 +14,15 @@ use std::collections::BTreeMap;
 pub(super) struct Context<'a> {
     /// The nominal motor: bounds and priors of every fit are around it.
     pub(super) motor: &'a Motor,
-    /// The run of each row (may be shorter than the rows: the rest are in run "").
-    pub(super) groups: &'a [String],
+    /// The run of each row the fits see (may be shorter than the rows: the rest are in
+    /// run "").
+    pub(super) groups: Vec<String>,
+    /// The input rows the fits see, by index, when the data have more than
+    /// `DiagnoseOptions::max_fit_rows` (`calibrate::systematic_sample`); `None`: all of them.
+    pub(super) sample: Option<Vec<usize>>,
+    /// The best noise levels (`baseline::noise_estimate`) from all input rows, when the
+    /// fits see a subsample (whose runs keep too few neighbouring readings for them).
+    pub(super) best_noise: Option<BTreeMap<Observable, NoiseScale>>,
     /// The options, exact cross-validation switched on for reduced data.
     pub(super) opts: DiagnoseOptions,
     /// The rows after the bench model, with their stated noise levels.
@@ -49,16 +56,37 @@ impl<'a> Context<'a> {
     pub(super) fn new(
         motor: &'a Motor,
         rows: &[ObservedRow],
-        groups: &'a [String],
+        groups: &[String],
         opts: &DiagnoseOptions,
     ) -> Result<Context<'a>, TrumError> {
-        let n_read: usize = rows.iter().map(|r| r.readings.len()).sum();
         // The bench model first: set points read back with noise are taken at their run's
         // mean, quantised readings carry their rounding error (`bench`).
-        let (unscaled, bench_notes) = bench_model(rows, groups);
+        let (unscaled, mut bench_notes) = bench_model(rows, groups);
         // Noise levels from the data, so that χ² and the evidence are on the scale of the
         // actual noise; clamped to [1/4, 4] × the stated levels.
         let est = crate::noise::estimate(&unscaled, groups);
+        // Large data: the fits see a systematic subsample; the set points, the noise levels
+        // and the best noise levels come from every row (each a pass over the rows, against
+        // hundreds for the fits).
+        let sample = crate::calibrate::systematic_sample(rows.len(), opts.max_fit_rows);
+        let (unscaled, groups, best_noise) = match &sample {
+            Some(s) => {
+                let best = super::baseline::noise_estimate(motor, &unscaled, groups, &est);
+                bench_notes.push(format!(
+                    "{} rows: the fits see a systematic subsample of {} of them (one row in every {:.1}, in file order, so \
+                     every run keeps its share); set points and noise levels come from all rows; the evidence, the \
+                     held-out figures and their intervals are those of the subsample (wider than all rows would give)",
+                    rows.len(),
+                    s.len(),
+                    rows.len() as f64 / s.len() as f64
+                ));
+                let picked: Vec<ObservedRow> = s.iter().map(|&i| unscaled[i].clone()).collect();
+                let g: Vec<String> = s.iter().map(|&i| groups.get(i).cloned().unwrap_or_default()).collect();
+                (picked, g, Some(best))
+            }
+            None => (unscaled, groups.to_vec(), None),
+        };
+        let n_read: usize = unscaled.iter().map(|r| r.readings.len()).sum();
         let scaled = noise_scaled(&unscaled, &est);
         let rows = &scaled[..];
         let noise_scale: Vec<(String, f64, usize)> =
@@ -69,7 +97,7 @@ impl<'a> Context<'a> {
                 rows.len()
             )));
         }
-        let (folds, k) = folds::assign(rows, groups, opts.folds)?;
+        let (folds, k) = folds::assign(rows, &groups, opts.folds)?;
         let mut notes: Vec<String> = bench_notes;
         if !noise_scale.is_empty() {
             let list: Vec<String> = noise_scale.iter().map(|(q, f, n)| format!("{q} ×{f:.2} ({n})")).collect();
@@ -105,6 +133,8 @@ impl<'a> Context<'a> {
         Ok(Context {
             motor,
             groups,
+            sample,
+            best_noise,
             opts: opts.clone(),
             unscaled,
             rows: scaled,
@@ -217,4 +247,61 @@ pub(super) fn noise_scaled(
 /// data (the blind benchmark's reference fits) have no noise to clip.
 pub(super) fn speed_std_clipped(rows: &[ObservedRow], estimated: bool) -> bool {
     estimated && rows.iter().flat_map(|r| &r.readings).any(|x| crate::noise::clipped_reading(x.0, x.1))
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests: a panic is the failure report
+mod tests {
+    use super::super::tests::quick;
+    use super::super::{diagnose, DiagnoseOptions};
+    use crate::effects::Effect;
+    use crate::synth::{synthesize, Campaign, SynthConfig};
+
+    /// Two preload-torque campaigns of one motor with a voltage sag (112 rows), diagnosed with
+    /// at most 56 rows fitted: the fits see one row in two, a note says so, the counts are
+    /// the input's rows and the subsample's readings, every held-out reading names its row
+    /// in the input with that row's measured value, and the sag is still found, with less
+    /// evidence than all rows give it.
+    #[test]
+    fn large_data_are_diagnosed_on_a_subsample_that_the_result_names() {
+        let nominal = crate::calibrate::tests::reference_motor();
+        let mut truth = nominal.clone();
+        truth.effects.set_strength(Effect::VoltageSag, 300.0);
+        // one motor (one motor seed) measured twice with different noise
+        let (mut rows, mut groups) = (Vec::new(), Vec::new());
+        for seed in [11, 12] {
+            let cfg = SynthConfig {
+                campaign: Campaign::PreloadTorque,
+                noise: 1.0,
+                seed,
+                motor_seed: Some(11),
+                ..SynthConfig::default()
+            };
+            for r in synthesize(&truth, &cfg).unwrap() {
+                rows.push(r.observed());
+                groups.push(format!("{seed}-{}", r.run_id));
+            }
+        }
+        let opts = DiagnoseOptions { max_fit_rows: 56, ..quick(false) };
+        let part = diagnose(&nominal, &rows, &groups, &opts).unwrap();
+        let all = diagnose(&nominal, &rows, &groups, &DiagnoseOptions { max_fit_rows: 0, ..opts.clone() }).unwrap();
+        assert_eq!(part.n_rows, 112);
+        assert_eq!(all.n_rows, 112);
+        let sample = crate::calibrate::systematic_sample(112, 56).unwrap();
+        let sampled_readings: usize = sample.iter().map(|&i| rows[i].readings.len()).sum();
+        assert_eq!(part.n_readings, sampled_readings);
+        assert!(part.notes.iter().any(|n| n.starts_with("112 rows: the fits see a systematic subsample of 56")));
+        assert!(!all.notes.iter().any(|n| n.contains("subsample")));
+        assert_eq!(part.heldout.len(), sampled_readings);
+        for h in &part.heldout {
+            assert!(sample.contains(&h.row), "row {}", h.row);
+            assert!(rows[h.row].readings.iter().any(|x| x.0 == h.observable && x.1 == h.measured));
+        }
+        for d in [&part, &all] {
+            assert_eq!(d.verdict, "voltage_sag", "{:?}", d.notes);
+        }
+        let evidence =
+            |d: &super::super::Diagnosis| d.ranking.iter().find(|r| r.effect == "voltage_sag").unwrap().evidence;
+        assert!(evidence(&part) > 5.0 && evidence(&part) < evidence(&all), "{} vs {}", evidence(&part), evidence(&all));
+    }
 }

@@ -74,7 +74,17 @@ pub struct DiagnoseOptions {
     /// ([`crate::calibrate::baseline_params_with`]): dotted key → prior standard deviation
     /// of the logarithm (0 holds a parameter at its nominal value).
     pub tolerances: BTreeMap<String, f64>,
+    /// Most rows the fits see: larger data are diagnosed on a systematic subsample of this
+    /// many rows (one in every n/m in file order), said in a note, with the evidence and
+    /// the held-out figures of the subsample; set points and noise levels still come from
+    /// every row. 0: every row, however many (the cost then grows with the rows).
+    pub max_fit_rows: usize,
 }
+
+/// The default [`DiagnoseOptions::max_fit_rows`]: the size at which a diagnosis with all
+/// seven candidates stays near a second on two cores (docs/PERFORMANCE.md), and where a
+/// candidate that matters reaches an evidence of hundreds on nominal bench noise.
+pub const MAX_FIT_ROWS: usize = 160;
 
 impl Default for DiagnoseOptions {
     fn default() -> Self {
@@ -87,6 +97,7 @@ impl Default for DiagnoseOptions {
             fit: FitOptions { huber_k: 3.0, irls_passes: 1, max_evaluations: 300, ..FitOptions::default() },
             exact_cv: false,
             tolerances: BTreeMap::new(),
+            max_fit_rows: MAX_FIT_ROWS,
         }
     }
 }
@@ -288,7 +299,13 @@ pub fn diagnose(
     }
     let (gap_where, where_note) = where_::locate(&ctx, &base);
     notes.extend(where_note);
-    let heldout = held_out(&ctx.rows, &base.cv.preds, &fits.cv_preds, &verdict);
+    let mut heldout = held_out(&ctx.rows, &base.cv.preds, &fits.cv_preds, &verdict);
+    if let Some(sample) = &ctx.sample {
+        // (held-out readings name their row in the input)
+        for h in heldout.iter_mut() {
+            h.row = sample[h.row];
+        }
+    }
     // (no verdict from figures that overflowed: json::guard_non_finite)
     Ok(json::guard_non_finite(Diagnosis {
         verdict,
@@ -303,7 +320,7 @@ pub fn diagnose(
         gap_where,
         ranking,
         notes,
-        n_rows: ctx.rows.len(),
+        n_rows: rows.len(),
         n_readings: ctx.n_read,
         folds: ctx.k,
         baseline_params: base.cal.params.iter().map(|p| (p.name.clone(), p.value)).collect(),
