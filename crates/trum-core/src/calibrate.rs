@@ -213,6 +213,45 @@ pub fn baseline_params_with(
     if let Some(fp) = torque_offset_param(rows, overrides) {
         out.push(fp);
     }
+    out.extend(own_effect_params(motor));
+    out
+}
+
+/// Prior standard deviation of the logarithm of the strength of an effect the motor file
+/// itself switches on: a factor of about 1.65 at one σ. A preset's effect strength is
+/// calibrated to a paper's figures, not measured on the motor at hand, so it is known as
+/// roughly as a material constant.
+pub const OWN_EFFECT_REL_SD: f64 = 0.5;
+
+/// The strengths of the effects the motor file itself switches on, as uncertain
+/// parameters of the motor: a Gaussian prior on the logarithm centred on the file's value
+/// ([`OWN_EFFECT_REL_SD`]; on the value itself, with a standard deviation of half its
+/// magnitude, for a negative strength), bounded at a tenth and ten times the value within
+/// the effect's valid range. Shape parameters stay where the file puts them. An effect the
+/// model already carries is part of the motor, so a calibration refits it with the rest
+/// and a diagnosis measures the gap beyond it, not against it.
+fn own_effect_params(motor: &Motor) -> Vec<FitParam> {
+    let mut out = Vec::new();
+    for e in motor.effects.active() {
+        for (i, p) in e.info().params.iter().enumerate().filter(|(_, p)| !p.shape) {
+            let v = motor.effects.value(e, i);
+            if !v.is_finite() || v == 0.0 {
+                continue;
+            }
+            let (lo, hi) = if v > 0.0 { (0.1 * v, 10.0 * v) } else { (10.0 * v, 0.1 * v) };
+            let (lo, hi) = (lo.max(p.min), hi.min(p.max));
+            // a value on (or beyond) its valid range's edge leaves nothing to fit within it
+            if !(lo < v && v < hi) || (v > 0.0 && lo <= 0.0) {
+                continue;
+            }
+            let prior = if v > 0.0 {
+                Prior { centre: v.ln(), sd: OWN_EFFECT_REL_SD }
+            } else {
+                Prior { centre: v, sd: OWN_EFFECT_REL_SD * v.abs() }
+            };
+            out.push(FitParam { param: ParamRef::Effect(e, i), lo, hi, log: v > 0.0, prior: Some(prior) });
+        }
+    }
     out
 }
 

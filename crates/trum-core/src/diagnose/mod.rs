@@ -230,8 +230,32 @@ pub fn diagnose(
     // runs inferred from the set points where the data name none
     let named = groups.iter().any(|g| !g.is_empty());
     let groups = &bench::runs(rows, groups)[..];
+    // The motor's own effects are part of its model: the baseline refits their strengths
+    // (`calibrate::baseline_params_with`), so they are not candidates for what it lacks.
+    let own: Vec<Effect> = motor.effects.active().into_iter().filter(|e| opts.candidates.contains(e)).collect();
+    let without_own;
+    let opts = if own.is_empty() {
+        opts
+    } else {
+        without_own = DiagnoseOptions {
+            candidates: opts.candidates.iter().copied().filter(|e| !own.contains(e)).collect(),
+            ..opts.clone()
+        };
+        &without_own
+    };
     let mut ctx = Context::new(motor, rows, groups, opts)?;
     let mut notes = std::mem::take(&mut ctx.notes);
+    if !own.is_empty() {
+        let names: Vec<&str> = own.iter().map(|e| e.name()).collect();
+        notes.insert(
+            0,
+            format!(
+                "the motor's own effects ({}) are part of the baseline: their strengths are calibrated with it (prior: the file's value, a factor of {:.2} at one σ) and they are not candidates",
+                names.join(", "),
+                crate::calibrate::OWN_EFFECT_REL_SD.exp()
+            ),
+        );
+    }
     if !named && !rows.is_empty() {
         let n = groups.iter().collect::<std::collections::BTreeSet<_>>().len();
         notes.insert(
