@@ -33,6 +33,9 @@ pub struct Law {
     /// Use the bench-truth forms (radius-resolved radial slip, algebraic saturation)
     /// instead of the candidate forms the diagnosis fits. See docs/EFFECTS.md.
     pub truth: bool,
+    /// n: sharpness of the candidate saturation's turn from stick to slip,
+    /// S(x) = tanh(xⁿ)^(1/n) [-]; 1 is tanh (`tangential_compliance`'s `stick_sharpness`).
+    pub sharpness: f64,
 }
 
 impl Law {
@@ -127,6 +130,28 @@ fn saturation(x: f64, truth: bool) -> (f64, f64) {
         let t = tanh_nonneg(x);
         (t, 1.0 - t * t)
     }
+}
+
+/// The stick-then-slip family of saturations, S(x) = tanh(xⁿ)^(1/n) and S'(x), for x ≥ 0
+/// and n ≥ 1: an elastic friction layer that carries traction in proportion to its shear
+/// (S ≈ x) until the traction reaches μp and the layer slips (S → 1), the turn between the
+/// two over a band that narrows as n grows (n = 1 is tanh, n → ∞ is min(x, 1), the
+/// elastic–perfectly-plastic layer of Storck & Wallaschek 2003). Written with
+/// t = tanh(y)/y, y = xⁿ: S = x·t^(1/n) and S' = t^(1/n − 1)·(1 − tanh²y), so both stay
+/// finite at x → 0 (t by its series below y = 1e-3, first omitted term below 1e-13).
+#[inline]
+fn stick_slip_saturation(x: f64, n: f64) -> (f64, f64) {
+    let y = x.powf(n);
+    let (th, t) = if y < 1e-3 {
+        let z = y * y;
+        let t = 1.0 + z * (-1.0 / 3.0 + z * (2.0 / 15.0));
+        (y * t, t)
+    } else {
+        let th = tanh_nonneg(y);
+        (th, th / y)
+    };
+    let r = t.powf(1.0 / n);
+    (x * r, r / t * (1.0 - th * th))
 }
 
 /// tanh x for x ≥ 0 (the slip speed over its scale): the odd series through x⁹ below
@@ -258,7 +283,11 @@ fn accumulate(f: &mut Factors, s: f64, co: f64, w: f64, c: f64, u: f64, rho: f64
     let inv_d = 1.0 / d;
     // traction per unit μp over the slip speed, g(D) = S(D/σ)/D, and dg/dD
     let (g, dg) = if law.slip_scale > 0.0 {
-        let (sv, ds) = saturation(d / law.slip_scale, law.truth);
+        let (sv, ds) = if law.sharpness != 1.0 && !law.truth {
+            stick_slip_saturation(d / law.slip_scale, law.sharpness)
+        } else {
+            saturation(d / law.slip_scale, law.truth)
+        };
         (sv * inv_d, (ds / law.slip_scale - sv * inv_d) * inv_d)
     } else {
         (inv_d, -inv_d * inv_d)
@@ -364,7 +393,7 @@ pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
     let phi0 = ct.half_angle_rad;
     let uc = u.clamp(-1.0, 1.0);
     let ts = uc.acos();
-    if let Some((ends, n)) = nearest_singularity(law, uc, phi0).and_then(|z| graded_ends(ts, phi0, z)) {
+    if let Some((ends, n)) = grading_singularity(law, uc, phi0).and_then(|z| graded_ends(ts, phi0, z)) {
         return graded_factors(&ends[..n], ct.offset, u, law);
     }
     let mut nodes = Nodes::new();
@@ -409,7 +438,7 @@ fn graded_factors(ends: &[f64], c: f64, u: f64, law: &Law) -> Factors {
 fn node_sums(nodes: &Nodes, c: f64, u: f64, law: &Law) -> Factors {
     let mut f = Factors::default();
     for (rho, weight) in radii(law) {
-        let part = if law.slip_scale > 0.0 && rho == 0.0 && !law.truth {
+        let part = if law.slip_scale > 0.0 && rho == 0.0 && !law.truth && law.sharpness == 1.0 {
             compliance_sums(nodes, c, u, law.slip_scale, weight)
         } else if law.slip_scale > 0.0 {
             let mut g = Factors::default();
@@ -530,6 +559,64 @@ fn nearest_singularity(law: &Law, u: f64, phi0: f64) -> Option<(f64, f64)> {
     }
     best
 }
+
+/// The singularity the rule grades towards: [`nearest_singularity`], or for the candidate's
+/// sharper stick-then-slip saturations (n ≠ 1, [`stick_slip_saturation`])
+/// [`nearest_stick_slip_singularity`].
+fn grading_singularity(law: &Law, u: f64, phi0: f64) -> Option<(f64, f64)> {
+    if law.sharpness != 1.0 && law.slip_scale > 0.0 && !law.truth {
+        nearest_stick_slip_singularity(law, u, phi0)
+    } else {
+        nearest_singularity(law, u, phi0)
+    }
+}
+
+/// The singularity nearest to the contact of the stick-then-slip law S(D/σ)/D with
+/// S(x) = tanh(xⁿ)^(1/n): tanh's pole at xⁿ = iπ/2 puts it where
+/// D² = ζ = σ²·(π/2)^(2/n)·e^(iπ/n) (for n = 1, ζ = −(πσ/2)², [`nearest_singularity`]'s
+/// κ). In the offset Δc = cos θ − u that is the quadratic
+/// (1 − ρ²)·Δc² − 2uρ²·Δc + ρ²(1 − u²) − ζ = 0 (its conjugate ζ̄ gives the conjugate
+/// roots, as far from the axis); θ* = arccos(u + Δc). The branch points of the 1/n-th
+/// power (tanh's zeros, |xⁿ| = π) lie farther out, and for integer n the law is analytic
+/// in D² at D² = 0.
+fn nearest_stick_slip_singularity(law: &Law, u: f64, phi0: f64) -> Option<(f64, f64)> {
+    let n = law.sharpness;
+    let zeta = C64::from_polar(law.slip_scale.powi(2) * FRAC_PI_2_F.powf(2.0 / n), PI / n);
+    let one_minus_u2 = (1.0 - u) * (1.0 + u);
+    let sin_ts = one_minus_u2.max(0.0).sqrt();
+    let mut best: Option<(f64, f64)> = None;
+    for (rho, _) in radii(law) {
+        let rho2 = rho * rho;
+        let a = (1.0 - rho) * (1.0 + rho);
+        // product of the roots times a, and half the linear coefficient
+        let c0 = C64::new(rho2 * one_minus_u2, 0.0) - zeta;
+        let b = u * rho2;
+        let root = csqrt(C64::new(b * b, 0.0) - c0 * a);
+        // the root of larger modulus without cancellation, the other from the product
+        let far = if (C64::new(b, 0.0) + root).norm() >= (C64::new(b, 0.0) - root).norm() {
+            C64::new(b, 0.0) + root
+        } else {
+            C64::new(b, 0.0) - root
+        };
+        let mut offsets: Vec<C64> = Vec::with_capacity(2);
+        if a != 0.0 {
+            offsets.push(far / a);
+        }
+        if far.norm() > 0.0 {
+            offsets.push(c0 / far);
+        }
+        for dc in offsets {
+            let th = arccos_near(u, sin_ts, dc);
+            let z = (th.re, th.im.abs());
+            if z.0.is_finite() && z.1.is_finite() && best.is_none_or(|bz| distance(z, phi0) < distance(bz, phi0)) {
+                best = Some(z);
+            }
+        }
+    }
+    best
+}
+
+const FRAC_PI_2_F: f64 = std::f64::consts::FRAC_PI_2;
 
 /// Distance [rad] of the point z = (Re, |Im|) from the segment [0, φ0] of the real axis.
 fn distance(z: (f64, f64), phi0: f64) -> f64 {
@@ -930,7 +1017,20 @@ pub(crate) fn interface_law(p: &Prepared, d: &Drive, ct: &Contact) -> Law {
         // the second truth family: radial slip that grows with the preload
         law.radial_ratio = p.law.radial_ratio * (d.f_n / 200.0).sqrt();
     }
+    if !p.truth && p.radial_exponent != 0.0 && law.radial_ratio > 0.0 {
+        law.radial_ratio = preload_grown_radial_ratio(p.law.radial_ratio, p.radial_exponent, d.f_n);
+    }
     law
+}
+
+/// `radial_friction`'s preload family: ρ(F_N) = ρ·(F_N/100 N)^q, capped at 10 (where the
+/// radial slip dwarfs the tangential one). The radial surface speed a contact point sees
+/// follows the radial slope of the mode shape across the contact's width (the
+/// radial-friction paper, eq. 10-12); a wider contact, pressed harder, reaches further
+/// into the slope: q = 0.5 is the width of a Hertzian line contact (∝ √F_N), q = 1 a slope
+/// in proportion to the load. ρ is the ratio at 100 N.
+pub(crate) fn preload_grown_radial_ratio(rho: f64, q: f64, f_n: f64) -> f64 {
+    (rho * (f_n.max(0.0) / 100.0).powf(q)).min(10.0)
 }
 
 #[cfg(test)]
@@ -1001,14 +1101,14 @@ mod tests {
     #[test]
     fn node_angles_by_angle_addition_match_direct_evaluation() {
         for law in [
-            Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false },
-            Law { radial_ratio: 0.7, slip_scale: 0.0, truth: false },
-            Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false },
-            Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false },
-            Law { radial_ratio: 0.0, slip_scale: 0.03, truth: false },
-            Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false },
-            Law { radial_ratio: 0.3, slip_scale: 0.02, truth: true },
-            Law { radial_ratio: 0.0, slip_scale: 0.2, truth: true },
+            Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.7, slip_scale: 0.0, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.03, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.3, slip_scale: 0.02, truth: true, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.2, truth: true, sharpness: 1.0 },
         ] {
             for &y in &[0.05, 0.8, 2.0, 3.1, 5.0] {
                 let ct = contact_from_ratio(y);
@@ -1034,7 +1134,7 @@ mod tests {
 
     #[test]
     fn coulomb_limit_reproduces_the_closed_forms() {
-        let law = Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false };
+        let law = Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false, sharpness: 1.0 };
         for &y in &[0.3, 1.5, 3.0, 4.0] {
             let ct = contact_from_ratio(y);
             for &u in &[0.0f64, 0.2, 0.6, 0.95] {
@@ -1058,11 +1158,11 @@ mod tests {
     fn torque_derivative_matches_central_differences() {
         let mut worst: f64 = 0.0;
         for law in [
-            Law { radial_ratio: 0.5, slip_scale: 0.0, truth: false },
-            Law { radial_ratio: 0.0, slip_scale: 0.05, truth: false },
-            Law { radial_ratio: 0.3, slip_scale: 0.02, truth: true },
-            Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false },
-            Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false },
+            Law { radial_ratio: 0.5, slip_scale: 0.0, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.05, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.3, slip_scale: 0.02, truth: true, sharpness: 1.0 },
+            Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false, sharpness: 1.0 },
         ] {
             for (&y, &u) in [0.8, 1.5].iter().flat_map(|y| [0.1, 0.5, 0.9, 0.99, 0.999].iter().map(move |u| (y, u))) {
                 let ct = contact_from_ratio(y);
@@ -1110,25 +1210,25 @@ mod tests {
     fn factors_agree_with_adaptive_quadrature_of_their_integrals() {
         use crate::quad::integrate;
         let laws = [
-            (Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false }, 1.5e-12),
-            (Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false }, 1.5e-12),
-            (Law { radial_ratio: 0.3, slip_scale: 0.0, truth: false }, 1.5e-12),
-            (Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.02, truth: false }, 1.5e-12),
-            (Law { radial_ratio: 0.003, slip_scale: 0.0, truth: true }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.003, truth: true }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.2, truth: false }, 1.5e-12),
-            (Law { radial_ratio: 0.5, slip_scale: 0.0, truth: true }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.05, truth: true }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.1, truth: false }, 1.5e-12),
-            (Law { radial_ratio: 1.0, slip_scale: 0.0, truth: true }, 1.5e-12),
-            (Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false }, 1.5e-12),
-            (Law { radial_ratio: 0.5, slip_scale: 0.02, truth: false }, 1.5e-12),
+            (Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.3, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.02, truth: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.003, slip_scale: 0.0, truth: true, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.003, truth: true, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.2, truth: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.5, slip_scale: 0.0, truth: true, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.05, truth: true, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.1, truth: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 1.0, slip_scale: 0.0, truth: true, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.5, slip_scale: 0.02, truth: false, sharpness: 1.0 }, 1.5e-12),
             // nearer than MIN_FEATURE_WIDTH (graded as that far), or at u = 1 exactly
-            (Law { radial_ratio: 1e-7, slip_scale: 0.0, truth: false }, 1.5e-9),
-            (Law { radial_ratio: 0.0, slip_scale: 1e-7, truth: false }, 1.5e-12),
-            (Law { radial_ratio: 1e-14, slip_scale: 0.0, truth: false }, 3e-8),
+            (Law { radial_ratio: 1e-7, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-9),
+            (Law { radial_ratio: 0.0, slip_scale: 1e-7, truth: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 1e-14, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 3e-8),
         ];
         for (law, tol) in laws {
             let (mut worst, mut worst_mid): (f64, f64) = (0.0, 0.0);
@@ -1213,11 +1313,11 @@ mod tests {
     #[test]
     fn the_nearest_singularity_is_a_zero_of_the_slip() {
         let laws = [
-            Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false },
-            Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false },
-            Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false },
-            Law { radial_ratio: 0.0, slip_scale: 0.02, truth: false },
-            Law { radial_ratio: 0.3, slip_scale: 0.01, truth: true },
+            Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.02, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.3, slip_scale: 0.01, truth: true, sharpness: 1.0 },
         ];
         for law in laws {
             let kappa = law.slip_scale * if law.truth { 1.0 } else { std::f64::consts::FRAC_PI_2 };
@@ -1250,10 +1350,12 @@ mod tests {
             }
         }
         let z =
-            nearest_singularity(&Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false }, -0.6, 1.0).expect("a zero");
+            nearest_singularity(&Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false, sharpness: 1.0 }, -0.6, 1.0)
+                .expect("a zero");
         assert!((z.1 - 0.5108).abs() < 1e-3, "{z:?}");
         let z =
-            nearest_singularity(&Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false }, 0.0, 1.0).expect("a zero");
+            nearest_singularity(&Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 0.0, 1.0)
+                .expect("a zero");
         assert_eq!(z.0, 0.0, "{z:?}");
     }
 
@@ -1281,8 +1383,8 @@ mod tests {
     #[test]
     fn radial_slip_lowers_torque_and_dissipates() {
         let ct = contact_from_ratio(1.5);
-        let base = factors(&ct, 0.5, &Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false });
-        let rad = factors(&ct, 0.5, &Law { radial_ratio: 0.5, slip_scale: 0.0, truth: false });
+        let base = factors(&ct, 0.5, &Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false, sharpness: 1.0 });
+        let rad = factors(&ct, 0.5, &Law { radial_ratio: 0.5, slip_scale: 0.0, truth: false, sharpness: 1.0 });
         assert!(rad.torque < base.torque);
         assert!(rad.radial > 0.0);
         // dissipation ∫ μ p |s| ≥ 0: power − u·torque

@@ -380,6 +380,25 @@ impl<'a> Scorer<'a> {
             }
             Err(_) => (f64::NEG_INFINITY, Vec::new(), base_cv.preds.clone(), None),
         };
+        // the held shape parameters where the scan moved them: the form the fit is of
+        let mut fitted = fitted;
+        if let Some(m) = &fitted_motor {
+            for &e in effects {
+                for (i, p) in e.info().params.iter().enumerate().filter(|(_, p)| p.held) {
+                    let v = m.motor.effects.value(e, i);
+                    if v != p.typical {
+                        fitted.push(FittedParam {
+                            name: format!("effects.{}.{}", e.name(), p.name),
+                            value: v,
+                            std_error: f64::NAN,
+                            at_bound: false,
+                            identifiable: false,
+                            prior_rel_sd: None,
+                        });
+                    }
+                }
+            }
+        }
         let (after, chi2_after, e2, _) = errors(rows, &preds, sc);
         let shrink = 1.0 - after / base_nrmse.max(1e-300);
         let interval = bootstrap_shrink(base_e2, &e2, opts.bootstrap, opts.seed);
@@ -503,6 +522,11 @@ fn at_typical_shape(start: &Motor, added: &[Effect]) -> Option<Motor> {
     moved.then_some(m)
 }
 
+/// True when `fp` is a shape parameter the local fits hold (`EffectParam::held`).
+fn is_held_shape(fp: &FitParam) -> bool {
+    matches!(fp.param, ParamRef::Effect(e, i) if e.info().params[i].held)
+}
+
 /// True when `fp` is a shape parameter of one of the `added` effects.
 fn is_shape_of(fp: &FitParam, added: &[Effect]) -> bool {
     matches!(fp.param, ParamRef::Effect(e, i) if added.contains(&e) && e.info().params[i].shape)
@@ -539,7 +563,8 @@ pub(super) fn fit_params(
             let info = e.info();
             m.effects.set(e, &info.with_primary(info.fit_start * info.params[0].typical));
         }
-        params.extend(effect_params(e));
+        // (a held shape parameter stays where the start puts it: `scan` moves it)
+        params.extend(effect_params(e).into_iter().filter(|fp| !is_held_shape(fp)));
     }
     (m, params)
 }

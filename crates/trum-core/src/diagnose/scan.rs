@@ -60,11 +60,14 @@ fn factors(e: Effect) -> Vec<f64> {
     out
 }
 
-/// The effect's parameter vectors of the grid: every strength at `factor` × typical,
-/// each shape parameter at its minimum, its fit start, its middle and its maximum.
-fn grid(e: Effect) -> Vec<(f64, Vec<f64>)> {
+/// The effect's parameter vectors of the grid: every strength at `factor` × typical; each
+/// shape parameter the fits free at its minimum, its fit start, its middle and its maximum
+/// (all their combinations); each held one at its typical value and, one at a time with
+/// the others typical, at each of its `levels` (for `voltage_sag`'s knee: `knee_levels`).
+fn grid(e: Effect, knee_levels: &[f64]) -> Vec<(f64, Vec<f64>)> {
     let info = e.info();
-    let shapes: Vec<usize> = info.params.iter().enumerate().filter(|(_, p)| p.shape).map(|(i, _)| i).collect();
+    let shapes: Vec<usize> =
+        info.params.iter().enumerate().filter(|(_, p)| p.shape && !p.held).map(|(i, _)| i).collect();
     let mut shape_sets: Vec<Vec<f64>> = vec![info.params.iter().map(|p| p.start()).collect()];
     for &i in &shapes {
         let p = &info.params[i];
@@ -82,6 +85,21 @@ fn grid(e: Effect) -> Vec<(f64, Vec<f64>)> {
             })
             .collect();
     }
+    // the held shape parameters, one at a time, on every set of the free ones
+    let held_sets: Vec<Vec<f64>> = shape_sets
+        .iter()
+        .flat_map(|set| {
+            info.params.iter().enumerate().filter(|(_, p)| p.held).flat_map(move |(i, p)| {
+                let levels: &[f64] = if e == Effect::VoltageSag && i == 1 { knee_levels } else { p.levels };
+                levels.iter().filter(move |&&x| x != p.typical && (p.min..=p.max).contains(&x)).map(move |&x| {
+                    let mut w = set.clone();
+                    w[i] = x;
+                    w
+                })
+            })
+        })
+        .collect();
+    shape_sets.extend(held_sets);
     let mut out = Vec::new();
     for f in factors(e) {
         for set in &shape_sets {
@@ -106,7 +124,12 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
     let sub: Vec<ObservedRow> = rows.iter().step_by(step).cloned().collect();
     let chi2 = |m: &Motor| residuals(m, &sub).iter().map(|z| z * z).sum::<f64>();
     let fit_chi2 = chi2(fitted);
-    let points = grid(e);
+    let knee = if e == Effect::VoltageSag {
+        bases.first().map(|b| knee_levels(b, &sub)).unwrap_or_default()
+    } else {
+        Vec::new()
+    };
+    let points = grid(e, &knee);
     let scored: Vec<Scored> = bases
         .iter()
         .enumerate()
@@ -163,6 +186,25 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
     out
 }
 
+/// Where the scan places `voltage_sag`'s knee: at the quartiles of the phase current
+/// amplitude `base` draws at the scan's rows, the only scale a current limit has. (A knee
+/// above every current is the baseline; one below every current sags like the resistive
+/// source with a smaller set voltage.)
+fn knee_levels(base: &Motor, rows: &[ObservedRow]) -> Vec<f64> {
+    let p = crate::solve::Prepared::new(base).without_stall_torque();
+    let inst = base.effects.instrument();
+    let mut amps: Vec<f64> = rows
+        .iter()
+        .map(|r| crate::solve::solve_prepared(&p, base, &inst.operating_point(&r.op), None).current_a)
+        .filter(|a| a.is_finite() && *a > 0.0)
+        .collect();
+    if amps.is_empty() {
+        return Vec::new();
+    }
+    amps.sort_by(f64::total_cmp);
+    [0.25, 0.5, 0.75].iter().map(|q| amps[((amps.len() - 1) as f64 * q).round() as usize]).collect()
+}
+
 /// Widens the bounds of `e`'s strength parameters in `params` to hold `values` with room
 /// to move (three times the value, within the valid range).
 pub(crate) fn widen(params: &mut [FitParam], e: Effect, values: &[f64]) {
@@ -203,7 +245,7 @@ mod tests {
         let ps = factors(Effect::PreloadStiffening);
         assert!(ps.last().copied().unwrap_or(0.0) * 0.05 > 3.0, "{ps:?}");
         // a shape parameter at its ends and middle
-        assert_eq!(grid(Effect::PreloadStiffening).len(), 3 * ps.len());
+        assert_eq!(grid(Effect::PreloadStiffening, &[]).len(), 3 * ps.len());
     }
 
     #[test]

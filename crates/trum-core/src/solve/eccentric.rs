@@ -46,6 +46,8 @@ pub(crate) fn eccentric_average_with(
             (phi.cos() + 0.4 * (3.0 * phi).cos()) / 1.4
         } else if p.truth {
             (phi.cos() + 0.3 * (2.0 * phi).cos()) / 1.3
+        } else if p.runout_harmonics != [0.0, 0.0] {
+            runout_shape(phi, p.runout_harmonics)
         } else {
             phi.cos()
         };
@@ -53,7 +55,11 @@ pub(crate) fn eccentric_average_with(
         let mut o = *op;
         o.preload_n = op.preload_n + ripple * shape;
         // at a quarter turn the candidate's ripple is zero: the nominal solve is that sample
-        let s = if !p.truth && 4 * j == SAMPLES { nominal.clone() } else { solve_at(&o, Some(&prev)) };
+        let s = if !p.truth && p.runout_harmonics[0] == 0.0 && 4 * j == SAMPLES {
+            nominal.clone()
+        } else {
+            solve_at(&o, Some(&prev))
+        };
         if s.status != Status::Ok || s.speed_rad_s <= 0.0 {
             // the rotor sticks in this sector: it stops there
             let mut st = s;
@@ -79,6 +85,16 @@ pub(crate) fn eccentric_average_with(
     out.torque_nm = op.torque_nm;
     out.iterations = prev.iterations;
     out
+}
+
+/// `eccentricity`'s harmonic family: the ripple's shape at rotor angle `phi` [rad],
+/// (cos φ + h₂·cos 2φ + h₃·cos 3φ)/(1 + h₂ + h₃), its peak 1 at φ = 0 so that the runout
+/// stays the ripple's peak. An offset rotor gives the once-per-revolution term (Chen et
+/// al. 2020 §4.3); a rotor face tilted against the stator adds the twice-per-revolution
+/// term and a three-lobed rotor or a three-point mount the three-times one. Even in φ, as
+/// the sampling by halves assumes.
+pub(crate) fn runout_shape(phi: f64, [h2, h3]: [f64; 2]) -> f64 {
+    (phi.cos() + h2 * (2.0 * phi).cos() + h3 * (3.0 * phi).cos()) / (1.0 + h2 + h3)
 }
 
 fn scale_solution(a: &Solution, k: f64) -> Solution {
