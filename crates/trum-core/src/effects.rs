@@ -507,10 +507,14 @@ impl Effects {
         !self.on.iter().any(|&b| b)
     }
 
-    /// Switches an effect on with all its parameters (missing ones are 0).
+    /// Switches an effect on with all its parameters (missing ones are 0, a missing held
+    /// shape parameter its typical value: the candidate's plainest form).
     pub fn set(&mut self, e: Effect, params: &[f64]) {
         self.on[e as usize] = true;
         let mut v = [0.0; MAX_PARAMS];
+        for (slot, p) in v.iter_mut().zip(e.info().params).filter(|(_, p)| p.held) {
+            *slot = p.typical;
+        }
         for (slot, p) in v.iter_mut().zip(params) {
             *slot = *p;
         }

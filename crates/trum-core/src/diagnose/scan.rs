@@ -248,6 +248,27 @@ mod tests {
         assert_eq!(grid(Effect::PreloadStiffening, &[]).len(), 3 * ps.len());
     }
 
+    /// Each held shape parameter is scanned at its levels, one at a time with the others at
+    /// their typical values, on every strength of the grid; `voltage_sag`'s knee at the
+    /// levels the data give.
+    #[test]
+    fn the_grid_tries_each_held_shape_at_its_levels() {
+        let count = |e: Effect, knee: &[f64]| grid(e, knee).len() / factors(e).len();
+        assert_eq!(count(Effect::RadialFriction, &[]), 3);
+        assert_eq!(count(Effect::HertzSoftening, &[]), 4);
+        assert_eq!(count(Effect::ThermalDrift, &[]), 3);
+        assert_eq!(count(Effect::Eccentricity, &[]), 5);
+        assert_eq!(count(Effect::TangentialCompliance, &[]), 3);
+        assert_eq!(count(Effect::VoltageSag, &[]), 1);
+        assert_eq!(count(Effect::VoltageSag, &[0.1, 0.2, 0.3]), 4);
+        // one shape moved at a time: never two held shapes off their typical values
+        for (_, v) in grid(Effect::Eccentricity, &[]) {
+            assert!(v[1] == 0.0 || v[2] == 0.0, "{v:?}");
+        }
+        let knees: Vec<f64> = grid(Effect::VoltageSag, &[0.1, 0.2, 0.3]).iter().map(|(_, v)| v[1]).collect();
+        assert!(knees.contains(&0.0) && knees.contains(&0.2));
+    }
+
     #[test]
     fn widening_holds_the_valley_within_the_valid_range() {
         let e = Effect::PreloadStiffening;

@@ -104,3 +104,34 @@ fn scale_solution(a: &Solution, k: f64) -> Solution {
 fn add_solution(a: &Solution, b: &Solution) -> Solution {
     map_solution(a, Some(b), |x, y| x + y)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The harmonic ripple keeps the runout as its peak (at φ = 0), has a zero mean over a
+    /// revolution (the mean preload stays) and its harmonics in the given proportions
+    /// (Fourier coefficients by a 64-point rule, exact for these trigonometric polynomials).
+    #[test]
+    fn the_harmonic_ripple_peaks_at_the_runout_with_its_harmonics() {
+        let h = [0.3, 0.7];
+        assert!((runout_shape(0.0, h) - 1.0).abs() < 1e-15);
+        let n = 64;
+        let coef = |k: f64| {
+            (0..n).map(|j| 2.0 * PI * j as f64 / n as f64).map(|p| runout_shape(p, h) * (k * p).cos()).sum::<f64>()
+                * 2.0
+                / n as f64
+        };
+        let mean = (0..n).map(|j| runout_shape(2.0 * PI * j as f64 / n as f64, h)).sum::<f64>() / n as f64;
+        assert!(mean.abs() < 1e-15, "{mean}");
+        let norm = 1.0 + h[0] + h[1];
+        for (k, want) in [(1.0, 1.0 / norm), (2.0, h[0] / norm), (3.0, h[1] / norm), (4.0, 0.0)] {
+            assert!((coef(k) - want).abs() < 1e-14, "harmonic {k}: {} vs {want}", coef(k));
+        }
+        // sampling by halves: even in φ
+        for j in 1..8 {
+            let p = 2.0 * PI * j as f64 / 8.0;
+            assert!((runout_shape(p, h) - runout_shape(2.0 * PI - p, h)).abs() < 1e-14);
+        }
+    }
+}
