@@ -827,7 +827,7 @@ mod tests {
         let mut fx = Effects::none();
         fx.parse_assignment("thermal_drift:stiffness_coefficient_per_k=-1e-4,friction_coefficient_per_k=0").unwrap();
         // the parameter not named keeps its typical value
-        assert_eq!(fx.get(Effect::ThermalDrift), Some(&[-1e-4, 0.0, 2e-3][..]));
+        assert_eq!(fx.get(Effect::ThermalDrift), Some(&[-1e-4, 0.0, 2e-3, 0.0][..]));
         fx.parse_assignment("radial_friction=0.3").unwrap();
         assert_eq!(fx.value(Effect::RadialFriction, 0), 0.3);
         assert_eq!(fx.active().len(), 2);
