@@ -522,11 +522,6 @@ fn at_typical_shape(start: &Motor, added: &[Effect]) -> Option<Motor> {
     moved.then_some(m)
 }
 
-/// True when `fp` is a shape parameter the local fits hold (`EffectParam::held`).
-fn is_held_shape(fp: &FitParam) -> bool {
-    matches!(fp.param, ParamRef::Effect(e, i) if e.info().params[i].held)
-}
-
 /// True when `fp` is a shape parameter of one of the `added` effects.
 fn is_shape_of(fp: &FitParam, added: &[Effect]) -> bool {
     matches!(fp.param, ParamRef::Effect(e, i) if added.contains(&e) && e.info().params[i].shape)
@@ -564,7 +559,7 @@ pub(super) fn fit_params(
             m.effects.set(e, &info.with_primary(info.fit_start * info.params[0].typical));
         }
         // (a held shape parameter stays where the start puts it: `scan` moves it)
-        params.extend(effect_params(e).into_iter().filter(|fp| !is_held_shape(fp)));
+        params.extend(effect_params(e));
     }
     (m, params)
 }
