@@ -116,11 +116,14 @@ fn radial_friction_ratio_grows_with_preload_by_its_exponent() {
         solve(&grown(0.5, 1.0), &op(100.0, 0.1, 0.0)).speed_rpm,
         solve(&grown(0.5, 0.0), &op(100.0, 0.1, 0.0)).speed_rpm
     );
-    // a ratio growing with the preload costs more speed at high preload, less at low
-    let (lo, hi) = (op(150.0, 0.1, 0.0), op(400.0, 0.1, 0.0));
-    let (flat, steep) = (grown(1.0, 0.0), grown(0.5, 1.0));
+    // a ratio growing with the preload: at 200 N the same as a flat one of 0.3, at 400 N
+    // twice that, which costs speed there
+    let (mid, hi) = (op(200.0, 0.1, 0.0), op(400.0, 0.1, 0.0));
+    let (flat, steep) = (grown(0.3, 0.0), grown(0.15, 1.0));
+    let (a, b) = (solve(&steep, &mid), solve(&flat, &mid));
+    assert!((a.speed_rpm - b.speed_rpm).abs() <= 1e-12 * b.speed_rpm, "{} vs {}", a.speed_rpm, b.speed_rpm);
+    assert_eq!(solve(&steep, &hi).status, Status::Ok);
     assert!(solve(&steep, &hi).speed_rpm < solve(&flat, &hi).speed_rpm);
-    assert!(solve(&steep, &lo).speed_rpm > solve(&flat, &lo).speed_rpm);
 }
 
 /// `hertz_softening`'s preload exponent: β·(1 + gF)² is the plain candidate with
@@ -169,23 +172,29 @@ fn a_current_limited_driver_holds_its_voltage_up_to_the_knee() {
     assert!((knee.current_a - y * ve).abs() < 1e-9 * knee.current_a);
 }
 
-/// `tangential_compliance`'s stick-then-slip layer: S = tanh(xⁿ)^(1/n) ≥ tanh x, the
-/// layer carries more traction before it slips than the smooth saturation, so a sharper
-/// layer's speed lies between the smooth one's and the rigid (Coulomb) baseline's.
+/// `tangential_compliance`'s stick-then-slip layer, S = tanh(xⁿ)^(1/n): a form of its own
+/// (n = 4 moves the speed by more than 0.1 % from tanh's at every load), the Coulomb
+/// baseline as the layer stiffens (σ → 0), and the energy balance.
 #[test]
-fn a_stick_then_slip_layer_lies_between_the_smooth_saturation_and_coulomb() {
+fn a_stick_then_slip_layer_is_its_own_form_and_stiffens_to_coulomb() {
     let tc = Effect::TangentialCompliance;
     let base = baseline();
-    let layer = |n: f64| with_shape(tc, 1, n);
+    let layer = |kappa: f64, n: f64| {
+        let mut m = baseline();
+        m.effects.set(tc, &[kappa, n]);
+        m
+    };
     for t in [0.0, 0.2, 0.4] {
         let o = op(250.0, t, 0.0);
-        let (b, smooth, sharp, sharper) =
-            (solve(&base, &o), solve(&layer(1.0), &o), solve(&layer(2.0), &o), solve(&layer(4.0), &o));
-        assert_eq!(sharper.status, Status::Ok, "T={t}");
-        assert!(smooth.speed_rpm < sharp.speed_rpm && sharp.speed_rpm < sharper.speed_rpm, "T={t}");
-        assert!(sharper.speed_rpm < b.speed_rpm, "T={t}: {} vs {}", sharper.speed_rpm, b.speed_rpm);
-        let bal = sharper.input_power_w - sharper.output_power_w - sharper.total_loss_w();
-        assert!(bal.abs() < 1e-6 * sharper.input_power_w, "T={t}: power balance {bal}");
+        let v: Vec<f64> = [1.0, 4.0].iter().map(|&n| solve(&layer(1.0, n), &o).speed_rpm).collect();
+        assert!((v[1] - v[0]).abs() > 1e-3 * v[0], "T={t}: {v:?}");
+        let b = solve(&base, &o).speed_rpm;
+        let stiff = solve(&layer(1e-4, 4.0), &o).speed_rpm;
+        assert!((stiff - b).abs() < 1e-3 * b && (stiff - b).abs() < (v[1] - b).abs(), "T={t}: {stiff} vs {b}");
+        let s = solve(&layer(1.0, 4.0), &o);
+        assert_eq!(s.status, Status::Ok, "T={t}");
+        let bal = s.input_power_w - s.output_power_w - s.total_loss_w();
+        assert!(bal.abs() < 1e-6 * s.input_power_w, "T={t}: power balance {bal}");
     }
 }
 
@@ -241,9 +250,10 @@ fn runout_harmonics_change_the_fluctuation_at_the_same_peak() {
 #[test]
 fn shape_keys_read_validate_and_round_trip() {
     let text = |effects: &str| {
-        let mut s = baseline().to_toml();
-        s.push_str(&format!("\n[effects]\n{effects}\n"));
-        s
+        let s = baseline().to_toml();
+        let header = "[effects]  # none switched on; see `trum effects`";
+        assert!(s.contains(header), "{s}");
+        s.replacen(header, &format!("[effects]\n{effects}"), 1)
     };
     let m = Motor::from_toml_str(
         &text("voltage_sag = { source_resistance_ohm = 100, knee_current_a = 0.2 }\ntangential_compliance = { shear_compliance_ratio = 1, stick_sharpness = 3 }"),
