@@ -41,8 +41,8 @@ pub(crate) struct Valley {
     pub chi2: f64,
 }
 
-/// Strength factors (× typical) of the grid: from 0.1 up to the largest one within the
-/// valid range of every strength parameter.
+/// Strength factors (× typical) of the grid: from 0.1 in steps of √10 up to the top of the
+/// valid range of every strength parameter (or [`MAX_FACTOR`]), the top included.
 fn factors(e: Effect) -> Vec<f64> {
     let top = e
         .info()
@@ -52,10 +52,17 @@ fn factors(e: Effect) -> Vec<f64> {
         .map(|p| if p.typical > 0.0 { p.max / p.typical } else { p.min / p.typical })
         .fold(f64::INFINITY, f64::min);
     let mut out = Vec::new();
+    let end = top.min(MAX_FACTOR);
     let mut f = 0.1;
-    while f <= top.min(MAX_FACTOR) * (1.0 + 1e-9) {
+    while f <= end * (1.0 + 1e-9) {
         out.push(f);
         f *= GRID_RATIO;
+    }
+    // the range's top itself, where the steps end short of it (`radial_friction`'s
+    // 3 × typical, `tangential_compliance`'s 20 ×, `thermal_drift`'s 25 ×,
+    // `eccentricity`'s 50 ×)
+    if out.last().is_some_and(|&l| l < end * (1.0 - 1e-9)) {
+        out.push(end);
     }
     out
 }
@@ -234,11 +241,16 @@ mod tests {
             let f = factors(e);
             assert!(!f.is_empty(), "{e}");
             assert!((f[0] - 0.1).abs() < 1e-12);
+            let mut reach = f64::INFINITY;
             for p in e.info().params.iter().filter(|p| !p.shape && p.typical != 0.0) {
                 let top = f.last().copied().unwrap_or(0.0) * p.typical;
-                // within the range, and within one grid step of its end (or the grid's cap)
+                // within the range
                 assert!(top.abs() <= p.max.abs().max(p.min.abs()) * (1.0 + 1e-9), "{e}: {top}");
+                reach = reach.min(if p.typical > 0.0 { p.max / p.typical } else { p.min / p.typical });
             }
+            // and at its end (or the grid's cap): the whole documented range
+            let last = f.last().copied().unwrap_or(0.0);
+            assert!((last - reach.min(MAX_FACTOR)).abs() <= 1e-9 * last, "{e}: {last} vs {reach}");
         }
         // preload_stiffening reaches its documented scale of 5 (100 × typical), beyond the
         // local fit's eight
