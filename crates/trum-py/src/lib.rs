@@ -584,7 +584,8 @@ fn preset_toml(py: Python<'_>, name: &str) -> PyResult<String> {
     presets::find(name).map(|p| p.to_toml()).map_err(|e| param_err(py, &e))
 }
 
-type EffectRow = (&'static str, &'static str, &'static str, Vec<(&'static str, &'static str, f64, f64, f64, bool, bool)>);
+type EffectRow =
+    (&'static str, &'static str, &'static str, Vec<(&'static str, &'static str, f64, f64, f64, bool, bool)>);
 
 /// `(name, summary, source, [(param, doc, typical, min, max, shape, held)])` of every effect.
 #[pyfunction]

@@ -70,8 +70,9 @@ fn factors(e: Effect) -> Vec<f64> {
 /// The effect's parameter vectors of the grid: every strength at `factor` × typical; each
 /// shape parameter the fits free at its minimum, its fit start, its middle and its maximum
 /// (all their combinations); each held one at its typical value and, one at a time with
-/// the others typical, at each of its `levels` (for `voltage_sag`'s knee: `knee_levels`).
-fn grid(e: Effect, knee_levels: &[f64]) -> Vec<(f64, Vec<f64>)> {
+/// the others typical, at each of its `levels` (for `voltage_sag`'s knee: `knee_levels`):
+/// (factor, values, whether a held shape is off its typical value).
+fn grid(e: Effect, knee_levels: &[f64]) -> Vec<(f64, Vec<f64>, bool)> {
     let info = e.info();
     let shapes: Vec<usize> =
         info.params.iter().enumerate().filter(|(_, p)| p.shape && !p.held).map(|(i, _)| i).collect();
@@ -106,13 +107,14 @@ fn grid(e: Effect, knee_levels: &[f64]) -> Vec<(f64, Vec<f64>)> {
             })
         })
         .collect();
+    let n_plain = shape_sets.len();
     shape_sets.extend(held_sets);
     let mut out = Vec::new();
     for f in factors(e) {
-        for set in &shape_sets {
+        for (k, set) in shape_sets.iter().enumerate() {
             let v: Vec<f64> =
                 info.params.iter().zip(set).map(|(p, &s)| if p.shape { s } else { f * p.typical }).collect();
-            out.push((f, v));
+            out.push((f, v, k >= n_plain));
         }
     }
     out
@@ -137,19 +139,45 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
         Vec::new()
     };
     let points = grid(e, &knee);
-    let scored: Vec<Scored> = bases
-        .iter()
-        .enumerate()
-        .flat_map(|(b, base)| points.iter().map(move |(f, v)| (b, base, *f, v.clone())))
-        .collect::<Vec<_>>()
-        .into_par_iter()
-        .map(|(b, base, f, v)| {
-            let mut m = (*base).clone();
-            m.effects.set(e, &v);
-            let c = chi2(&m);
-            (b, f, v, if c.is_finite() { c } else { f64::INFINITY })
+    let score = |pts: Vec<(usize, &&Motor, f64, Vec<f64>)>| -> Vec<Scored> {
+        pts.into_par_iter()
+            .map(|(b, base, f, v)| {
+                let mut m = (*base).clone();
+                m.effects.set(e, &v);
+                let c = chi2(&m);
+                (b, f, v, if c.is_finite() { c } else { f64::INFINITY })
+            })
+            .collect()
+    };
+    // first the plain forms (held shapes typical) at every strength
+    let mut scored: Vec<Scored> = score(
+        bases
+            .iter()
+            .enumerate()
+            .flat_map(|(b, base)| points.iter().filter(|p| !p.2).map(move |(f, v, _)| (b, base, *f, v.clone())))
+            .collect(),
+    );
+    // then each held shape's levels at the strengths within one grid step of the plain
+    // forms' best from that base (a form changes how strong the effect must be by about
+    // a step; the whole grid for every level cost a null diagnosis a quarter more time)
+    let grid_factors = factors(e);
+    let near: Vec<Vec<f64>> = (0..bases.len())
+        .map(|b| {
+            let best = scored.iter().filter(|p| p.0 == b).min_by(|x, y| x.3.total_cmp(&y.3)).map(|p| p.1);
+            let k = best.and_then(|f| grid_factors.iter().position(|&g| g == f)).unwrap_or(0);
+            grid_factors[k.saturating_sub(1)..(k + 2).min(grid_factors.len())].to_vec()
         })
         .collect();
+    scored.extend(score(
+        bases
+            .iter()
+            .enumerate()
+            .flat_map(|(b, base)| {
+                let near = &near[b];
+                points.iter().filter(move |p| p.2 && near.contains(&p.0)).map(move |(f, v, _)| (b, base, *f, v.clone()))
+            })
+            .collect(),
+    ));
     let mut found: Vec<Valley> = Vec::new();
     for (b, base) in bases.iter().enumerate() {
         // one series per shape set: the values with the same shape parameters
@@ -163,8 +191,10 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
                 None => series.push(vec![p]),
             }
         }
+        // (within the fit's bounds: every form scanned from this base, as a held shape's
+        // short series may have no strength of its own there)
+        let inside = scored.iter().filter(|p| p.0 == b && p.1 <= 8.0).map(|p| p.3).fold(f64::INFINITY, f64::min);
         for s in &series {
-            let inside = s.iter().filter(|p| p.1 <= 8.0).map(|p| p.3).fold(f64::INFINITY, f64::min);
             for (i, p) in s.iter().enumerate() {
                 let left = i == 0 || s[i - 1].3 > p.3;
                 let right = i + 1 == s.len() || s[i + 1].3 >= p.3;
@@ -258,6 +288,7 @@ mod tests {
         assert!(ps.last().copied().unwrap_or(0.0) * 0.05 > 3.0, "{ps:?}");
         // a shape parameter at its ends and middle
         assert_eq!(grid(Effect::PreloadStiffening, &[]).len(), 3 * ps.len());
+        assert!(grid(Effect::PreloadStiffening, &[]).iter().all(|p| !p.2));
     }
 
     /// Each held shape parameter is scanned at its levels, one at a time with the others at
@@ -274,10 +305,11 @@ mod tests {
         assert_eq!(count(Effect::VoltageSag, &[]), 1);
         assert_eq!(count(Effect::VoltageSag, &[0.1, 0.2, 0.3]), 4);
         // one shape moved at a time: never two held shapes off their typical values
-        for (_, v) in grid(Effect::Eccentricity, &[]) {
+        for (_, v, held) in grid(Effect::Eccentricity, &[]) {
             assert!(v[1] == 0.0 || v[2] == 0.0, "{v:?}");
+            assert_eq!(held, v[1] != 0.0 || v[2] != 0.0, "{v:?}");
         }
-        let knees: Vec<f64> = grid(Effect::VoltageSag, &[0.1, 0.2, 0.3]).iter().map(|(_, v)| v[1]).collect();
+        let knees: Vec<f64> = grid(Effect::VoltageSag, &[0.1, 0.2, 0.3]).iter().map(|(_, v, _)| v[1]).collect();
         assert!(knees.contains(&0.0) && knees.contains(&0.2));
     }
 
