@@ -107,8 +107,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         params: &[
             EffectParam {
                 name: "radial_velocity_ratio",
-                doc: "peak radial surface speed over peak tangential surface speed [-] (at a \
-                      preload of 100 N where preload_exponent is not 0)",
+                doc: "peak radial surface speed over peak tangential surface speed [-]",
                 typical: 1.0,
                 min: 0.0,
                 max: 3.0,
@@ -118,9 +117,9 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
             },
             EffectParam {
                 name: "preload_exponent",
-                doc: "growth of the radial-speed ratio with the preload [-]: rho·(F_N/100 N)^q; \
-                      0 a ratio the preload does not change, 0.5 one that follows the contact \
-                      width of a Hertzian line contact",
+                doc: "growth of the radial-speed ratio with the preload [-]: rho·(F_N/100 N)^q, \
+                      rho then the ratio at 100 N; 0 a ratio the preload does not change, 0.5 \
+                      one that follows the contact width of a Hertzian line contact",
                 typical: 0.0,
                 min: 0.0,
                 max: 1.5,
