@@ -1,7 +1,8 @@
 //! The library of named, switchable unmodelled effects (names fixed by
 //! `shared/spec/diagnose.md`). Like PyBaMM's model options: an explicit set of named
-//! effects, each with one to three strength parameters in physical units, `none` by
-//! default, validated with errors that list the valid names.
+//! effects, each with one to three strength parameters in physical units and shape
+//! parameters that choose among its forms, `none` by default, validated with errors that
+//! list the valid names.
 //!
 //! This module holds the registry and the switch; the physics of each effect lives next
 //! to the part of the model it changes and is applied by [`crate::solve`].
