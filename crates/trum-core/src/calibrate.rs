@@ -294,13 +294,16 @@ fn fit_rel(motor: &Motor, key: &str, lo: f64, hi: f64) -> FitParam {
 
 /// The fit parameters of an effect: all its strength parameters, bounded to eight times
 /// their typical magnitude inside the valid range (beyond that an effect would dominate
-/// the motor's behaviour rather than perturb it, and the solves get needlessly hard).
+/// the motor's behaviour rather than perturb it, and the solves get needlessly hard), and
+/// the shape parameters a fit frees; a held shape parameter stays where the motor has it
+/// (`EffectParam::held`: the diagnosis's scan chooses it).
 pub fn effect_params(effect: Effect) -> Vec<FitParam> {
     effect
         .info()
         .params
         .iter()
         .enumerate()
+        .filter(|(_, p)| !p.held)
         .map(|(i, p)| {
             // a strength within 8 × its typical value; a shape parameter over its whole range
             let span = if p.shape { f64::INFINITY } else { 8.0 * p.typical.abs() };

@@ -1,7 +1,8 @@
 //! The library of named, switchable unmodelled effects (names fixed by
 //! `shared/spec/diagnose.md`). Like PyBaMM's model options: an explicit set of named
-//! effects, each with one to three strength parameters in physical units, `none` by
-//! default, validated with errors that list the valid names.
+//! effects, each with one to three strength parameters in physical units and shape
+//! parameters that choose among its forms, `none` by default, validated with errors that
+//! list the valid names.
 //!
 //! This module holds the registry and the switch; the physics of each effect lives next
 //! to the part of the model it changes and is applied by [`crate::solve`].
@@ -27,14 +28,22 @@ pub struct EffectParam {
     /// leaves it out keep its typical value, and the diagnosis fits it over its whole range
     /// from the middle (and probes it there).
     pub shape: bool,
+    /// A shape parameter the local fits hold where their start puts it (its typical value,
+    /// the candidate's plainest form, or the level the scan found): the diagnosis's scan of
+    /// the effect's range tries it at [`EffectParam::levels`] (docs/DIAGNOSIS.md, "Fits
+    /// that search"). False for strengths and for shape parameters the fits free.
+    pub held: bool,
+    /// The values of a held shape parameter the scan tries besides its typical value (the
+    /// scan derives `voltage_sag`'s knee current from the data instead).
+    pub levels: &'static [f64],
 }
 
 impl EffectParam {
     /// Where a fit or a sensitivity probe places a further (non-primary) parameter: its
-    /// typical value, or the middle of its range for a shape parameter (whose typical value
-    /// may sit on a bound, where a fit's transformed gradient vanishes).
+    /// typical value, or the middle of its range for a shape parameter the fits free (whose
+    /// typical value may sit on a bound, where a fit's transformed gradient vanishes).
     pub fn start(&self) -> f64 {
-        if self.shape {
+        if self.shape && !self.held {
             0.5 * (self.min + self.max)
         } else {
             self.typical
@@ -74,8 +83,9 @@ pub enum Effect {
 /// Number of effects in the registry.
 pub const N_EFFECTS: usize = 7;
 
-/// Most strength parameters an effect has (`thermal_drift`: stiffness, damping, friction).
-pub const MAX_PARAMS: usize = 3;
+/// Most parameters an effect has (`thermal_drift`: stiffness, damping and friction
+/// coefficients and the interface node's share).
+pub const MAX_PARAMS: usize = 4;
 
 /// All effects, in the order of [`Effect`].
 pub const ALL: [Effect; N_EFFECTS] = [
@@ -95,14 +105,30 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         summary: "stator surface points also slip radially; friction acts along the total slip, \
                   driving force drops and radial slip dissipates power",
         source: "the radial-friction paper (radial friction in the contact mechanism), eq. 19-21 and 27",
-        params: &[EffectParam {
-            name: "radial_velocity_ratio",
-            doc: "peak radial surface speed over peak tangential surface speed [-]",
-            typical: 1.0,
-            min: 0.0,
-            max: 3.0,
-            shape: false,
-        }],
+        params: &[
+            EffectParam {
+                name: "radial_velocity_ratio",
+                doc: "peak radial surface speed over peak tangential surface speed [-]",
+                typical: 1.0,
+                min: 0.0,
+                max: 3.0,
+                shape: false,
+                held: false,
+                levels: &[],
+            },
+            EffectParam {
+                name: "preload_exponent",
+                doc: "growth of the radial-speed ratio with the preload [-]: rho·(F_N/100 N)^q, \
+                      rho then the ratio at 100 N; 0 a ratio the preload does not change, 0.5 \
+                      one that follows the contact width of a Hertzian line contact",
+                typical: 0.0,
+                min: 0.0,
+                max: 1.5,
+                shape: true,
+                held: true,
+                levels: &[0.5, 1.0],
+            },
+        ],
         fit_start: 0.5,
     },
     EffectInfo {
@@ -118,6 +144,8 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 min: 0.0,
                 max: 5.0,
                 shape: false,
+                held: false,
+                levels: &[],
             },
             EffectParam {
                 name: "modal_fraction",
@@ -128,6 +156,8 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 min: 0.0,
                 max: 1.0,
                 shape: true,
+                held: false,
+                levels: &[],
             },
         ],
         fit_start: 0.5,
@@ -145,6 +175,8 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 min: 0.0,
                 max: 1.0e23,
                 shape: false,
+                held: false,
+                levels: &[],
             },
             EffectParam {
                 name: "preload_gain_per_n",
@@ -153,6 +185,20 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 min: 0.0,
                 max: 1.0,
                 shape: false,
+                held: false,
+                levels: &[],
+            },
+            EffectParam {
+                name: "preload_exponent",
+                doc: "exponent n of the preload growth of the cubic coefficient [-]: \
+                      beta·(1 + g·F_N)^n; 1 linear growth, 1.5 the growth of a Hertzian \
+                      contact's stiffness with its load",
+                typical: 1.0,
+                min: 0.5,
+                max: 3.0,
+                shape: true,
+                held: true,
+                levels: &[0.5, 1.5, 2.0],
             },
         ],
         fit_start: 0.5,
@@ -171,6 +217,8 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 min: -0.05,
                 max: 0.05,
                 shape: false,
+                held: false,
+                levels: &[],
             },
             EffectParam {
                 name: "friction_coefficient_per_k",
@@ -179,6 +227,8 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 min: -0.05,
                 max: 0.05,
                 shape: false,
+                held: false,
+                levels: &[],
             },
             EffectParam {
                 name: "damping_coefficient_per_k",
@@ -188,6 +238,20 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
                 min: -0.05,
                 max: 0.05,
                 shape: false,
+                held: false,
+                levels: &[],
+            },
+            EffectParam {
+                name: "interface_fraction",
+                doc: "share of the temperature rise carried by a fast node at the friction \
+                      interface, with a tenth of the lumped time constant [-]: 0 one lumped \
+                      capacity (Chen et al. 2020 eq. 11)",
+                typical: 0.0,
+                min: 0.0,
+                max: 0.9,
+                shape: true,
+                held: true,
+                levels: &[0.4, 0.8],
             },
         ],
         fit_start: 0.5,
@@ -197,14 +261,31 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         summary: "the driver cannot hold the set voltage: the electrode voltage falls with the \
                   load current through the driver's output impedance",
         source: "Sun et al. 2021 section 3.1",
-        params: &[EffectParam {
-            name: "source_resistance_ohm",
-            doc: "output resistance of the drive electronics per phase [ohm]",
-            typical: 150.0,
-            min: 0.0,
-            max: 1.0e5,
-            shape: false,
-        }],
+        params: &[
+            EffectParam {
+                name: "source_resistance_ohm",
+                doc: "output resistance of the drive electronics per phase [ohm] (with a knee: \
+                      acting on the current above it)",
+                typical: 150.0,
+                min: 0.0,
+                max: 1.0e5,
+                shape: false,
+                held: false,
+                levels: &[],
+            },
+            EffectParam {
+                name: "knee_current_a",
+                doc: "current amplitude per phase up to which the driver holds its set voltage \
+                      [A]: a current-limited driver sags only with the current above it; 0 a \
+                      plain resistive source",
+                typical: 0.0,
+                min: 0.0,
+                max: 100.0,
+                shape: true,
+                held: true,
+                levels: &[],
+            },
+        ],
         fit_start: 0.5,
     },
     EffectInfo {
@@ -212,14 +293,41 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         summary: "assembly error makes the preload vary once per revolution; contact angle and \
                   speed fluctuate and the mean speed shifts",
         source: "Chen et al. 2020 section 4.3 and eq. 12",
-        params: &[EffectParam {
-            name: "runout_m",
-            doc: "once-per-revolution axial runout of the rotor [m]",
-            typical: 20.0e-6,
-            min: 0.0,
-            max: 1.0e-3,
-            shape: false,
-        }],
+        params: &[
+            EffectParam {
+                name: "runout_m",
+                doc: "once-per-revolution axial runout of the rotor [m] (the peak of the whole \
+                      ripple where it has harmonics)",
+                typical: 20.0e-6,
+                min: 0.0,
+                max: 1.0e-3,
+                shape: false,
+                held: false,
+                levels: &[],
+            },
+            EffectParam {
+                name: "second_harmonic_fraction",
+                doc: "amplitude of a twice-per-revolution ripple relative to the \
+                      once-per-revolution one [-]: a tilted rotor face",
+                typical: 0.0,
+                min: 0.0,
+                max: 1.0,
+                shape: true,
+                held: true,
+                levels: &[0.3, 0.7],
+            },
+            EffectParam {
+                name: "third_harmonic_fraction",
+                doc: "amplitude of a three-times-per-revolution ripple relative to the \
+                      once-per-revolution one [-]: a three-lobed rotor or a three-point mount",
+                typical: 0.0,
+                min: 0.0,
+                max: 1.0,
+                shape: true,
+                held: true,
+                levels: &[0.3, 0.7],
+            },
+        ],
         fit_start: 0.5,
     },
     EffectInfo {
@@ -227,14 +335,31 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
         summary: "shear compliance of the friction layer: partial stick inside the contact and a \
                   smooth speed-torque curve instead of a sharp stall",
         source: "the bar-type transient paper eq. 1-2; Storck and Wallaschek, Int. J. Non-Linear Mech. 38 (2003)",
-        params: &[EffectParam {
-            name: "shear_compliance_ratio",
-            doc: "ratio of tangential to normal compliance of the friction layer [-]",
-            typical: 1.0,
-            min: 0.0,
-            max: 20.0,
-            shape: false,
-        }],
+        params: &[
+            EffectParam {
+                name: "shear_compliance_ratio",
+                doc: "ratio of tangential to normal compliance of the friction layer [-]",
+                typical: 1.0,
+                min: 0.0,
+                max: 20.0,
+                shape: false,
+                held: false,
+                levels: &[],
+            },
+            EffectParam {
+                name: "stick_sharpness",
+                doc: "sharpness n of the layer's turn from stick to slip [-]: traction \
+                      tanh(x^n)^(1/n) at slip speed x over its scale; 1 the smooth saturation, \
+                      large n an elastic layer that sticks (traction in proportion to its \
+                      shear) and then slips at full friction",
+                typical: 1.0,
+                min: 1.0,
+                max: 4.0,
+                shape: true,
+                held: true,
+                levels: &[2.0, 4.0],
+            },
+        ],
         // Weak: from half its typical strength a fit can stick in a basin beyond a barrier
         // from zero, neither fitting the data nor reaching the baseline it nests (on the
         // 1000-row radial-friction benchmark at twice the baseline's χ², 140 passes, 6 of
@@ -382,10 +507,14 @@ impl Effects {
         !self.on.iter().any(|&b| b)
     }
 
-    /// Switches an effect on with all its parameters (missing ones are 0).
+    /// Switches an effect on with all its parameters (missing ones are 0, a missing held
+    /// shape parameter its typical value: the candidate's plainest form).
     pub fn set(&mut self, e: Effect, params: &[f64]) {
         self.on[e as usize] = true;
         let mut v = [0.0; MAX_PARAMS];
+        for (slot, p) in v.iter_mut().zip(e.info().params).filter(|(_, p)| p.held) {
+            *slot = p.typical;
+        }
         for (slot, p) in v.iter_mut().zip(params) {
             *slot = *p;
         }
@@ -601,6 +730,7 @@ impl Effects {
                 .params
                 .iter()
                 .zip(self.values[e as usize])
+                .filter(|(p, v)| written(p, *v))
                 .map(|(p, v)| format!("{} = {}", p.name, fmt_toml_number(v, false)))
                 .collect();
             s.push_str(&format!("{} = {{ {} }}\n", e.name(), parts.join(", ")));
@@ -623,6 +753,7 @@ impl fmt::Display for Effects {
                     .params
                     .iter()
                     .zip(self.values[e as usize])
+                    .filter(|(p, v)| written(p, *v))
                     .map(|(p, v)| format!("{}={}", p.name, v))
                     .collect();
                 format!("{}({})", e.name(), ps.join(", "))
@@ -634,6 +765,12 @@ impl fmt::Display for Effects {
         }
         Ok(())
     }
+}
+
+/// Whether a parameter is written out: a held shape parameter at its typical value (the
+/// candidate's plainest form, which a table that leaves it out reads back) is not.
+fn written(p: &EffectParam, v: f64) -> bool {
+    !(p.held && v == p.typical)
 }
 
 fn num(v: &toml::Value) -> Option<f64> {
@@ -690,7 +827,7 @@ mod tests {
         let mut fx = Effects::none();
         fx.parse_assignment("thermal_drift:stiffness_coefficient_per_k=-1e-4,friction_coefficient_per_k=0").unwrap();
         // the parameter not named keeps its typical value
-        assert_eq!(fx.get(Effect::ThermalDrift), Some(&[-1e-4, 0.0, 2e-3][..]));
+        assert_eq!(fx.get(Effect::ThermalDrift), Some(&[-1e-4, 0.0, 2e-3, 0.0][..]));
         fx.parse_assignment("radial_friction=0.3").unwrap();
         assert_eq!(fx.value(Effect::RadialFriction, 0), 0.3);
         assert_eq!(fx.active().len(), 2);

@@ -130,10 +130,21 @@ pub(crate) fn softening_per_w2(p: &Prepared, d: &Drive) -> f64 {
         (0.8 * p.beta_gain * d.f_n).exp()
     } else if p.truth {
         (1.0 + p.beta_gain * d.f_n).powf(1.3)
+    } else if p.beta_exponent != 1.0 {
+        hertz_preload_growth(p.beta_gain, p.beta_exponent, d.f_n)
     } else {
         1.0 + p.beta_gain * d.f_n
     };
     0.75 * p.beta * growth
+}
+
+/// `hertz_softening`'s preload family: the cubic coefficient grows as (1 + g·F_N)^n [-]. The
+/// Hertzian driving-circuit paper (2022, eq. 2-4) takes the contact's cubic term in
+/// proportion to its load (n = 1); the stiffness of a Hertzian contact itself grows as
+/// F^(1/3) (point) to F^(1/2) and its nonlinear terms faster, so the paper's linear law is
+/// one member of a family whose exponent a bench may show anywhere in [0.5, 3].
+pub(crate) fn hertz_preload_growth(g: f64, n: f64, f_n: f64) -> f64 {
+    (1.0 + g * f_n).max(0.0).powf(n)
 }
 
 /// The modal stiffness at amplitude `w` [m] with contact `ct` and force scale `a` [N]: the

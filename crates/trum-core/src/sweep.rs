@@ -164,7 +164,8 @@ mod tests {
             let mut m = crate::presets::frozen(name.split('+').next().unwrap_or(name)).expect("preset");
             if name.ends_with("softening") {
                 let e = crate::effects::Effect::HertzSoftening;
-                let strong: Vec<f64> = e.info().params.iter().map(|p| 3.0 * p.typical).collect();
+                let strong: Vec<f64> =
+                    e.info().params.iter().map(|p| if p.shape { p.typical } else { 3.0 * p.typical }).collect();
                 m.effects.set(e, &strong);
             }
             (name, m)

@@ -584,9 +584,10 @@ fn preset_toml(py: Python<'_>, name: &str) -> PyResult<String> {
     presets::find(name).map(|p| p.to_toml()).map_err(|e| param_err(py, &e))
 }
 
-type EffectRow = (&'static str, &'static str, &'static str, Vec<(&'static str, &'static str, f64, f64, f64, bool)>);
+type EffectRow =
+    (&'static str, &'static str, &'static str, Vec<(&'static str, &'static str, f64, f64, f64, bool, bool)>);
 
-/// `(name, summary, source, [(param, doc, typical, min, max, shape)])` of every effect.
+/// `(name, summary, source, [(param, doc, typical, min, max, shape, held)])` of every effect.
 #[pyfunction]
 fn effects_list() -> Vec<EffectRow> {
     EFFECTS
@@ -596,7 +597,7 @@ fn effects_list() -> Vec<EffectRow> {
                 e.name,
                 e.summary,
                 e.source,
-                e.params.iter().map(|p| (p.name, p.doc, p.typical, p.min, p.max, p.shape)).collect(),
+                e.params.iter().map(|p| (p.name, p.doc, p.typical, p.min, p.max, p.shape, p.held)).collect(),
             )
         })
         .collect()

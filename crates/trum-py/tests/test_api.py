@@ -113,6 +113,12 @@ def test_registries():
     # preload_stiffening's second parameter is a shape, not a strength, as `trum effects` says
     ps = fx["preload_stiffening"].params
     assert [(p.name, p.shape) for p in ps] == [("stiffness_scale", False), ("modal_fraction", True)]
+    # voltage_sag's family: the knee of a current-limited driver, held by the local fits
+    sag = fx["voltage_sag"].params
+    assert [(p.name, p.shape, p.held) for p in sag] == [
+        ("source_resistance_ohm", False, False),
+        ("knee_current_a", True, True),
+    ]
     assert (ps[1].typical, ps[1].min, ps[1].max) == (0.0, 0.0, 1.0)
     # NAME=STRENGTH keeps Sun et al. 2021 eq. 8 (fraction 0) bit for bit; the modal projection differs
     speed = lambda spec: trum.Motor("trum60a").with_effects(spec).solve(

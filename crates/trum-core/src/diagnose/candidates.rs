@@ -380,6 +380,25 @@ impl<'a> Scorer<'a> {
             }
             Err(_) => (f64::NEG_INFINITY, Vec::new(), base_cv.preds.clone(), None),
         };
+        // the held shape parameters where the scan moved them: the form the fit is of
+        let mut fitted = fitted;
+        if let Some(m) = &fitted_motor {
+            for &e in effects {
+                for (i, p) in e.info().params.iter().enumerate().filter(|(_, p)| p.held) {
+                    let v = m.motor.effects.value(e, i);
+                    if v != p.typical {
+                        fitted.push(FittedParam {
+                            name: format!("effects.{}.{}", e.name(), p.name),
+                            value: v,
+                            std_error: f64::NAN,
+                            at_bound: false,
+                            identifiable: false,
+                            prior_rel_sd: None,
+                        });
+                    }
+                }
+            }
+        }
         let (after, chi2_after, e2, _) = errors(rows, &preds, sc);
         let shrink = 1.0 - after / base_nrmse.max(1e-300);
         let interval = bootstrap_shrink(base_e2, &e2, opts.bootstrap, opts.seed);
@@ -539,6 +558,7 @@ pub(super) fn fit_params(
             let info = e.info();
             m.effects.set(e, &info.with_primary(info.fit_start * info.params[0].typical));
         }
+        // (a held shape parameter stays where the start puts it: `scan` moves it)
         params.extend(effect_params(e));
     }
     (m, params)

@@ -41,8 +41,8 @@ pub(crate) struct Valley {
     pub chi2: f64,
 }
 
-/// Strength factors (× typical) of the grid: from 0.1 up to the largest one within the
-/// valid range of every strength parameter.
+/// Strength factors (× typical) of the grid: from 0.1 in steps of √10 up to the top of the
+/// valid range of every strength parameter (or [`MAX_FACTOR`]), the top included.
 fn factors(e: Effect) -> Vec<f64> {
     let top = e
         .info()
@@ -52,19 +52,30 @@ fn factors(e: Effect) -> Vec<f64> {
         .map(|p| if p.typical > 0.0 { p.max / p.typical } else { p.min / p.typical })
         .fold(f64::INFINITY, f64::min);
     let mut out = Vec::new();
+    let end = top.min(MAX_FACTOR);
     let mut f = 0.1;
-    while f <= top.min(MAX_FACTOR) * (1.0 + 1e-9) {
+    while f <= end * (1.0 + 1e-9) {
         out.push(f);
         f *= GRID_RATIO;
+    }
+    // the range's top itself, where the steps end short of it (`radial_friction`'s
+    // 3 × typical, `tangential_compliance`'s 20 ×, `thermal_drift`'s 25 ×,
+    // `eccentricity`'s 50 ×)
+    if out.last().is_some_and(|&l| l < end * (1.0 - 1e-9)) {
+        out.push(end);
     }
     out
 }
 
-/// The effect's parameter vectors of the grid: every strength at `factor` × typical,
-/// each shape parameter at its minimum, its fit start, its middle and its maximum.
-fn grid(e: Effect) -> Vec<(f64, Vec<f64>)> {
+/// The effect's parameter vectors of the grid: every strength at `factor` × typical; each
+/// shape parameter the fits free at its minimum, its fit start, its middle and its maximum
+/// (all their combinations); each held one at its typical value and, one at a time with
+/// the others typical, at each of its `levels` (for `voltage_sag`'s knee: `knee_levels`):
+/// (factor, values, whether a held shape is off its typical value).
+fn grid(e: Effect, knee_levels: &[f64]) -> Vec<(f64, Vec<f64>, bool)> {
     let info = e.info();
-    let shapes: Vec<usize> = info.params.iter().enumerate().filter(|(_, p)| p.shape).map(|(i, _)| i).collect();
+    let shapes: Vec<usize> =
+        info.params.iter().enumerate().filter(|(_, p)| p.shape && !p.held).map(|(i, _)| i).collect();
     let mut shape_sets: Vec<Vec<f64>> = vec![info.params.iter().map(|p| p.start()).collect()];
     for &i in &shapes {
         let p = &info.params[i];
@@ -82,12 +93,28 @@ fn grid(e: Effect) -> Vec<(f64, Vec<f64>)> {
             })
             .collect();
     }
+    // the held shape parameters, one at a time, on every set of the free ones
+    let held_sets: Vec<Vec<f64>> = shape_sets
+        .iter()
+        .flat_map(|set| {
+            info.params.iter().enumerate().filter(|(_, p)| p.held).flat_map(move |(i, p)| {
+                let levels: &[f64] = if e == Effect::VoltageSag && i == 1 { knee_levels } else { p.levels };
+                levels.iter().filter(move |&&x| x != p.typical && (p.min..=p.max).contains(&x)).map(move |&x| {
+                    let mut w = set.clone();
+                    w[i] = x;
+                    w
+                })
+            })
+        })
+        .collect();
+    let n_plain = shape_sets.len();
+    shape_sets.extend(held_sets);
     let mut out = Vec::new();
     for f in factors(e) {
-        for set in &shape_sets {
+        for (k, set) in shape_sets.iter().enumerate() {
             let v: Vec<f64> =
                 info.params.iter().zip(set).map(|(p, &s)| if p.shape { s } else { f * p.typical }).collect();
-            out.push((f, v));
+            out.push((f, v, k >= n_plain));
         }
     }
     out
@@ -106,20 +133,51 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
     let sub: Vec<ObservedRow> = rows.iter().step_by(step).cloned().collect();
     let chi2 = |m: &Motor| residuals(m, &sub).iter().map(|z| z * z).sum::<f64>();
     let fit_chi2 = chi2(fitted);
-    let points = grid(e);
-    let scored: Vec<Scored> = bases
-        .iter()
-        .enumerate()
-        .flat_map(|(b, base)| points.iter().map(move |(f, v)| (b, base, *f, v.clone())))
-        .collect::<Vec<_>>()
-        .into_par_iter()
-        .map(|(b, base, f, v)| {
-            let mut m = (*base).clone();
-            m.effects.set(e, &v);
-            let c = chi2(&m);
-            (b, f, v, if c.is_finite() { c } else { f64::INFINITY })
+    let knee = if e == Effect::VoltageSag {
+        bases.first().map(|b| knee_levels(b, &sub)).unwrap_or_default()
+    } else {
+        Vec::new()
+    };
+    let points = grid(e, &knee);
+    let score = |pts: Vec<(usize, &&Motor, f64, Vec<f64>)>| -> Vec<Scored> {
+        pts.into_par_iter()
+            .map(|(b, base, f, v)| {
+                let mut m = (*base).clone();
+                m.effects.set(e, &v);
+                let c = chi2(&m);
+                (b, f, v, if c.is_finite() { c } else { f64::INFINITY })
+            })
+            .collect()
+    };
+    // first the plain forms (held shapes typical) at every strength
+    let mut scored: Vec<Scored> = score(
+        bases
+            .iter()
+            .enumerate()
+            .flat_map(|(b, base)| points.iter().filter(|p| !p.2).map(move |(f, v, _)| (b, base, *f, v.clone())))
+            .collect(),
+    );
+    // then each held shape's levels at the strengths within one grid step of the plain
+    // forms' best from that base (a form changes how strong the effect must be by about
+    // a step; the whole grid for every level cost a null diagnosis a quarter more time)
+    let grid_factors = factors(e);
+    let near: Vec<Vec<f64>> = (0..bases.len())
+        .map(|b| {
+            let best = scored.iter().filter(|p| p.0 == b).min_by(|x, y| x.3.total_cmp(&y.3)).map(|p| p.1);
+            let k = best.and_then(|f| grid_factors.iter().position(|&g| g == f)).unwrap_or(0);
+            grid_factors[k.saturating_sub(1)..(k + 2).min(grid_factors.len())].to_vec()
         })
         .collect();
+    scored.extend(score(
+        bases
+            .iter()
+            .enumerate()
+            .flat_map(|(b, base)| {
+                let near = &near[b];
+                points.iter().filter(move |p| p.2 && near.contains(&p.0)).map(move |(f, v, _)| (b, base, *f, v.clone()))
+            })
+            .collect(),
+    ));
     let mut found: Vec<Valley> = Vec::new();
     for (b, base) in bases.iter().enumerate() {
         // one series per shape set: the values with the same shape parameters
@@ -133,8 +191,10 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
                 None => series.push(vec![p]),
             }
         }
+        // (within the fit's bounds: every form scanned from this base, as a held shape's
+        // short series may have no strength of its own there)
+        let inside = scored.iter().filter(|p| p.0 == b && p.1 <= 8.0).map(|p| p.3).fold(f64::INFINITY, f64::min);
         for s in &series {
-            let inside = s.iter().filter(|p| p.1 <= 8.0).map(|p| p.3).fold(f64::INFINITY, f64::min);
             for (i, p) in s.iter().enumerate() {
                 let left = i == 0 || s[i - 1].3 > p.3;
                 let right = i + 1 == s.len() || s[i + 1].3 >= p.3;
@@ -161,6 +221,25 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
         }
     }
     out
+}
+
+/// Where the scan places `voltage_sag`'s knee: at the quartiles of the phase current
+/// amplitude `base` draws at the scan's rows, the only scale a current limit has. (A knee
+/// above every current is the baseline; one below every current sags like the resistive
+/// source with a smaller set voltage.)
+fn knee_levels(base: &Motor, rows: &[ObservedRow]) -> Vec<f64> {
+    let p = crate::solve::Prepared::new(base).without_stall_torque();
+    let inst = base.effects.instrument();
+    let mut amps: Vec<f64> = rows
+        .iter()
+        .map(|r| crate::solve::solve_prepared(&p, base, &inst.operating_point(&r.op), None).current_a)
+        .filter(|a| a.is_finite() && *a > 0.0)
+        .collect();
+    if amps.is_empty() {
+        return Vec::new();
+    }
+    amps.sort_by(f64::total_cmp);
+    [0.25, 0.5, 0.75].iter().map(|q| amps[((amps.len() - 1) as f64 * q).round() as usize]).collect()
 }
 
 /// Widens the bounds of `e`'s strength parameters in `params` to hold `values` with room
@@ -192,18 +271,46 @@ mod tests {
             let f = factors(e);
             assert!(!f.is_empty(), "{e}");
             assert!((f[0] - 0.1).abs() < 1e-12);
+            let mut reach = f64::INFINITY;
             for p in e.info().params.iter().filter(|p| !p.shape && p.typical != 0.0) {
                 let top = f.last().copied().unwrap_or(0.0) * p.typical;
-                // within the range, and within one grid step of its end (or the grid's cap)
+                // within the range
                 assert!(top.abs() <= p.max.abs().max(p.min.abs()) * (1.0 + 1e-9), "{e}: {top}");
+                reach = reach.min(if p.typical > 0.0 { p.max / p.typical } else { p.min / p.typical });
             }
+            // and at its end (or the grid's cap): the whole documented range
+            let last = f.last().copied().unwrap_or(0.0);
+            assert!((last - reach.min(MAX_FACTOR)).abs() <= 1e-9 * last, "{e}: {last} vs {reach}");
         }
         // preload_stiffening reaches its documented scale of 5 (100 × typical), beyond the
         // local fit's eight
         let ps = factors(Effect::PreloadStiffening);
         assert!(ps.last().copied().unwrap_or(0.0) * 0.05 > 3.0, "{ps:?}");
         // a shape parameter at its ends and middle
-        assert_eq!(grid(Effect::PreloadStiffening).len(), 3 * ps.len());
+        assert_eq!(grid(Effect::PreloadStiffening, &[]).len(), 3 * ps.len());
+        assert!(grid(Effect::PreloadStiffening, &[]).iter().all(|p| !p.2));
+    }
+
+    /// Each held shape parameter is scanned at its levels, one at a time with the others at
+    /// their typical values, on every strength of the grid; `voltage_sag`'s knee at the
+    /// levels the data give.
+    #[test]
+    fn the_grid_tries_each_held_shape_at_its_levels() {
+        let count = |e: Effect, knee: &[f64]| grid(e, knee).len() / factors(e).len();
+        assert_eq!(count(Effect::RadialFriction, &[]), 3);
+        assert_eq!(count(Effect::HertzSoftening, &[]), 4);
+        assert_eq!(count(Effect::ThermalDrift, &[]), 3);
+        assert_eq!(count(Effect::Eccentricity, &[]), 5);
+        assert_eq!(count(Effect::TangentialCompliance, &[]), 3);
+        assert_eq!(count(Effect::VoltageSag, &[]), 1);
+        assert_eq!(count(Effect::VoltageSag, &[0.1, 0.2, 0.3]), 4);
+        // one shape moved at a time: never two held shapes off their typical values
+        for (_, v, held) in grid(Effect::Eccentricity, &[]) {
+            assert!(v[1] == 0.0 || v[2] == 0.0, "{v:?}");
+            assert_eq!(held, v[1] != 0.0 || v[2] != 0.0, "{v:?}");
+        }
+        let knees: Vec<f64> = grid(Effect::VoltageSag, &[0.1, 0.2, 0.3]).iter().map(|(_, v, _)| v[1]).collect();
+        assert!(knees.contains(&0.0) && knees.contains(&0.2));
     }
 
     #[test]

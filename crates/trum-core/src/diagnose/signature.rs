@@ -60,7 +60,8 @@ pub(crate) fn signature(cal: &Calibration, rows: &[ObservedRow], e: Effect) -> O
     probe.effects.set(e, &typical);
     let on = weighted(cal, &probe, rows);
     let mut cols = vec![&on - r];
-    for (i, &v) in typical.iter().enumerate().skip(1) {
+    // (a column for each parameter the fits free; a held shape parameter is not fitted)
+    for (i, &v) in typical.iter().enumerate().skip(1).filter(|(i, _)| !info.params[*i].held) {
         let mut m = probe.clone();
         *m.effects.value_mut(e, i) = 2.0 * v;
         cols.push(weighted(cal, &m, rows) - &on);
@@ -71,7 +72,7 @@ pub(crate) fn signature(cal: &Calibration, rows: &[ObservedRow], e: Effect) -> O
     }
     let j = &cal.lin.jacobian;
     let st = &s - j * (pseudo_inverse(&(j.transpose() * j)) * (j.transpose() * &s));
-    let shape: Vec<bool> = info.params.iter().map(|p| p.shape).collect();
+    let shape: Vec<bool> = info.params.iter().filter(|p| !p.held).map(|p| p.shape).collect();
     let (linear_chi2_drop, linear_change) = one_sided_drop(&st, r, info.params[0].min >= 0.0, &shape);
     let s0 = st.column(0);
     let denom = s0.norm() * r.norm();

@@ -244,7 +244,9 @@ fn an_effect_the_data_cannot_see_is_not_fitted() {
     let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
     let entry = |name: &str| d.ranking.iter().find(|r| r.effect == name).expect("ranked");
     let thermal = entry("thermal_drift");
-    let penalty = 0.5 * Effect::ThermalDrift.info().params.len() as f64 * (d.n_readings as f64).ln();
+    // (the fitted parameters: a held shape parameter is not one)
+    let fitted = Effect::ThermalDrift.info().params.iter().filter(|p| !p.held).count();
+    let penalty = 0.5 * fitted as f64 * (d.n_readings as f64).ln();
     assert!(thermal.params.is_empty() && thermal.shrink == 0.0, "{thermal:?}");
     assert!((thermal.evidence + penalty).abs() < 1e-9 * penalty, "{} vs −{penalty}", thermal.evidence);
     assert!(thermal.signature_match.is_none());
@@ -578,4 +580,34 @@ fn an_effect_fitted_to_next_to_zero_counts_as_collapsed() {
     let with =
         Calibration::builder(&start, &grid(&truth)).params(&params).options(&opts).adding(&[tc]).run().expect("fit");
     assert!(!with.abandoned && !added_near_zero(&params, &with.params, &[tc]), "{:?}", with.params);
+}
+
+/// A current-limited driver (a knee at the median phase current, a steep sag above it) is
+/// diagnosed as `voltage_sag` and the fit closes the held-out gap to near the noise. (On
+/// preload-torque data at one voltage the plain resistive source already does: the
+/// phase current is mostly capacitive, so the knee's drop, in phase with it, moves the
+/// electrode voltage much as a larger resistance does; the fit reaches the noise and the
+/// scan has nothing left to explain. A knee the scan moves is reported with the effect's
+/// parameters, within its range.)
+#[test]
+fn a_current_limited_driver_is_diagnosed_as_voltage_sag() {
+    let nominal = crate::calibrate::tests::reference_motor();
+    let (probe_rows, _) = data(&nominal, 1.0, 13);
+    let mut amps: Vec<f64> = probe_rows.iter().map(|r| crate::solve::solve(&nominal, &r.op).current_a).collect();
+    amps.sort_by(f64::total_cmp);
+    let knee = amps[amps.len() / 2];
+    let mut truth = nominal.clone();
+    truth.effects.set(Effect::VoltageSag, &[2000.0, knee]);
+    let (rows, groups) = data(&truth, 1.0, 13);
+    let opts = DiagnoseOptions { candidates: vec![Effect::VoltageSag, Effect::RadialFriction], ..quick(false) };
+    let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+    let sag = d.ranking.iter().find(|r| r.effect == "voltage_sag").expect("ranked");
+    assert_eq!(d.verdict, "voltage_sag");
+    assert!(sag.shrink > 0.8 && sag.heldout_chi2_after < 2.0, "{sag:?}");
+    let p = &Effect::VoltageSag.info().params[1];
+    for (name, v) in &sag.params {
+        if name.ends_with(p.name) {
+            assert!(*v > p.min && *v <= p.max, "{name} = {v}");
+        }
+    }
 }

@@ -46,6 +46,8 @@ pub(crate) fn eccentric_average_with(
             (phi.cos() + 0.4 * (3.0 * phi).cos()) / 1.4
         } else if p.truth {
             (phi.cos() + 0.3 * (2.0 * phi).cos()) / 1.3
+        } else if p.runout_harmonics != [0.0, 0.0] {
+            runout_shape(phi, p.runout_harmonics)
         } else {
             phi.cos()
         };
@@ -53,7 +55,11 @@ pub(crate) fn eccentric_average_with(
         let mut o = *op;
         o.preload_n = op.preload_n + ripple * shape;
         // at a quarter turn the candidate's ripple is zero: the nominal solve is that sample
-        let s = if !p.truth && 4 * j == SAMPLES { nominal.clone() } else { solve_at(&o, Some(&prev)) };
+        let s = if !p.truth && p.runout_harmonics[0] == 0.0 && 4 * j == SAMPLES {
+            nominal.clone()
+        } else {
+            solve_at(&o, Some(&prev))
+        };
         if s.status != Status::Ok || s.speed_rad_s <= 0.0 {
             // the rotor sticks in this sector: it stops there
             let mut st = s;
@@ -81,10 +87,51 @@ pub(crate) fn eccentric_average_with(
     out
 }
 
+/// `eccentricity`'s harmonic family: the ripple's shape at rotor angle `phi` [rad],
+/// (cos φ + h₂·cos 2φ + h₃·cos 3φ)/(1 + h₂ + h₃), its peak 1 at φ = 0 so that the runout
+/// stays the ripple's peak. An offset rotor gives the once-per-revolution term (Chen et
+/// al. 2020 §4.3); a rotor face tilted against the stator adds the twice-per-revolution
+/// term and a three-lobed rotor or a three-point mount the three-times one. Even in φ, as
+/// the sampling by halves assumes.
+pub(crate) fn runout_shape(phi: f64, [h2, h3]: [f64; 2]) -> f64 {
+    (phi.cos() + h2 * (2.0 * phi).cos() + h3 * (3.0 * phi).cos()) / (1.0 + h2 + h3)
+}
+
 fn scale_solution(a: &Solution, k: f64) -> Solution {
     map_solution(a, None, |x, _| x * k)
 }
 
 fn add_solution(a: &Solution, b: &Solution) -> Solution {
     map_solution(a, Some(b), |x, y| x + y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The harmonic ripple keeps the runout as its peak (at φ = 0), has a zero mean over a
+    /// revolution (the mean preload stays) and its harmonics in the given proportions
+    /// (Fourier coefficients by a 64-point rule, exact for these trigonometric polynomials).
+    #[test]
+    fn the_harmonic_ripple_peaks_at_the_runout_with_its_harmonics() {
+        let h = [0.3, 0.7];
+        assert!((runout_shape(0.0, h) - 1.0).abs() < 1e-15);
+        let n = 64;
+        let coef = |k: f64| {
+            (0..n).map(|j| 2.0 * PI * j as f64 / n as f64).map(|p| runout_shape(p, h) * (k * p).cos()).sum::<f64>()
+                * 2.0
+                / n as f64
+        };
+        let mean = (0..n).map(|j| runout_shape(2.0 * PI * j as f64 / n as f64, h)).sum::<f64>() / n as f64;
+        assert!(mean.abs() < 1e-15, "{mean}");
+        let norm = 1.0 + h[0] + h[1];
+        for (k, want) in [(1.0, 1.0 / norm), (2.0, h[0] / norm), (3.0, h[1] / norm), (4.0, 0.0)] {
+            assert!((coef(k) - want).abs() < 1e-14, "harmonic {k}: {} vs {want}", coef(k));
+        }
+        // sampling by halves: even in φ
+        for j in 1..8 {
+            let p = 2.0 * PI * j as f64 / 8.0;
+            assert!((runout_shape(p, h) - runout_shape(2.0 * PI - p, h)).abs() < 1e-14);
+        }
+    }
 }

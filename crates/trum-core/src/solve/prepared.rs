@@ -63,6 +63,18 @@ pub struct Prepared {
     pub(crate) sag_ohm: f64,
     /// `eccentricity`: axial runout δ of the rotor [m] (0: off).
     pub(crate) runout_m: f64,
+    /// `radial_friction`'s preload exponent q: ρ·(F_N/100 N)^q [-] (0: ρ as given).
+    pub(crate) radial_exponent: f64,
+    /// `hertz_softening`'s preload exponent n: β·(1 + g·F_N)^n [-] (1: linear growth).
+    pub(crate) beta_exponent: f64,
+    /// `thermal_drift`: share of the rise on a fast interface node [-] (0: one capacity).
+    pub(crate) thermal_interface: f64,
+    /// `voltage_sag`: current amplitude per phase the driver holds its voltage up to [A]
+    /// (0: a plain resistive source).
+    pub(crate) sag_knee_a: f64,
+    /// `eccentricity`: twice- and three-times-per-revolution ripple relative to the
+    /// once-per-revolution one [-].
+    pub(crate) runout_harmonics: [f64; 2],
     /// Effects in their truth forms (synthetic bench data) instead of the candidate forms.
     pub(crate) truth: bool,
     /// With `truth`: the second family of truth forms (docs/EFFECTS.md).
@@ -106,11 +118,21 @@ impl Prepared {
                 radial_ratio: fx.value(Effect::RadialFriction, 0),
                 slip_scale: 0.0,
                 truth: fx.truth_forms(),
+                sharpness: if fx.is_on(Effect::TangentialCompliance) {
+                    fx.value(Effect::TangentialCompliance, 1)
+                } else {
+                    1.0
+                },
             },
             compliance: fx.value(Effect::TangentialCompliance, 0),
             thermal: [0, 1, 2].map(|i| fx.value(Effect::ThermalDrift, i)),
             sag_ohm: fx.value(Effect::VoltageSag, 0),
             runout_m: fx.value(Effect::Eccentricity, 0),
+            radial_exponent: fx.value(Effect::RadialFriction, 1),
+            beta_exponent: if fx.is_on(Effect::HertzSoftening) { fx.value(Effect::HertzSoftening, 2) } else { 1.0 },
+            thermal_interface: fx.value(Effect::ThermalDrift, 3),
+            sag_knee_a: fx.value(Effect::VoltageSag, 1),
+            runout_harmonics: [fx.value(Effect::Eccentricity, 1), fx.value(Effect::Eccentricity, 2)],
             truth: fx.truth_forms(),
             truth_b: fx.truth_form_b(),
             stall_torque: true,

@@ -144,11 +144,36 @@ pub(super) fn sagged_voltage_at(p: &Prepared, op: &OperatingPoint, (yr, yi): (f6
         (p.sag_ohm * (0.4 + 4.5 * p.sag_ohm * yr.hypot(yi)), 0.0)
     } else if p.truth {
         (p.sag_ohm, 0.5 * p.sag_ohm)
+    } else if p.sag_knee_a > 0.0 {
+        return knee_sagged_voltage_v(op.voltage_v, p.sag_ohm, p.sag_knee_a, (yr, yi));
     } else {
         (p.sag_ohm, 0.0)
     };
     let (re, im) = (1.0 + zr * yr - zi * yi, zr * yi + zi * yr);
     op.voltage_v / re.hypot(im)
+}
+
+/// `voltage_sag`'s current-limited driver: it holds the set voltage `v_set` [V] while the
+/// phase current amplitude |I| = |Y|·V_e stays at or below the knee `knee_a` [A], and above
+/// it its output resistance `r_ohm` [Ω] drops the voltage by R·(|I| − I_k), in phase with the
+/// current: V_set = |V_e + R·(|Y|·V_e − I_k)·Y/|Y||. A driver whose output stage limits its
+/// current (Sun et al. 2021 §3.1 for the resistive drop; the knee is the limit), and with a
+/// large R a constant-current source above the knee. Continuous in the current: at
+/// |Y|·V_set = I_k both branches give V_set. The balance is a quadratic in V_e,
+/// (A² + B²)·V² − 2(A·C + B·D)·V + C² + D² − V_set² = 0 with A + iB = 1 + R·Y and
+/// C + iD = R·I_k·Y/|Y|; V_e is its larger root (the one that meets V_set at the knee).
+pub(crate) fn knee_sagged_voltage_v(v_set: f64, r_ohm: f64, knee_a: f64, (yr, yi): (f64, f64)) -> f64 {
+    let y = yr.hypot(yi);
+    if y * v_set <= knee_a || y == 0.0 {
+        return v_set;
+    }
+    let (a, b) = (1.0 + r_ohm * yr, r_ohm * yi);
+    let (c, d) = (r_ohm * knee_a * yr / y, r_ohm * knee_a * yi / y);
+    let qa = a * a + b * b;
+    let qb = a * c + b * d;
+    let qc = c * c + d * d - v_set * v_set;
+    let disc = (qb * qb - qa * qc).max(0.0);
+    (qb + disc.sqrt()) / qa
 }
 
 pub(super) fn trial(

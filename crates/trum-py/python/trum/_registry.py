@@ -17,9 +17,11 @@ class PresetInfo(NamedTuple):
 class EffectParam(NamedTuple):
     """One parameter of an effect (name carries its unit).
 
-    ``shape`` marks a shape parameter, not a strength (``preload_stiffening``'s
-    ``modal_fraction``): ``NAME=STRENGTH`` leaves it at ``typical``, and the diagnosis
-    fits it over ``[min, max]``.
+    ``shape`` marks a shape parameter, not a strength: ``NAME=STRENGTH`` leaves it at
+    ``typical`` (the effect's plainest form). The diagnosis fits ``preload_stiffening``'s
+    ``modal_fraction`` over ``[min, max]``; a ``held`` one (every other effect's family:
+    ``knee_current_a``, ``stick_sharpness``, the preload exponents, ...) it scans at a few
+    levels before its local fits, which keep it where the scan put it.
     """
 
     name: str
@@ -28,6 +30,7 @@ class EffectParam(NamedTuple):
     min: float
     max: float
     shape: bool = False
+    held: bool = False
 
 
 class EffectInfo(NamedTuple):
