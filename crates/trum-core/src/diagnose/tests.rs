@@ -253,13 +253,48 @@ fn an_effect_the_data_cannot_see_is_not_fitted() {
     let sag = entry("voltage_sag");
     assert!(!sag.params.is_empty() && sag.evidence > 5.0 && sag.signature_match.is_some(), "{sag:?}");
     assert!(d.notes.iter().any(|n| n.contains("thermal_drift cannot act")));
-    // the same when the nominal motor already carries it (no probe then: switched off)
+    // when the nominal motor already carries it, it is part of the baseline, not a candidate
     let mut carrying = nominal.clone();
     let typical: Vec<f64> = Effect::ThermalDrift.info().params.iter().map(|p| p.typical).collect();
     carrying.effects.set(Effect::ThermalDrift, &typical);
     let d = diagnose(&carrying, &rows, &groups, &opts).expect("diagnosis");
-    let thermal = d.ranking.iter().find(|r| r.effect == "thermal_drift").expect("ranked");
-    assert!(thermal.params.is_empty() && thermal.shrink == 0.0, "{thermal:?}");
+    assert!(d.ranking.iter().all(|r| r.effect != "thermal_drift"), "{:?}", d.ranking);
+    assert!(
+        d.notes.iter().any(|n| n.contains("own effects (thermal_drift) are part of the baseline")),
+        "{:?}",
+        d.notes
+    );
+}
+
+/// An effect the nominal motor carries (a preset's calibrated stiffening or sag) is part
+/// of the motor: the baseline refits its strength under a prior, so data whose only
+/// difference from the nominal is that strength (300 Ω where the file says 150 Ω) give
+/// `none`, with the fitted strength near the true one, and the effect is not a candidate.
+#[test]
+fn the_motors_own_effect_is_refitted_in_the_baseline_not_named() {
+    let mut nominal = crate::calibrate::tests::reference_motor();
+    nominal.effects.set_strength(Effect::VoltageSag, 150.0);
+    let mut truth = nominal.clone();
+    truth.effects.set_strength(Effect::VoltageSag, 300.0);
+    let cfg = SynthConfig {
+        campaign: Campaign::PreloadTorque,
+        noise: 1.0,
+        seed: 11,
+        truth_forms: false,
+        ..SynthConfig::default()
+    };
+    let synth = synthesize(&truth, &cfg).expect("synth");
+    let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
+    let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+    let d = diagnose(&nominal, &rows, &groups, &quick(false)).expect("diagnosis");
+    assert_eq!(d.verdict, "none", "{:?}", d.ranking);
+    assert!(d.ranking.iter().all(|r| r.effect != "voltage_sag"));
+    let (_, r) = d
+        .baseline_params
+        .iter()
+        .find(|(k, _)| k == "effects.voltage_sag.source_resistance_ohm")
+        .expect("the sag is a baseline parameter");
+    assert!((r / 300.0 - 1.0).abs() < 0.2, "fitted {r} Ω against 300 Ω");
 }
 
 /// One motor (`motor_seed` = `seed`) measured in a run of `campaign` at each drive
