@@ -14,7 +14,9 @@ fn point_json_matches_the_library() {
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
     let m = trum_core::presets::preset("trum60a").expect("preset");
-    let s = trum_core::solve(&m, &trum_core::OperatingPoint::new(300.0, 0.2, 200.0, 43e3));
+    // without --voltage-v and --frequency-hz the point runs at the preset's [drive]
+    let d = trum_core::presets::find("trum60a").expect("preset").drive().expect("a [drive] table");
+    let s = trum_core::solve(&m, &trum_core::OperatingPoint::new(300.0, 0.2, d.voltage_v, d.frequency_hz));
     assert_eq!(v["status"], s.status.as_str());
     for q in trum_core::quantities::QUANTITIES {
         // serde_json's default float parser may be one ulp off, so allow a few ulps

@@ -1056,6 +1056,26 @@ mod tests {
     use super::*;
     use crate::contact::{chi, contact_from_ratio, e_int};
 
+    /// Break points of a reference quadrature over [0, φ0] of an interface integrand: the
+    /// ends, the stick point θs, and about each singularity (re, im) of the slip law the
+    /// real part and points at powers of ten of its distance from both it and θs (a band
+    /// narrower than the first Kronrod nodes' spacing is invisible to the adaptive rule's
+    /// error estimate).
+    fn quadrature_cuts(ts: f64, phi0: f64, singularities: impl IntoIterator<Item = (f64, f64)>) -> Vec<f64> {
+        let mut cuts = vec![0.0, phi0, ts];
+        for (re, im) in singularities {
+            let mut d = im.max(1e-9);
+            while d < phi0 {
+                cuts.extend([ts - d, ts + d, re - d, re + d]);
+                d *= 10.0;
+            }
+            cuts.push(re);
+        }
+        cuts.retain(|&x| (0.0..=phi0).contains(&x));
+        cuts.sort_by(f64::total_cmp);
+        cuts
+    }
+
     #[test]
     fn gauss_legendre_integrates_polynomials_exactly() {
         let s: f64 = gauss_legendre().iter().map(|(x, w)| w * x.powi(22)).sum();
@@ -1278,17 +1298,7 @@ mod tests {
                     // distance about both: a band narrower than its first Kronrod nodes'
                     // spacing is invisible to the adaptive rule's error estimate, and at
                     // ρ = 1e-7 it missed 1.8e-7)
-                    let mut cuts = vec![0.0, phi0, ts];
-                    if let Some((re, im)) = nearest_singularity(&law, u, phi0) {
-                        let mut d = im.max(1e-9);
-                        while d < phi0 {
-                            cuts.extend([ts - d, ts + d, re - d, re + d]);
-                            d *= 10.0;
-                        }
-                        cuts.push(re);
-                    }
-                    cuts.retain(|&x| (0.0..=phi0).contains(&x));
-                    cuts.sort_by(f64::total_cmp);
+                    let cuts = quadrature_cuts(ts, phi0, nearest_singularity(&law, u, phi0));
                     // one component of the integrand at θ, summed over the law's radii
                     let part = |pick: fn(&Factors) -> f64, th: f64| {
                         let mut f = Factors::default();
@@ -1458,17 +1468,7 @@ mod tests {
                 for &u in &[0.0, 0.3, 0.8, 0.95, 0.99, 0.999, 1.0] {
                     let rule = factors(&ct, u, &l);
                     let (ts, phi0) = (u.acos(), ct.half_angle_rad);
-                    let mut cuts = vec![0.0, phi0, ts];
-                    for (re, im) in stick_slip_singularities(&l, u, phi0).into_iter().flatten() {
-                        let mut d = im.max(1e-9);
-                        while d < phi0 {
-                            cuts.extend([ts - d, ts + d, re - d, re + d]);
-                            d *= 10.0;
-                        }
-                        cuts.push(re);
-                    }
-                    cuts.retain(|&x| (0.0..=phi0).contains(&x));
-                    cuts.sort_by(f64::total_cmp);
+                    let cuts = quadrature_cuts(ts, phi0, stick_slip_singularities(&l, u, phi0).into_iter().flatten());
                     let part = |pick: fn(&Factors) -> f64, th: f64| {
                         let mut f = Factors::default();
                         for (rho, w) in radii(&l) {
