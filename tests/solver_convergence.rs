@@ -248,6 +248,14 @@ fn stress(n: usize, seed: u64, sag: bool, thermal: bool) -> std::collections::BT
         }
         if !consistent {
             *counts.entry("inconsistent".to_string()).or_insert(0) += 1;
+            let v_set = (s.electrode_voltage_v + z * s.current_in_phase_a).hypot(z * s.current_quadrature_a);
+            eprintln!(
+                "inconsistent: {name} scaled, {op:?}, {:?}, sag {z} ohm: set voltage {v_set} V, rise {} K at elapsed of {} K steady\n{}",
+                s.status,
+                s.temperature_rise_at_elapsed_k,
+                s.temperature_rise_k,
+                m.to_toml()
+            );
         }
         if s.status == Status::NoConvergence && !(sag || thermal) {
             eprintln!("no_convergence: {name} scaled, {op:?}\n{}", m.to_toml());

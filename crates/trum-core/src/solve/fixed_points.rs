@@ -50,6 +50,7 @@ fn solve_effects_with(
         return drive(&Drive::at(p, op), guess, None);
     }
     let direct_warm = |d: &Drive, _: f64, g: Option<&Solution>, top: Option<WarmTop>| drive(d, g, top);
+    let direct_cold = |d: &Drive, _: f64, g: Option<&Solution>, _: Option<WarmTop>| drive(d, g, None);
     let (mut s, mut rise, mut settled) = settle_with(p, op, guess, (thermal, sag), 0.0, &direct_warm);
     if branches && sag && !thermal && !settled {
         if let Some(stalled) = settle_lower_branch(p, op, &s, 0.0).or_else(|| settle_on_amplitude(p, op, 0.0)) {
@@ -84,8 +85,11 @@ fn solve_effects_with(
         let nested = |lower: bool| {
             let inner_settled = std::cell::Cell::new(true);
             let unsettled = std::cell::Cell::new(0);
+            // (cold descents: warm-started, a nested settle under strong drift and sag can
+            // end 1.2e-9 off its own set voltage, beyond the 1e-9 a fixed point keeps;
+            // tests/solver_convergence.rs `stress_self_consistent_effects`)
             let inner = |_: &Drive, r: f64, g: Option<&Solution>| {
-                let (mut s, _, mut ok) = settle_with(p, op, g, (false, true), r, &direct_warm);
+                let (mut s, _, mut ok) = settle_with(p, op, g, (false, true), r, &direct_cold);
                 if lower && !ok {
                     if let Some(l) = settle_lower_branch(p, op, &s, r).or_else(|| settle_on_amplitude(p, op, r)) {
                         (s, ok) = (l, true);
