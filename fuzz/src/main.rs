@@ -393,7 +393,7 @@ impl Case {
                 Some("param") if w.len() > 2 => c.params.push((w[1].to_string(), f(2))),
                 Some("effect") if w.len() > 1 => {
                     if let Ok(e) = Effect::from_name(w[1]) {
-                        c.effects.push((e, [2, 3, 4].map(f)));
+                        c.effects.push((e, std::array::from_fn(|i| f(i + 2))));
                     }
                 }
                 Some("truth") => c.truth = true,
