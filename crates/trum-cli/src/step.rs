@@ -14,6 +14,9 @@ use anyhow::{anyhow, bail, Result};
 use clap::Args;
 use plotters::style::RGBColor;
 use rayon::prelude::*;
+
+/// Time steps per drive period when `--steps-per-period` is not given.
+const DEFAULT_STEPS_PER_PERIOD: usize = 64;
 use std::io::Write;
 use std::path::PathBuf;
 use trum_core::dynamics::bar_type::{bar_step_response, BarMotor, BarStepConfig};
@@ -48,9 +51,10 @@ pub struct StepArgs {
     /// Simulated time [s] (ring default 0.01, bar-type 0.015).
     #[arg(long)]
     duration_s: Option<f64>,
-    /// Time steps per drive period.
-    #[arg(long, default_value_t = 64)]
-    steps_per_period: usize,
+    /// Time steps per drive period (default 64 on a ring motor, raised in steps of 16 where
+    /// the explicit scheme would be unstable; given, it is used as is).
+    #[arg(long)]
+    steps_per_period: Option<usize>,
     /// Contact nodes per wavelength (256 in [BarTransient]; on a bar-type motor, nodes on the contact circle).
     #[arg(long, default_value_t = 256)]
     nodes_per_wavelength: usize,
@@ -253,7 +257,7 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
     let config = |v: f64, f: f64, p: f64| match &motor {
         StepMotor::Ring(_) => Settings::Ring(TransientConfig {
             duration_s: duration,
-            steps_per_period: a.steps_per_period,
+            steps_per_period: a.steps_per_period.unwrap_or(DEFAULT_STEPS_PER_PERIOD),
             nodes_per_wavelength: a.nodes_per_wavelength,
             phase_difference_rad: p.to_radians(),
             load_torque_nm: a.torque_nm,
@@ -269,7 +273,7 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
         }),
         StepMotor::Bar(_) => Settings::Bar(BarStepConfig {
             duration_s: duration,
-            steps_per_period: a.steps_per_period,
+            steps_per_period: a.steps_per_period.unwrap_or(DEFAULT_STEPS_PER_PERIOD),
             nodes: a.nodes_per_wavelength,
             phase_difference_rad: p.to_radians(),
             load_torque_nm: a.torque_nm,
@@ -292,7 +296,14 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
         .par_iter()
         .map(|&(v, f, p)| {
             let (result, steady) = match (&motor, config(v, f, p)) {
-                (StepMotor::Ring(m), Settings::Ring(c)) => (step_response(m, &c), Some(steady_comparison(m, &c))),
+                (StepMotor::Ring(m), Settings::Ring(c)) => {
+                    let r = if a.steps_per_period.is_some() {
+                        step_response(m, &c)
+                    } else {
+                        trum_core::dynamics::transient::step_response_stable(m, &c).map(|(r, _)| r)
+                    };
+                    (r, Some(steady_comparison(m, &c)))
+                }
                 (StepMotor::Bar(m), Settings::Bar(c)) => (bar_step_response(m, &c), None),
                 _ => unreachable!("the settings follow the motor"),
             };
@@ -446,7 +457,8 @@ fn print_single(r: &Run, motor: &StepMotor, a: &StepArgs, shown: &Shown, out: &m
         "model    {} s, {} steps ({} per period), {contact}",
         fmt_sig(shown.duration_s, 6),
         resp.steps,
-        a.steps_per_period,
+        // (the steps the run used: a default is raised where it would be unstable)
+        (1.0 / (r.frequency_hz * resp.time_step_s)).round(),
     )?;
     match &r.steady {
         Some(st) => writeln!(out, "status   {} (steady solver: {})", status(&r.result), st.status)?,

@@ -252,7 +252,7 @@ fn argument(name: &str) -> &str {
 /// at the same point), `snapshots` (per-node arrays and states), `time_step_s`, `steps`.
 #[pyfunction]
 #[pyo3(signature = (motor, voltage_v, frequency_hz, phase_difference_deg, preload_n, torque_nm, duration_s,
-    steps_per_period, nodes_per_wavelength, tangential_stiffness_ratio, record_every, snapshot_at_s))]
+    steps_per_period, nodes_per_wavelength, tangential_stiffness_ratio, record_every, snapshot_at_s, auto_steps = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn step<'py>(
     py: Python<'py>,
@@ -268,6 +268,7 @@ pub fn step<'py>(
     tangential_stiffness_ratio: f64,
     record_every: usize,
     snapshot_at_s: Vec<f64>,
+    auto_steps: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &motor.get().inner;
     if !m.effects.is_none() {
@@ -290,7 +291,15 @@ pub fn step<'py>(
         tangential_stiffness_ratio,
         ..TransientConfig::default()
     };
-    let (r, steady) = detached(py, || (step_response(m, &cfg), steady_comparison(m, &cfg)))?;
+    // (`auto_steps`: the caller left the step to the tool, which refines an unstable one)
+    let run = || {
+        if auto_steps {
+            trum_core::dynamics::transient::step_response_stable(m, &cfg).map(|(r, _)| r)
+        } else {
+            step_response(m, &cfg)
+        }
+    };
+    let (r, steady) = detached(py, || (run(), steady_comparison(m, &cfg)))?;
     let r = r.map_err(|e| transient_err(py, e, phase_difference_deg))?;
     response_dict(py, r, Some(steady), m.friction_layer.friction_coefficient)
 }

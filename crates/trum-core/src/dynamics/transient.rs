@@ -362,6 +362,32 @@ pub fn step_response(motor: &Motor, cfg: &TransientConfig) -> Result<StepRespons
     Ok(response(sim::run(&plant)?, &plant))
 }
 
+/// [`step_response`] at `cfg.steps_per_period`, or, where the explicit scheme would be
+/// unstable there ([`TransientError::StepTooLarge`]), at the smallest multiple of 16 steps
+/// per period that brings the stiffest mode's ω_max·h to 95 % of its limit (h is the period
+/// over the steps, so ω_max·h falls as 1/steps), up to [`MAX_STEP_REFINEMENT`] times the
+/// given steps; beyond that the refusal stands, since the run would cost that many times
+/// more. For front-ends whose user left the time step to the tool: a stiffer contact
+/// layer needs a finer step, and the default 64 steps must not turn into an error.
+/// Returns the response and the steps per period used.
+pub fn step_response_stable(motor: &Motor, cfg: &TransientConfig) -> Result<(StepResponse, usize), TransientError> {
+    match step_response(motor, cfg) {
+        Err(TransientError::StepTooLarge { omega_h, limit, what }) if omega_h.is_finite() => {
+            let need = (cfg.steps_per_period as f64 * omega_h / (0.95 * limit) / 16.0).ceil() * 16.0;
+            if need > (MAX_STEP_REFINEMENT * cfg.steps_per_period) as f64 {
+                return Err(TransientError::StepTooLarge { omega_h, limit, what });
+            }
+            let steps = (need as usize).max(cfg.steps_per_period + 16);
+            let raised = TransientConfig { steps_per_period: steps, ..cfg.clone() };
+            step_response(motor, &raised).map(|r| (r, steps))
+        }
+        r => r.map(|r| (r, cfg.steps_per_period)),
+    }
+}
+
+/// How many times the given steps per period [`step_response_stable`] may take.
+pub const MAX_STEP_REFINEMENT: usize = 4;
+
 /// Fraction of the stator surface's peak tangential speed below which a settled rotor
 /// counts as at rest (`not_moving`): a standing wave leaves the rotor at rounding-error
 /// speeds, a travelling wave drives it at a sizeable fraction of the surface speed.

@@ -116,6 +116,7 @@ def step(
     tangential_stiffness_ratio: float,
     record_every: int,
     snapshot_at_s: Sequence[float],
+    auto_steps: bool = False,
 ) -> Dict[str, Any]: ...
 def bar_step(
     spec: str,

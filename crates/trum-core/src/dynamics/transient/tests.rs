@@ -177,6 +177,20 @@ fn invalid_configurations_are_errors_not_panics() {
     }
     let stiff = TransientConfig { tangential_stiffness_ratio: 1e5, ..TransientConfig::default() };
     assert!(matches!(step_response(&m, &stiff), Err(TransientError::StepTooLarge { .. })));
+    // (a stiffness that would need more than MAX_STEP_REFINEMENT times the steps is refused)
+    assert!(matches!(step_response_stable(&m, &stiff), Err(TransientError::StepTooLarge { .. })));
+    // left to the tool, the step is refined until the scheme is stable: the run then
+    // equals an explicit run at the steps it chose, which the coarser step refused
+    let stiffer = TransientConfig { tangential_stiffness_ratio: 1e3, ..TransientConfig::default() };
+    assert!(matches!(step_response(&m, &stiffer), Err(TransientError::StepTooLarge { .. })));
+    let short = TransientConfig { duration_s: 2e-4, ..stiffer.clone() };
+    let (auto, steps) = step_response_stable(&m, &short).expect("a stable step");
+    assert!(steps > short.steps_per_period && steps % 16 == 0, "{steps}");
+    let explicit = step_response(&m, &TransientConfig { steps_per_period: steps, ..short.clone() }).expect("explicit");
+    assert_eq!(auto.series.speed_rpm, explicit.series.speed_rpm);
+    let (_, same) =
+        step_response_stable(&m, &TransientConfig { duration_s: 2e-4, ..TransientConfig::default() }).expect("run");
+    assert_eq!(same, 64);
     let long = TransientConfig { duration_s: 1e4, ..TransientConfig::default() };
     assert!(matches!(step_response(&m, &long), Err(TransientError::TooManySteps { .. })));
     let mut bad_motor = m.clone();
