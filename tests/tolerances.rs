@@ -1,7 +1,7 @@
 //! The `[tolerances]` table of a motor file: the baseline calibration's priors
 //! (docs/MOTOR_FILE.md, docs/DIAGNOSIS.md).
 
-use trum_core::params::tolerances_from_toml_str;
+use trum_core::params::{tolerances_from_pairs, tolerances_from_toml_str};
 use trum_core::Motor;
 
 const MOTOR: &str = include_str!("data/motors/ring60.toml");
@@ -29,6 +29,9 @@ fn a_tolerance_on_a_parameter_that_is_not_fitted_or_negative_is_an_error_naming_
     let unknown = format!("{MOTOR}\n[tolerances]\n\"rotor.mass_kg\" = 0.1\n");
     let e = tolerances_from_toml_str(&unknown, "m.toml").expect_err("rotor mass is not calibrated").to_string();
     assert!(e.contains("m.toml") && e.contains("tolerances.rotor.mass_kg") && e.contains("valid keys"), "{e}");
+    // the line of a quoted dotted key (the form docs/MOTOR_FILE.md shows)
+    let line = MOTOR.lines().count() + 3;
+    assert!(e.starts_with(&format!("m.toml: line {line}, key ")), "{e}");
     let negative = format!("{MOTOR}\n[tolerances]\n\"geometry.mean_radius_m\" = -0.1\n");
     let e = tolerances_from_toml_str(&negative, "m.toml").expect_err("negative").to_string();
     assert!(e.contains("tolerances.geometry.mean_radius_m") && e.contains(">= 0"), "{e}");
@@ -81,4 +84,16 @@ fn the_torque_offset_width_comes_from_the_table_and_zero_removes_it() {
     let held = tolerances_from_toml_str(&format!("{MOTOR}\n[tolerances]\n\"bench.torque_offset_nm\" = 0\n"), "m.toml")
         .expect("valid key");
     assert!(offset(&held).is_none());
+}
+
+#[test]
+fn pairs_are_checked_as_the_tables_entries_are() {
+    let ok = [("geometry.mean_radius_m".to_string(), 0.01), ("bench.speed_std_floor_rpm".to_string(), 0.0)];
+    let t = tolerances_from_pairs(&ok, "tolerances").expect("valid pairs");
+    assert_eq!(t.get("geometry.mean_radius_m"), Some(&0.01));
+    assert_eq!(t.get("bench.speed_std_floor_rpm"), Some(&0.0));
+    let e = tolerances_from_pairs(&[("rotor.mass_kg".into(), 0.1)], "tolerances").expect_err("unknown").to_string();
+    assert!(e.starts_with("tolerances, key 'tolerances.rotor.mass_kg'") && e.contains("valid keys"), "{e}");
+    let e = tolerances_from_pairs(&[("geometry.mean_radius_m".into(), f64::NAN)], "t").expect_err("nan").to_string();
+    assert!(e.contains(">= 0"), "{e}");
 }

@@ -301,11 +301,6 @@ pub fn tolerances_from_toml_str(
     })?;
     let mut out = std::collections::BTreeMap::new();
     let Some(table) = file.tolerances else { return Ok(out) };
-    let valid: Vec<String> = crate::tolerances::TOLERANCES
-        .iter()
-        .map(|t| t.key.to_string())
-        .chain(["bench.speed_std_floor_rpm", "bench.torque_offset_nm"].map(String::from))
-        .collect();
     let mut flat: Vec<(String, &toml::Value)> = Vec::new();
     for (k, v) in &table {
         match v {
@@ -322,18 +317,58 @@ pub fn tolerances_from_toml_str(
             key: format!("tolerances.{key}"),
             reason,
         };
-        if !valid.contains(&key) {
-            return Err(err(format!("not a calibrated parameter; valid keys are: {}", valid.join(", "))));
-        }
         let x = match v {
             toml::Value::Integer(i) => *i as f64,
             toml::Value::Float(x) => *x,
+            _ if !tolerance_keys().contains(&key) => return Err(err(check_tolerance(&key, 0.0).unwrap_err())),
             _ => return Err(err("expected a number (relative standard deviation, 0 or inf)".into())),
         };
-        if x.is_nan() || x < 0.0 {
-            return Err(err(format!("{x} must be >= 0 (or inf)")));
-        }
+        check_tolerance(&key, x).map_err(err)?;
         out.insert(key, x);
+    }
+    Ok(out)
+}
+
+/// The keys a `[tolerances]` table accepts: the parameters calibration fits
+/// ([`crate::tolerances::TOLERANCES`]) by dotted motor key, then the bench's
+/// `bench.speed_std_floor_rpm` and `bench.torque_offset_nm`.
+pub fn tolerance_keys() -> Vec<String> {
+    crate::tolerances::TOLERANCES
+        .iter()
+        .map(|t| t.key.to_string())
+        .chain(["bench.speed_std_floor_rpm", "bench.torque_offset_nm"].map(String::from))
+        .collect()
+}
+
+/// Whether `x` may be the tolerance of `key` (see [`tolerances_from_toml_str`]): a valid key
+/// and a value ≥ 0 (or inf). The error is the reason, listing the valid keys for an unknown one.
+fn check_tolerance(key: &str, x: f64) -> Result<(), String> {
+    let valid = tolerance_keys();
+    if !valid.iter().any(|k| k == key) {
+        return Err(format!("not a calibrated parameter; valid keys are: {}", valid.join(", ")));
+    }
+    if x.is_nan() || x < 0.0 {
+        return Err(format!("{x} must be >= 0 (or inf)"));
+    }
+    Ok(())
+}
+
+/// Tolerances given as (key, value) pairs, such as a Python mapping, checked as the
+/// `[tolerances]` table's entries are ([`tolerances_from_toml_str`]); an error names
+/// `source_name` and the key. A later pair of the same key wins.
+pub fn tolerances_from_pairs(
+    pairs: &[(String, f64)],
+    source_name: &str,
+) -> Result<std::collections::BTreeMap<String, f64>, ParamError> {
+    let mut out = std::collections::BTreeMap::new();
+    for (key, x) in pairs {
+        check_tolerance(key, *x).map_err(|reason| ParamError {
+            source_name: source_name.into(),
+            line: None,
+            key: format!("tolerances.{key}"),
+            reason,
+        })?;
+        out.insert(key.clone(), *x);
     }
     Ok(out)
 }

@@ -43,7 +43,8 @@ pub(crate) fn line_of_key(text: &str, section: &str, key: &str) -> Option<usize>
             }
             continue;
         }
-        let lhs = line.split('=').next().unwrap_or("").trim();
+        // a quoted key (`"geometry.mean_radius_m" = ...`) names the same dotted path
+        let lhs = line.split('=').next().unwrap_or("").trim().trim_matches(|c| c == '"' || c == '\'');
         let full = if current.is_empty() { lhs.to_string() } else { format!("{current}.{lhs}") };
         let want = if section.is_empty() { key.to_string() } else { format!("{section}.{key}") };
         if full == want || (current.is_empty() && lhs == want) {

@@ -16,10 +16,12 @@ use trum_core::measurements::{parse_measurements_with, PlausibleRanges};
 /// `trum.InputError` naming the file, line and column; data that cannot support a
 /// held-out test raise `trum.InputError` too. `plausible` replaces columns' plausible
 /// ranges (`COLUMN=LOW:HIGH` or `COLUMN=any`, as the CLI's `--plausible`), after the
-/// `[plausible]` table of `plausible_toml` (a TOML file's text and name). The work runs
-/// with the GIL released.
+/// `[plausible]` table of `plausible_toml` (a TOML file's text and name). The priors of
+/// the calibration are the `[tolerances]` table of `tolerances_toml` (text, name), then the
+/// `(key, value)` pairs of `tolerances` ([`tolerances_in_force`]). The work runs with the
+/// GIL released.
 #[pyfunction]
-#[pyo3(signature = (motor, data, source, motor_source, exact_cv = false, plausible = Vec::new(), plausible_toml = None))]
+#[pyo3(signature = (motor, data, source, motor_source, exact_cv = false, plausible = Vec::new(), plausible_toml = None, tolerances = Vec::new(), tolerances_toml = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn diagnose_csv(
     py: Python<'_>,
@@ -30,13 +32,16 @@ pub fn diagnose_csv(
     exact_cv: bool,
     plausible: Vec<String>,
     plausible_toml: Option<(String, String)>,
+    tolerances: Vec<(String, f64)>,
+    tolerances_toml: Option<(String, String)>,
 ) -> PyResult<(String, Vec<String>)> {
     let m = motor.get().inner.clone();
     let ranges = plausible_ranges(py, &plausible, plausible_toml.as_ref())?;
+    let tolerances = tolerances_in_force(py, &tolerances, tolerances_toml.as_ref())?;
     let out = detached(py, move || -> Result<(String, Vec<String>), String> {
         let meas = parse_measurements_with(&data, &source, &ranges).map_err(|e| e.to_string())?;
         let bench = observations(&meas, &m);
-        let opts = DiagnoseOptions { exact_cv, ..DiagnoseOptions::default() };
+        let opts = DiagnoseOptions { exact_cv, tolerances, ..DiagnoseOptions::default() };
         let d =
             diagnose(&m, &bench.rows, &bench.groups, &opts).map_err(|e| format!("cannot diagnose '{source}': {e}"))?;
         let src = Provenance { motor_name: &m.name, motor_source: &motor_source, data: &source, lines: &bench.lines };
@@ -61,6 +66,27 @@ fn plausible_ranges(py: Python<'_>, specs: &[String], toml: Option<&(String, Str
     Ok(ranges)
 }
 
+/// The calibration's priors (docs/MOTOR_FILE.md, `[tolerances]`): the `[tolerances]` table
+/// of the TOML text `toml` (text, source name) when given, then the `(key, value)` pairs,
+/// which win for the keys they name. A bad table or pair raises `trum.InputError` naming the
+/// file, line and key (or the key), with the valid keys for an unknown one.
+fn tolerances_in_force(
+    py: Python<'_>,
+    pairs: &[(String, f64)],
+    toml: Option<&(String, String)>,
+) -> PyResult<std::collections::BTreeMap<String, f64>> {
+    let mut out = match toml {
+        Some((text, source)) => {
+            trum_core::params::tolerances_from_toml_str(text, source).map_err(|e| input_err(py, e.to_string()))?
+        }
+        None => Default::default(),
+    };
+    out.extend(
+        trum_core::params::tolerances_from_pairs(pairs, "tolerances").map_err(|e| input_err(py, e.to_string()))?,
+    );
+    Ok(out)
+}
+
 /// Calibrates the uncertain baseline parameters of `motor` to the measurement CSV `data`
 /// (its bytes; `source` names it in messages), as `trum calibrate` does: a maximum a
 /// posteriori fit with each parameter's tolerance as its prior, bounds refitted once, and
@@ -68,9 +94,11 @@ fn plausible_ranges(py: Python<'_>, specs: &[String], toml: Option<&(String, Str
 /// calibrated motor), `params` (rows of name, nominal, value, std_error, at_bound,
 /// identifiable), `chi2`, `chi2_per_reading`, `n_rows`, `n_readings`, `evaluations`,
 /// `warnings` (the fit's) and `notes` (the reader's). `plausible` and `plausible_toml` set
-/// the plausible ranges as for [`diagnose_csv`]. The GIL is released while it runs.
+/// the plausible ranges, `tolerances` and `tolerances_toml` the priors, as for
+/// [`diagnose_csv`]. The GIL is released while it runs.
 #[pyfunction]
-#[pyo3(signature = (motor, data, source, plausible = Vec::new(), plausible_toml = None))]
+#[pyo3(signature = (motor, data, source, plausible = Vec::new(), plausible_toml = None, tolerances = Vec::new(), tolerances_toml = None))]
+#[allow(clippy::too_many_arguments)]
 pub fn calibrate_csv<'py>(
     py: Python<'py>,
     motor: &Bound<'py, PyMotor>,
@@ -78,15 +106,19 @@ pub fn calibrate_csv<'py>(
     source: String,
     plausible: Vec<String>,
     plausible_toml: Option<(String, String)>,
+    tolerances: Vec<(String, f64)>,
+    tolerances_toml: Option<(String, String)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let pm = motor.get().clone();
     let m = pm.inner.clone();
     let ranges = plausible_ranges(py, &plausible, plausible_toml.as_ref())?;
+    let tolerances = tolerances_in_force(py, &tolerances, tolerances_toml.as_ref())?;
     let out = detached(py, move || -> Result<_, String> {
         let meas = parse_measurements_with(&data, &source, &ranges).map_err(|e| e.to_string())?;
         let bench = observations(&meas, &m);
         let mut cal = Calibration::builder(&m, &bench.rows)
             .options(&FitOptions::default())
+            .tolerances(&tolerances)
             .refit_bounds(true)
             .run()
             .map_err(|e| format!("{source}: {e}"))?;

@@ -149,3 +149,46 @@ def test_calibrate_matches_trum_calibrate_json():
     for a, b in zip(py.params, cli["params"]):
         assert a["name"] == b["name"] and a["value"] == pytest.approx(b["value"], rel=1e-12)
         assert a["std_error"] == pytest.approx(b["std_error"], rel=1e-9)
+
+
+def test_calibrate_takes_tolerances_from_a_mapping_or_a_motor_files_table(tmp_path):
+    free = {p["name"]: p for p in trum.calibrate(RING, DATA).params}
+    mu = "friction_layer.friction_coefficient"
+    assert free[mu]["value"] != free[mu]["nominal"]  # the data move it when it is free
+    # tolerance 0 holds a parameter at the motor's value, from a mapping ...
+    held = {p["name"]: p for p in trum.calibrate(RING, DATA, tolerances={mu: 0}).params}
+    assert held.get(mu, {"value": RING[mu]})["value"] == RING[mu]
+    # ... and from the [tolerances] table of a TOML file (the motor file itself), identically
+    f = tmp_path / "ring60_tol.toml"
+    f.write_text(RING_FILE.read_text() + '\n[tolerances]\n"friction_layer.friction_coefficient" = 0\n')
+    by_file = trum.calibrate(trum.Motor.from_toml(str(f)), DATA, tolerances=str(f)).params
+    assert [(p["name"], p["value"]) for p in by_file] == [(p["name"], p["value"]) for p in held.values()]
+
+
+def test_a_bad_tolerance_names_the_key_and_the_valid_ones(tmp_path):
+    with pytest.raises(trum.InputError, match=r"tolerances\.geometry\.radius_m.*valid keys are: .*geometry\.mean_radius_m"):
+        trum.calibrate(RING, DATA, tolerances={"geometry.radius_m": 0.02})
+    with pytest.raises(trum.InputError, match=r"must be >= 0"):
+        trum.diagnose(RING, DATA, tolerances={"geometry.mean_radius_m": -1})
+    f = tmp_path / "bad.toml"
+    f.write_text('[tolerances]\n"stator.modal_mass" = 0.1\n')
+    with pytest.raises(trum.InputError, match=r"bad\.toml: line 2, key 'tolerances\.stator\.modal_mass'"):
+        trum.calibrate(RING, DATA, tolerances=str(f))
+    with pytest.raises(trum.InputError, match=r"expected a number"):
+        trum.calibrate(RING, DATA, tolerances={"geometry.mean_radius_m": "tight"})
+
+
+@pytest.mark.skipif(not os.environ.get("TRUM_BIN"), reason="set TRUM_BIN to a trum CLI binary to compare with it")
+def test_tolerances_from_a_motor_file_give_the_clis_calibration(tmp_path):
+    f = tmp_path / "ring60_tol.toml"
+    f.write_text(RING_FILE.read_text() + '\n[tolerances]\n"geometry.neutral_plane_distance_m" = 0.005\n'
+                 '"bench.speed_std_floor_rpm" = 0\n')
+    exe = shutil.which(os.environ["TRUM_BIN"]) or os.environ["TRUM_BIN"]
+    out = subprocess.run([exe, "calibrate", "--motor", str(f), "--data", str(DATA), "--json", "-", "-q"],
+                         check=True, capture_output=True, text=True).stdout
+    cli = json.loads(out)
+    py = trum.calibrate(trum.Motor.from_toml(str(f)), str(DATA), tolerances=str(f))
+    assert py.chi2 == pytest.approx(cli["chi2"], rel=1e-12)
+    assert [p["name"] for p in py.params] == [p["name"] for p in cli["params"]]
+    for a, b in zip(py.params, cli["params"]):
+        assert a["value"] == pytest.approx(b["value"], rel=1e-12)

@@ -70,9 +70,9 @@ def _plausible_specs(plausible: Optional[Mapping[str, Any]]) -> List[str]:
 Plausible = Union[None, Mapping[str, Any], str, "os.PathLike[str]"]
 
 
-class _PlausibleToml:
-    """A ``[plausible]`` TOML file already read: its text and name (what travels to a
-    Dask worker, which may not see the client's files)."""
+class _TomlText:
+    """A TOML file already read: its text and name (what travels to a Dask worker, which
+    may not see the client's files)."""
 
     __slots__ = ("text", "source")
 
@@ -80,7 +80,28 @@ class _PlausibleToml:
         self.text, self.source = text, source
 
     def __reduce__(self) -> Any:
-        return (_PlausibleToml, (self.text, self.source))
+        return (_TomlText, (self.text, self.source))
+
+
+def _read_toml(path: Union[str, "os.PathLike[str]"], what: str) -> Tuple[str, str]:
+    """The text and name of the TOML file ``path`` given as ``what=``; a missing file or
+    bytes that are not UTF-8 raise ``trum.InputError`` naming the file (and line, byte)."""
+    source = os.fspath(path)
+    try:
+        with open(source, "rb") as f:
+            raw = f.read()
+    except FileNotFoundError:
+        raise InputError(f"{what}: TOML file '{source}' does not exist") from None
+    except OSError as e:
+        raise InputError(f"{what}: cannot read TOML file '{source}': {e.strerror}") from None
+    try:
+        return raw.decode("utf-8"), source
+    except UnicodeDecodeError as e:
+        line = 1 + raw[: e.start].count(b"\n")
+        raise InputError(
+            f"{source}: line {line}: byte 0x{raw[e.start]:02X} at offset {e.start} is not valid UTF-8; "
+            "save the file as UTF-8"
+        ) from None
 
 
 def _plausible_args(plausible: Plausible) -> Tuple[List[str], Optional[Tuple[str, str]]]:
@@ -88,31 +109,56 @@ def _plausible_args(plausible: Plausible) -> Tuple[List[str], Optional[Tuple[str
     name of a TOML file whose ``[plausible]`` table sets the ranges (a motor file)."""
     if plausible is None:
         return [], None
-    if isinstance(plausible, _PlausibleToml):
+    if isinstance(plausible, _TomlText):
         return [], (plausible.text, plausible.source)
     if isinstance(plausible, (str, os.PathLike)):
-        source = os.fspath(plausible)
-        try:
-            with open(source, "rb") as f:
-                raw = f.read()
-        except FileNotFoundError:
-            raise InputError(f"plausible: TOML file '{source}' does not exist") from None
-        except OSError as e:
-            raise InputError(f"plausible: cannot read TOML file '{source}': {e.strerror}") from None
-        try:
-            return [], (raw.decode("utf-8"), source)
-        except UnicodeDecodeError as e:
-            line = 1 + raw[: e.start].count(b"\n")
-            raise InputError(
-                f"{source}: line {line}: byte 0x{raw[e.start]:02X} at offset {e.start} is not valid UTF-8; "
-                "save the file as UTF-8"
-            ) from None
+        return [], _read_toml(plausible, "plausible")
     if isinstance(plausible, Mapping):
         return _plausible_specs(plausible), None
     raise TypeError(
         "plausible: expected a mapping {column: (low, high) or None} or the path of a TOML file with a "
         f"[plausible] table, got {type(plausible).__name__}"
     )
+
+
+Tolerances = Union[None, Mapping[str, float], str, "os.PathLike[str]"]
+
+
+def _tolerances_args(tolerances: Tolerances) -> Tuple[List[Tuple[str, float]], Optional[Tuple[str, str]]]:
+    """``tolerances=`` as the extension takes it: the (key, value) pairs of a mapping, or the
+    text and name of a TOML file whose ``[tolerances]`` table sets the priors (a motor
+    file). The keys and values are checked by the extension, which names the bad one."""
+    if tolerances is None:
+        return [], None
+    if isinstance(tolerances, _TomlText):
+        return [], (tolerances.text, tolerances.source)
+    if isinstance(tolerances, (str, os.PathLike)):
+        return [], _read_toml(tolerances, "tolerances")
+    if isinstance(tolerances, Mapping):
+        pairs = []
+        for k, v in tolerances.items():
+            try:
+                pairs.append((str(k), float(v)))
+            except (TypeError, ValueError):
+                raise InputError(
+                    f"tolerances, key 'tolerances.{k}': expected a number (relative standard deviation, 0 or inf), "
+                    f"got {v!r}"
+                ) from None
+        return pairs, None
+    raise TypeError(
+        "tolerances: expected a mapping {parameter key: relative standard deviation} or the path of a TOML file "
+        f"with a [tolerances] table, got {type(tolerances).__name__}"
+    )
+
+
+def _portable(arg: Any, read: Any) -> Any:
+    """``plausible=`` or ``tolerances=`` in a form that travels to a Dask worker: a TOML
+    file as its text (read once here by ``read``, the argument's parser), a mapping as a
+    plain dict."""
+    _, toml = read(arg)
+    if toml is not None:
+        return _TomlText(*toml)
+    return None if arg is None else dict(arg)
 
 
 class Diagnosis(dict):
@@ -194,6 +240,7 @@ def diagnose(
     *,
     exact_cv: bool = False,
     plausible: Plausible = None,
+    tolerances: Tolerances = None,
 ) -> Diagnosis:
     """Where the calibrated baseline misses the measurements, which unmodelled effect
     causes it, and how far the held-out gap shrinks once it is added.
@@ -213,12 +260,22 @@ def diagnose(
     values are real (``None`` for no bound at all; ``None`` at either end of a pair for
     no bound there); ``plausible="motor.toml"`` reads them from the ``[plausible]`` table
     of a TOML file, such as the motor file (docs/MOTOR_FILE.md).
+
+    ``tolerances`` sets the priors of the calibration, as a motor file's ``[tolerances]``
+    table does for ``trum diagnose`` (docs/MOTOR_FILE.md): the path of a TOML file whose
+    table is read (``tolerances="motor.toml"``, the motor file itself), or a mapping of
+    dotted keys to the relative standard deviation, ``{"geometry.neutral_plane_distance_m":
+    0.02, "stator.resonance_frequency_hz": 0, "bench.speed_std_floor_rpm": 0}`` (0 holds a
+    parameter, ``float("inf")`` fits it without a prior; the bench keys state the sensors'
+    specs). Without it the default tolerances apply. An unknown key raises
+    ``trum.InputError`` listing the valid ones.
     """
     m = _motor(motor)
     raw, source = _read_data(data)
     motor_source = motor if isinstance(motor, str) else (m.preset or m.name)
     specs, toml = _plausible_args(plausible)
-    text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv), specs, toml)
+    tol, tol_toml = _tolerances_args(tolerances)
+    text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv), specs, toml, tol, tol_toml)
     for w in notes:
         warnings.warn(w, stacklevel=2)
     return Diagnosis(json.loads(text))
@@ -257,7 +314,9 @@ class Calibration:
                 f"{self.chi2_per_reading:.3g} over {self.n_readings} readings; {len(self.warnings)} warnings>")
 
 
-def calibrate(motor: Union[Motor, str], data: DataLike, *, plausible: Plausible = None) -> Calibration:
+def calibrate(
+    motor: Union[Motor, str], data: DataLike, *, plausible: Plausible = None, tolerances: Tolerances = None
+) -> Calibration:
     """Calibrates the uncertain baseline parameters of ``motor`` to measurements, as
     ``trum calibrate`` does (a maximum a posteriori fit, each parameter's tolerance as its
     prior; docs/DIAGNOSIS.md). ``data`` is a measurement table in the layout of
@@ -265,14 +324,15 @@ def calibrate(motor: Union[Motor, str], data: DataLike, *, plausible: Plausible 
     Returns a :class:`Calibration` (``.motor`` is the calibrated motor,
     ``.to_pandas()`` the parameter table). The reader's notes (ignored columns) come as
     ``warnings.warn``; a bad file raises ``trum.InputError`` naming the file, line and
-    column. A motor file's ``[tolerances]`` table is not read here: the default tolerances
-    apply. ``plausible`` replaces plausible ranges as in :func:`diagnose` (a mapping, or
-    the path of a TOML file with a ``[plausible]`` table). The GIL is released while it
-    runs."""
+    column. ``plausible`` replaces plausible ranges and ``tolerances`` sets the priors as
+    in :func:`diagnose` (a mapping, or the path of a TOML file with a ``[plausible]`` or
+    ``[tolerances]`` table, such as the motor file; without ``tolerances`` the default
+    tolerances apply). The GIL is released while it runs."""
     m = _motor(motor)
     raw, source = _read_data(data)
     specs, toml = _plausible_args(plausible)
-    d = _trum.calibrate_csv(m, raw, source, specs, toml)
+    tol, tol_toml = _tolerances_args(tolerances)
+    d = _trum.calibrate_csv(m, raw, source, specs, toml, tol, tol_toml)
     for w in d["notes"]:
         warnings.warn(w, stacklevel=2)
     return Calibration(d)

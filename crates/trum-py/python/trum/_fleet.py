@@ -9,7 +9,7 @@ import warnings
 from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 from ._api import _motor
-from ._diagnosis import Plausible, _PlausibleToml, _plausible_args, calibrate, diagnose
+from ._diagnosis import Plausible, Tolerances, _plausible_args, _portable, _tolerances_args, calibrate, diagnose
 from ._errors import InputError
 from ._motor import Motor
 from ._result import _require_pandas
@@ -79,8 +79,8 @@ def _row(work: Callable[[str], Dict[str, Any]], path: str) -> Dict[str, Any]:
     return row
 
 
-def _diagnose_cells(path: str, motor: Motor, plausible: Any, exact_cv: bool) -> Dict[str, Any]:
-    d = diagnose(motor, path, exact_cv=exact_cv, plausible=plausible)
+def _diagnose_cells(path: str, motor: Motor, plausible: Any, tolerances: Any, exact_cv: bool) -> Dict[str, Any]:
+    d = diagnose(motor, path, exact_cv=exact_cv, plausible=plausible, tolerances=tolerances)
     ranking = d.get("ranking", [])
     verdict = d["verdict"]
     of_verdict = next((r for r in ranking if _same_set(r["effect"], verdict)), None)
@@ -108,8 +108,8 @@ def _diagnose_cells(path: str, motor: Motor, plausible: Any, exact_cv: bool) -> 
     return cells
 
 
-def _calibrate_cells(path: str, motor: Motor, plausible: Any) -> Dict[str, Any]:
-    c = calibrate(motor, path, plausible=plausible)
+def _calibrate_cells(path: str, motor: Motor, plausible: Any, tolerances: Any) -> Dict[str, Any]:
+    c = calibrate(motor, path, plausible=plausible, tolerances=tolerances)
     cells: Dict[str, Any] = {
         "rows": c.n_rows,
         "readings": c.n_readings,
@@ -183,6 +183,7 @@ def diagnose_fleet(
     npartitions: Optional[int] = None,
     exact_cv: bool = False,
     plausible: Plausible = None,
+    tolerances: Tolerances = None,
 ) -> Any:
     """Diagnoses every measurement file in ``files`` on its own, in parallel on Dask, and
     returns one summary row per file as a pandas DataFrame, the table of ``trum diagnose
@@ -201,12 +202,19 @@ def diagnose_fleet(
 
     ``client``: a ``distributed.Client`` (default: the running default client, else
     threads of this process). ``npartitions``: Dask tasks (default one per file).
-    ``exact_cv`` and ``plausible`` as for :func:`trum.diagnose`; a ``plausible`` TOML file
-    is read once here and its text shipped to the workers. Rows come in the order of the
+    ``exact_cv``, ``plausible`` and ``tolerances`` as for :func:`trum.diagnose`; a
+    ``plausible`` or ``tolerances`` TOML file is read once here and its text shipped to the
+    workers. Rows come in the order of the
     file list."""
     m = Motor._wrap(_motor(motor))
     paths = _files(files)
-    work = functools.partial(_diagnose_cells, motor=m, plausible=_portable(plausible), exact_cv=bool(exact_cv))
+    work = functools.partial(
+        _diagnose_cells,
+        motor=m,
+        plausible=_portable(plausible, _plausible_args),
+        tolerances=_portable(tolerances, _tolerances_args),
+        exact_cv=bool(exact_cv),
+    )
     return _frame(_map(work, paths, client, npartitions), DIAGNOSE_FLEET_COLUMNS)
 
 
@@ -217,6 +225,7 @@ def calibrate_fleet(
     client: Any = None,
     npartitions: Optional[int] = None,
     plausible: Plausible = None,
+    tolerances: Tolerances = None,
 ) -> Any:
     """Calibrates ``motor`` to every measurement file in ``files`` on its own, in parallel
     on Dask, as :func:`diagnose_fleet` does for the diagnosis; the table is that of
@@ -224,17 +233,13 @@ def calibrate_fleet(
     ``readings``, ``chi2_per_reading``, ``evaluations``, each fitted parameter by its
     motor-file key with its standard error as ``std_error.KEY``, ``warnings`` (the
     reader's and the fit's) and ``error``. Each row equals :func:`trum.calibrate` on that
-    file."""
+    file (``plausible`` and ``tolerances`` as there)."""
     m = Motor._wrap(_motor(motor))
     paths = _files(files)
-    work = functools.partial(_calibrate_cells, motor=m, plausible=_portable(plausible))
+    work = functools.partial(
+        _calibrate_cells,
+        motor=m,
+        plausible=_portable(plausible, _plausible_args),
+        tolerances=_portable(tolerances, _tolerances_args),
+    )
     return _frame(_map(work, paths, client, npartitions), CALIBRATE_FLEET_COLUMNS)
-
-
-def _portable(plausible: Plausible) -> Any:
-    """``plausible`` in a form that travels to a worker: a TOML file as its text (read once
-    here), a mapping as a plain dict."""
-    _, toml = _plausible_args(plausible)
-    if toml is not None:
-        return _PlausibleToml(*toml)
-    return None if plausible is None else dict(plausible)  # type: ignore[call-overload]

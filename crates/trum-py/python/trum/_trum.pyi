@@ -141,6 +141,8 @@ def diagnose_csv(
     exact_cv: bool = False,
     plausible: List[str] = ...,
     plausible_toml: Optional[Tuple[str, str]] = None,
+    tolerances: List[Tuple[str, float]] = ...,
+    tolerances_toml: Optional[Tuple[str, str]] = None,
 ) -> Tuple[str, List[str]]: ...
 def calibrate_csv(
     motor: Motor,
@@ -148,6 +150,8 @@ def calibrate_csv(
     source: str,
     plausible: List[str] = ...,
     plausible_toml: Optional[Tuple[str, str]] = None,
+    tolerances: List[Tuple[str, float]] = ...,
+    tolerances_toml: Optional[Tuple[str, str]] = None,
 ) -> Dict[str, Any]: ...
 
 def estimate_rows(
