@@ -138,8 +138,8 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
 }
 
 /// Drive of a motor without a `[drive]` table, when the command line gives none.
-const DEFAULT_VOLTAGE_V: f64 = 200.0;
-const DEFAULT_FREQUENCY_HZ: f64 = 43_000.0;
+pub const DEFAULT_VOLTAGE_V: f64 = 200.0;
+pub const DEFAULT_FREQUENCY_HZ: f64 = 43_000.0;
 
 /// The load at which the loaded motor stops at the point's preload and drive
 /// (`criterion::loaded_stall_torque_nm`, about 30 solves), or NaN where the rotor does not

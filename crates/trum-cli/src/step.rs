@@ -30,13 +30,13 @@ use trum_core::Motor;
 pub struct StepArgs {
     #[command(flatten)]
     motor: MotorArgs,
-    /// Ring motor: drive voltage amplitude per phase, zero-to-peak [V] (default 200): VALUE or START:STOP:N.
+    /// Ring motor: drive voltage amplitude per phase, zero-to-peak [V] (default: the motor's [drive], else 200): VALUE or START:STOP:N.
     #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true)]
     voltage_v: Option<Axis>,
     /// Bar-type motor: drive moment amplitude per axis [N·m] (default: the motor's [drive]): VALUE or START:STOP:N.
     #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true)]
     moment_nm: Option<Axis>,
-    /// Drive frequency [Hz] (ring default 43000; bar-type: the motor's [drive]): VALUE or START:STOP:N.
+    /// Drive frequency [Hz] (default: the motor's [drive]; a ring motor without one 43000): VALUE or START:STOP:N.
     #[arg(long, value_name = "VALUE|START:STOP:N", value_parser = parse_axis, allow_hyphen_values = true)]
     frequency_hz: Option<Axis>,
     /// Phase of phase B behind phase A [deg] (default 90: travelling wave; 0: standing wave; -90: reversed): VALUE or START:STOP:N.
@@ -232,7 +232,13 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
     let motor = load(a, err)?;
     let axis = |ax: &Option<Axis>, default: f64| ax.unwrap_or(Axis { start: default, stop: default, n: 1 });
     let (drive_axis, drive_flag, freq_default, phase_default) = match &motor {
-        StepMotor::Ring(_) => (axis(&a.voltage_v, 200.0), "--voltage-v", 43e3, 90.0),
+        StepMotor::Ring(_) => {
+            // the drive of the motor's figures ([drive]), as `trum point` and `trum optimize` use it
+            let drive = crate::optimize::motor_drive(&a.motor.motor)?;
+            let v = drive.map_or(crate::point::DEFAULT_VOLTAGE_V, |d| d.voltage_v);
+            let f = drive.map_or(crate::point::DEFAULT_FREQUENCY_HZ, |d| d.frequency_hz);
+            (axis(&a.voltage_v, v), "--voltage-v", f, 90.0)
+        }
         StepMotor::Bar(b) => {
             (axis(&a.moment_nm, b.moment_amplitude_nm), "--moment-nm", b.frequency_hz, b.phase_difference_deg)
         }

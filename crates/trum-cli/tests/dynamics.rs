@@ -506,3 +506,15 @@ fn step_runs_the_bar_type_motor_and_ring_commands_refuse_it() {
     let shown = ok(&["presets", "show", "bar36"]);
     assert!(shown.contains("kind = \"bar\"") && shown.contains("natural_frequency_hz = 36500.0"), "{shown}");
 }
+
+#[test]
+fn step_runs_a_ring_motor_at_its_drive_unless_told() {
+    // trum60a's [drive] is its paper's 200 V, 42 kHz; a frozen copy without one runs at 43 kHz
+    let short = ["--duration-s", "0.0003", "--nodes-per-wavelength", "32"];
+    let at_drive = ok(&[&["step", "--motor", "trum60a"][..], &short].concat());
+    assert!(at_drive.contains("drive    200 V, 42000 Hz"), "{at_drive}");
+    let told = ok(&[&["step", "--motor", "trum60a", "--frequency-hz", "43500"][..], &short].concat());
+    assert!(told.contains("drive    200 V, 43500 Hz"), "{told}");
+    let frozen = ok(&[&["step", "--motor", FROZEN_TRUM60A][..], &short].concat());
+    assert!(frozen.contains("drive    200 V, 43000 Hz"), "{frozen}");
+}

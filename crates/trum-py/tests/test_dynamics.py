@@ -217,3 +217,14 @@ def test_matches_cli_resonance_and_step():
         assert float(row["final_speed_rpm"]) == r.averages["speed_rpm"]
         assert float(row["delay_s"]) == r.metrics["delay_s"]
         assert float(row["steady_speed_rpm"]) == r.steady["speed_rpm"]
+
+
+def test_step_runs_a_ring_motor_at_its_drive_unless_told():
+    short = dict(duration_s=3e-4, nodes_per_wavelength=32)
+    with pytest.warns(UserWarning, match="no unmodelled effects"):
+        r = trum.step("trum60a", **short)
+    assert trum.Motor("trum60a").drive == (200.0, 42e3)
+    assert r.conditions["voltage_v"] == 200.0 and r.conditions["frequency_hz"] == 42e3
+    with pytest.warns(UserWarning):
+        told = trum.step("trum60a", frequency_hz=43.5e3, **short)
+    assert told.conditions["frequency_hz"] == 43.5e3

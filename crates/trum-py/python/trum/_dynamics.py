@@ -13,7 +13,7 @@ import numpy as np
 
 from . import _trum
 from . import _axes, _plot
-from ._api import _motor
+from ._api import _drive, _motor
 from ._result import _require_pandas
 from ._errors import InputError
 from ._motor import Motor, _number
@@ -376,7 +376,8 @@ def step(
     other way, status ``ok``. The GIL is released while it runs.
 
     ``motor``: a ring motor (``trum.Motor`` or preset name; driven by ``voltage_v``,
-    default 200 V at 43 kHz, 260 N, 10 ms) or a bar-type motor (preset name such as
+    by default at the motor's ``[drive]`` (``Motor.drive``; else 200 V at 43 kHz), 260 N,
+    10 ms) or a bar-type motor (preset name such as
     ``"bar36"`` or a bar-type motor file path; driven by ``moment_nm``, every default from
     the motor's ``[drive]``: 0.25 N·m at 36.7 kHz, 40 N, 15 ms for ``bar36``).
 
@@ -423,13 +424,15 @@ def step(
             )
             m = m.with_effects("none")
         opt = lambda v, default: float(default if v is None else v)  # noqa: E731
+        # the drive of the motor's figures, as trum.solve and trum step use it
+        drive_v, drive_hz = _drive(_motor(m))
         d = _trum.step(
-            _motor(m), opt(voltage_v, 200.0), opt(frequency_hz, 43e3), opt(phase_difference_deg, 90.0),
+            _motor(m), opt(voltage_v, drive_v), opt(frequency_hz, drive_hz), opt(phase_difference_deg, 90.0),
             opt(preload_n, 260.0), float(torque_nm), opt(duration_s, 10e-3), int(steps_per_period),
             int(nodes_per_wavelength), opt(tangential_stiffness_ratio, 300.0), int(record_every), snaps_at,
             auto_steps,
         )
-        cond = {"voltage_v": opt(voltage_v, 200.0), "frequency_hz": opt(frequency_hz, 43e3),
+        cond = {"voltage_v": opt(voltage_v, drive_v), "frequency_hz": opt(frequency_hz, drive_hz),
                 "preload_n": opt(preload_n, 260.0), "torque_nm": float(torque_nm)}
         name = m.name
     snaps = []
