@@ -145,7 +145,14 @@ pub fn run(a: &MapArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32>
         }
         g
     } else {
-        a.grid.resolve(&sweep, &default_grid())
+        // an axis set nowhere is fixed; its drive is the motor's own ([drive]), as for
+        // `trum point`, `trum optimize` and `trum plot`
+        let mut fallback = default_grid();
+        if let Some(d) = crate::optimize::motor_drive(&a.motor.motor)? {
+            fallback.voltage_v = Axis::fixed(d.voltage_v);
+            fallback.frequency_hz = Axis::fixed(d.frequency_hz);
+        }
+        a.grid.resolve(&sweep, &fallback)
     };
     check_grid(&grid)?;
     let cols = parse_columns(a.columns.as_deref())?;

@@ -133,8 +133,8 @@ fn map_columns_rows_and_defaults() {
     want.extend(trum_core::quantities::QUANTITIES.iter().map(|q| q.name));
     assert_eq!(h, want);
     assert_eq!(rows.len(), 12);
-    // torque fastest, defaults 200 V and 43 kHz
-    assert_eq!(&rows[1][..4], ["100", "0.5", "200", "43000"]);
+    // torque fastest, the drive defaults to the preset's [drive], 200 V and 42 kHz
+    assert_eq!(&rows[1][..4], ["100", "0.5", "200", "42000"]);
     assert_eq!(&rows[11][..2], ["300", "1.5"]);
     // numbers are Rust's shortest round-trip form
     let speed: f64 = rows[0][6].parse().expect("number");
@@ -168,6 +168,24 @@ fn map_columns_rows_and_defaults() {
     // one axis given: the other axes take their defaults, as before
     let one = ok(&["map", "--motor", "generic60", "--preload-n", "250", "--columns", "speed_rpm", "-o", "-"]);
     assert_eq!(parse_csv(&one).1.len(), 1);
+    // ... and the drive is the motor's [drive] (trum60a: its paper's 200 V, 42 kHz), as for `trum point`
+    let (_, rows) =
+        parse_csv(&ok(&["map", "--motor", "trum60a", "--preload-n", "250", "--columns", "speed_rpm", "-o", "-"]));
+    assert_eq!((rows[0][2].as_str(), rows[0][3].as_str()), ("200", "42000"));
+    let (_, told) = parse_csv(&ok(&[
+        "map",
+        "--motor",
+        "trum60a",
+        "--preload-n",
+        "250",
+        "--frequency-hz",
+        "43000",
+        "--columns",
+        "speed_rpm",
+        "-o",
+        "-",
+    ]));
+    assert_eq!(told[0][3], "43000");
 }
 
 #[test]
