@@ -10,7 +10,7 @@ import numpy as np
 
 from . import _trum
 from ._api import _motor
-from ._errors import InputError
+from ._errors import InputError, decode_utf8
 from ._motor import Motor
 from ._result import _require_pandas
 
@@ -94,14 +94,7 @@ def _read_toml(path: Union[str, "os.PathLike[str]"], what: str) -> Tuple[str, st
         raise InputError(f"{what}: TOML file '{source}' does not exist") from None
     except OSError as e:
         raise InputError(f"{what}: cannot read TOML file '{source}': {e.strerror}") from None
-    try:
-        return raw.decode("utf-8"), source
-    except UnicodeDecodeError as e:
-        line = 1 + raw[: e.start].count(b"\n")
-        raise InputError(
-            f"{source}: line {line}: byte 0x{raw[e.start]:02X} at offset {e.start} is not valid UTF-8; "
-            "save the file as UTF-8"
-        ) from None
+    return decode_utf8(raw, source, InputError), source
 
 
 def _plausible_args(plausible: Plausible) -> Tuple[List[str], Optional[Tuple[str, str]]]:

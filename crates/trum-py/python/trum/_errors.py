@@ -1,7 +1,7 @@
 """Exceptions of trum. Messages are the core's, word for word (the CLI prints the same)."""
 from __future__ import annotations
 
-from typing import Optional
+from typing import Optional, Type
 
 
 class TrumError(Exception):
@@ -40,3 +40,16 @@ class ParameterKeyError(ParameterError, KeyError):
 
 class InputError(TrumError, ValueError):
     """An operating-point, sweep or criterion argument is invalid (bad axis, shapes that do not broadcast, ...)."""
+
+
+def decode_utf8(raw: bytes, source: str, error: Type[TrumError]) -> str:
+    """The text of a file's bytes; bytes that are not UTF-8 raise ``error`` naming the file,
+    line, byte and offset, in the CLI's words."""
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = 1 + raw[: e.start].count(b"\n")
+        raise error(
+            f"{source}: line {line}: byte 0x{raw[e.start]:02X} at offset {e.start} is not valid UTF-8; "
+            "save the file as UTF-8"
+        ) from None

@@ -9,7 +9,7 @@ from typing import Any, Dict, Iterable, List, Mapping, Optional, Tuple, Union
 import numpy as np
 
 from . import _trum
-from ._errors import InputError, ParameterError, ParameterKeyError, TrumError
+from ._errors import InputError, ParameterError, ParameterKeyError, TrumError, decode_utf8
 from ._result import Result
 
 ArrayLike = Any  # scalar or array of real numbers
@@ -128,16 +128,7 @@ class Motor:
         """Reads a TOML motor file (``preset = "..."`` plus overrides, or every key)."""
         with open(path, "rb") as f:
             raw = f.read()
-        try:
-            text = raw.decode("utf-8")
-        except UnicodeDecodeError as e:
-            # same words as the CLI
-            line = 1 + raw[: e.start].count(b"\n")
-            raise TrumError(
-                f"{os.fspath(path)}: line {line}: byte 0x{raw[e.start]:02X} at offset {e.start} "
-                "is not valid UTF-8; save the file as UTF-8"
-            ) from None
-        return cls.from_toml_str(text, os.fspath(path))
+        return cls.from_toml_str(decode_utf8(raw, os.fspath(path), TrumError), os.fspath(path))
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any], source: str = "dict") -> "Motor":
