@@ -128,3 +128,24 @@ if given is not None:
         m = trum.Motor.from_dict({"preset": "generic60", "name": name})
         assert pickle.loads(pickle.dumps(m)).name == name
         assert trum.Motor.from_toml_str(m.to_toml()).name == name
+
+    @settings(max_examples=25, deadline=None)
+    @given(
+        st.sampled_from(["trum60a", "trum60-qut", "generic60"]),
+        st.floats(min_value=5.0, max_value=600.0),
+        st.floats(min_value=5.0, max_value=300.0),
+        st.floats(min_value=38e3, max_value=46e3),
+    )
+    def test_map_status_agrees_with_its_loaded_stall_torque(preset, preload, voltage, frequency):
+        # along a torque line: ok below the line's loaded stall torque, not ok above it
+        m = trum.Motor(preset)
+        d = trum.map(m, preload_n=preload, voltage_v=voltage, frequency_hz=frequency,
+                     torque_nm=trum.linspace(0.0, 3.0, 31))
+        t = float(d["loaded_stall_torque_nm"][0])
+        assert np.all(d["loaded_stall_torque_nm"] == t) or np.isnan(d["loaded_stall_torque_nm"]).all()
+        ok = d["status"] == "ok"
+        if np.isnan(t):
+            assert not ok.any()
+        else:
+            assert ok[d["torque_nm"] < t * (1 - 1e-6)].all()
+            assert not ok[d["torque_nm"] > t * (1 + 1e-6)].any()
