@@ -225,12 +225,13 @@ fn seconds_per_point(motor: &Motor) -> f64 {
     }
 }
 
-/// Cold solves of one torque line's loaded stall torque: the bisection to 1e-9 (about 30)
-/// and its bracket (docs/PERFORMANCE.md, "CSV maps").
+/// Cold solves of one torque line's loaded stall torque: the no-load point, the bracket
+/// and the bisection to a relative 1e-9 (about 30).
 const SOLVES_PER_LINE: f64 = 34.0;
 
-/// Solver time of one cold solve [s] on one core, relative to a warm-started map point's
-/// [`seconds_per_point`] (docs/PERFORMANCE.md, "CSV maps").
+/// The time of one cold solve in warm-started map points ([`seconds_per_point`]): 1.3-3
+/// measured, effect-free and with the shipped `trum60a`'s effects (docs/PERFORMANCE.md,
+/// the cost of `loaded_stall_torque_nm`).
 const COLD_SOLVE_POINTS: f64 = 3.0;
 
 /// The size model of `trum map`: (points, estimated CSV bytes, estimated seconds). The
