@@ -229,7 +229,7 @@ fn seconds_per_point(motor: &Motor) -> f64 {
 /// and the bisection to a relative 1e-9 (about 30).
 const SOLVES_PER_LINE: f64 = 34.0;
 
-/// The time of one cold solve in warm-started map points ([`seconds_per_point`]): 1.3-3
+/// The time of one cold solve in warm-started map points ([`seconds_per_point`]): 0.7-3
 /// measured, effect-free and with the shipped `trum60a`'s effects (docs/PERFORMANCE.md,
 /// the cost of `loaded_stall_torque_nm`).
 const COLD_SOLVE_POINTS: f64 = 3.0;
