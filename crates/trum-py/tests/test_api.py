@@ -261,7 +261,7 @@ def test_tables_and_reprs(motor):
     pd = pytest.importorskip("pandas")
     d = trum.map(motor, preload_n=[150, 250, 350], torque_nm=trum.linspace(0, 0.6, 7), voltage_v=200, frequency_hz=43e3)
     df = d.to_pandas()
-    assert df.shape == (21, 6 + len(trum.QUANTITY_NAMES)) and str(df["status"].dtype) == "category"
+    assert df.shape == (21, 7 + len(trum.QUANTITY_NAMES)) and str(df["status"].dtype) == "category"
     assert d.shape == (3, 1, 1, 7) and d.swept == ["preload_n", "torque_nm"]
     assert d.fixed == {"voltage_v": 200.0, "frequency_hz": 43e3}
     text = repr(d)
