@@ -730,6 +730,21 @@ fn map_statuses_agree_with_the_loaded_stall_torque_column() {
     let (_, rows) = parse_csv(&out);
     let (at_rest, loaded): (f64, f64) = (rows[0][6].parse().expect("at rest"), rows[0][7].parse().expect("loaded"));
     assert!(loaded < 0.5 * at_rest, "{loaded} against {at_rest}");
+    // the same number as `trum point` reports for the point
+    let point = ok(&[
+        "point",
+        "--motor",
+        "generic60",
+        "--preload-n",
+        "26.87",
+        "--voltage-v",
+        "6.63",
+        "--frequency-hz",
+        "40456.6",
+        "--json",
+    ]);
+    let v: serde_json::Value = point.parse().expect("JSON");
+    assert_eq!(v["loaded_stall_torque_nm"].as_f64(), Some(loaded));
     let unknown = fails(
         &["map", "--motor", "generic60", "--preload-n", "100", "--columns", "loaded_stall_torqe_nm", "-o", "-"],
         1,
