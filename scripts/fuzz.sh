@@ -1,23 +1,77 @@
 #!/usr/bin/env bash
-# Coverage-guided fuzzing (cargo-fuzz, libFuzzer) of every target in fuzz/coverage/ for a
+# Coverage-guided fuzzing (cargo-fuzz, libFuzzer) of the targets in fuzz/coverage/ for a
 # stated budget, with a seed that changes per run unless given, printed for replay.
-#   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
+#   scripts/fuzz.sh [OPTIONS] [BUDGET] [TARGET[:BUDGET]...]
+# BUDGET is seconds per target (default 60), or a count of executions per target when
+# written with an x suffix (1000000x: libFuzzer's -runs, the run stops at the count); a
+# target's own budget after a colon overrides it (diagnose:3600).
+# Options:
+#   --sanitizer none|address   the build (default address, cargo-fuzz's own). `none` runs
+#                              several times faster; trum is safe Rust, so AddressSanitizer
+#                              only adds checks inside unsafe code of its dependencies
+#                              (docs/RELIABILITY.md, "Coverage-guided fuzzing")
+#   --timeout S                an input slower than S seconds is a hang (default 10)
+# Debug assertions and overflow checks are on in every build (-a).
+# Every target is built before the first one runs, so the figures are of one source state.
 # Needs a nightly toolchain (`rustup toolchain list`) and cargo-fuzz (`cargo install
 # cargo-fuzz`). Corpora grow in fuzz/coverage/corpus/<target>/ (git-ignored, seeded from
 # the committed fuzz/corpus/ where a target reads the same format); crashes go to
-# fuzz/coverage/artifacts/<target>/. Prints executions, coverage and corpus size per
-# target (docs/RELIABILITY.md, "Coverage-guided fuzzing").
+# fuzz/coverage/artifacts/<target>/. Prints executions, rate, coverage, corpus size and
+# peak RSS per target.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-SECONDS_PER_TARGET=${1:-60}
+SANITIZER=address
+TIMEOUT=10
+while [ $# -gt 0 ]; do
+  case $1 in
+    --sanitizer) SANITIZER=${2:?--sanitizer needs none or address}; shift 2 ;;
+    --sanitizer=*) SANITIZER=${1#*=}; shift ;;
+    --timeout) TIMEOUT=${2:?--timeout needs seconds}; shift 2 ;;
+    --timeout=*) TIMEOUT=${1#*=}; shift ;;
+    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
+    -*) echo "fuzz.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
+    *) break ;;
+  esac
+done
+case $SANITIZER in
+  none|address) ;;
+  *) echo "fuzz.sh: --sanitizer must be none or address, not '$SANITIZER'" >&2; exit 2 ;;
+esac
+BUDGET=${1:-60}
 shift || true
-TARGETS=("$@")
-if [ ${#TARGETS[@]} -eq 0 ]; then
-  TARGETS=(motor_reader measurement_reader solver writers_round_trip calibrate_diagnose)
+# budget_args BUDGET: libFuzzer's options for that budget, or exit 2
+budget_args() {
+  if ! [[ ${1%x} =~ ^[0-9]+$ ]]; then
+    echo "fuzz.sh: a budget must be seconds (600) or executions (1000000x), not '$1'" >&2
+    exit 2
+  fi
+  case $1 in
+    *x) echo "-runs=${1%x}" ;;
+    *) echo "-max_total_time=$1" ;;
+  esac
+}
+budget_args "$BUDGET" >/dev/null
+ARGS=("$@")
+if [ ${#ARGS[@]} -eq 0 ]; then
+  ARGS=(motor_reader measurement_reader solver writers_round_trip calibrate diagnose)
 fi
+TARGETS=()
+for a in "${ARGS[@]}"; do
+  TARGETS+=("${a%%:*}")
+  [[ $a == *:* ]] && budget_args "${a#*:}" >/dev/null
+done
 SEED=${TRUM_FUZZ_SEED:-$(( $(date +%s) % 1000000007 ))}
-echo "fuzz seed: $SEED, ${SECONDS_PER_TARGET} s per target (replay a crash: cargo +nightly fuzz run --fuzz-dir fuzz/coverage TARGET ARTIFACT)"
+BUILD=(cargo +nightly fuzz build --fuzz-dir fuzz/coverage -O -a -s "$SANITIZER")
+echo "fuzz seed: $SEED, budget $BUDGET per target (x: executions, else seconds), sanitizer $SANITIZER, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "replay a crash: cargo +nightly fuzz run --fuzz-dir fuzz/coverage -O -a -s $SANITIZER TARGET ARTIFACT"
 for t in "${TARGETS[@]}"; do
+  "${BUILD[@]}" "$t"
+done
+BIN_DIR=fuzz/coverage/target/$(rustc +nightly -vV | sed -n 's/^host: //p')/release
+for a in "${ARGS[@]}"; do
+  t=${a%%:*}
+  b=$BUDGET
+  [[ $a == *:* ]] && b=${a#*:}
   corpus=fuzz/coverage/corpus/$t
   mkdir -p "$corpus" "fuzz/coverage/artifacts/$t"
   # inputs up to the length a target can use, from the start (-len_control=0)
@@ -26,14 +80,17 @@ for t in "${TARGETS[@]}"; do
     measurement_reader) seeds=fuzz/corpus/csv; max_len=8192 ;;
     solver) seeds=; max_len=128 ;;
     writers_round_trip) seeds=; max_len=512 ;;
-    calibrate_diagnose) seeds=; max_len=64 ;;
+    calibrate|diagnose) seeds=; max_len=64 ;;
     *) seeds=; max_len=4096 ;;
   esac
-  echo "== $t"
+  echo "== $t, budget $b (load $(cut -d' ' -f1-3 /proc/loadavg))"
   log=$(mktemp)
-  # -rss_limit_mb bounds memory; -timeout reports an input slower than 10 s as a hang
-  if ! cargo +nightly fuzz run --fuzz-dir fuzz/coverage "$t" "$corpus" $seeds -- \
-      -seed="$SEED" -max_total_time="$SECONDS_PER_TARGET" -rss_limit_mb=4096 -timeout=10 \
+  start=$(date +%s)
+  # -rss_limit_mb bounds memory; -timeout reports a slow input as a hang
+  # shellcheck disable=SC2086
+  if ! /usr/bin/time -f "wall %e s, max RSS %M kB" "$BIN_DIR/$t" "$corpus" $seeds \
+      -artifact_prefix="fuzz/coverage/artifacts/$t/" \
+      -seed="$SEED" "$(budget_args "$b")" -rss_limit_mb=4096 -timeout="$TIMEOUT" \
       -max_len="$max_len" -len_control=0 \
       -print_final_stats=1 >"$log" 2>&1; then
     tail -40 "$log"
@@ -41,7 +98,9 @@ for t in "${TARGETS[@]}"; do
     rm -f "$log"
     exit 1
   fi
+  secs=$(( $(date +%s) - start ))
   grep -E "^#[0-9]+.*(DONE|cov:)" "$log" | tail -1
-  grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "$log" || true
+  grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|stat::peak_rss_mb|^wall" "$log" || true
+  echo "corpus: $(find "$corpus" -type f | wc -l) files, $(du -sh "$corpus" | cut -f1); ${secs} s"
   rm -f "$log"
 done

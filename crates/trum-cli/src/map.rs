@@ -19,7 +19,9 @@ use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 use trum_core::quantities::{self, Quantity, QUANTITIES};
 use trum_core::solve::Prepared;
-use trum_core::sweep::{axis_values, chunk_count, chunk_range, solve_range, Axis, Grid, AXES, CHUNK_POINTS};
+use trum_core::sweep::{
+    axis_values, chunk_count, chunk_range, solve_range, Axis, Grid, LineStall, AXES, CHUNK_POINTS, LOADED_STALL_COLUMN,
+};
 use trum_core::Motor;
 
 /// Bytes between the early disk flushes of a map written to a file (4-32 MB measured the
@@ -35,7 +37,8 @@ pub struct MapArgs {
     motor: MotorArgs,
     #[command(flatten)]
     grid: GridArgs,
-    /// Quantity columns to write, comma-separated (default: all; see `trum point` for the list).
+    /// Quantity columns to write, comma-separated (default: all, `loaded_stall_torque_nm`
+    /// last; see `trum point` for the list).
     #[arg(long, value_name = "a,b,c")]
     columns: Option<String>,
     /// Output CSV file (`-` for stdout). Written to a temporary file and renamed at the end.
@@ -99,24 +102,54 @@ fn axis_text(a: &Axis) -> String {
     }
 }
 
-/// Parses `--columns`: known quantity names, no duplicates.
-pub fn parse_columns(spec: Option<&str>) -> Result<Vec<&'static Quantity>> {
-    let Some(spec) = spec else { return Ok(QUANTITIES.iter().collect()) };
-    let mut cols: Vec<&'static Quantity> = Vec::new();
+/// A column of a map after the inputs, `status` and `warnings`.
+#[derive(Clone, Copy, Debug)]
+pub enum MapColumn {
+    /// A quantity of the point's own solution.
+    Quantity(&'static Quantity),
+    /// The load torque at which the loaded motor stops on the point's torque line
+    /// ([`LOADED_STALL_COLUMN`], [`LineStall`]): one bisection per line, shared by its points.
+    LoadedStall,
+}
+
+impl MapColumn {
+    /// The column's name in the header.
+    pub fn name(&self) -> &'static str {
+        match self {
+            MapColumn::Quantity(q) => q.name,
+            MapColumn::LoadedStall => LOADED_STALL_COLUMN.0,
+        }
+    }
+}
+
+/// The default columns: every quantity, then the loaded stall torque.
+pub fn default_columns() -> Vec<MapColumn> {
+    QUANTITIES.iter().map(MapColumn::Quantity).chain([MapColumn::LoadedStall]).collect()
+}
+
+/// Parses `--columns`: known quantity names (and `loaded_stall_torque_nm`), no duplicates.
+pub fn parse_columns(spec: Option<&str>) -> Result<Vec<MapColumn>> {
+    let Some(spec) = spec else { return Ok(default_columns()) };
+    let mut cols: Vec<MapColumn> = Vec::new();
     for name in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         if INPUT_COLUMNS.contains(&name) || name == "status" || name == "warnings" {
             bail!(
                 "--columns: '{name}' is always written (inputs, status and warnings come first); list only quantities"
             );
         }
-        let q = quantities::find(name).map_err(|m| {
-            let hint = crate::suggest::hint(name, crate::suggest::names(quantities::QUANTITIES.iter().map(|q| q.name)));
-            anyhow!("--columns: {m}{hint}")
-        })?;
-        if cols.iter().any(|c| c.name == q.name) {
+        let c = if name == LOADED_STALL_COLUMN.0 {
+            MapColumn::LoadedStall
+        } else {
+            MapColumn::Quantity(quantities::find(name).map_err(|m| {
+                let known = quantities::QUANTITIES.iter().map(|q| q.name).chain([LOADED_STALL_COLUMN.0]);
+                let hint = crate::suggest::hint(name, crate::suggest::names(known));
+                anyhow!("--columns: {m}{hint}")
+            })?)
+        };
+        if cols.iter().any(|k| k.name() == c.name()) {
             bail!("--columns: '{name}' is listed twice");
         }
-        cols.push(q);
+        cols.push(c);
     }
     if cols.is_empty() {
         bail!("--columns: no column given");
@@ -160,7 +193,7 @@ pub fn run(a: &MapArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32>
         bail!("--chunk-points must be >= 1");
     }
     let threads = crate::output::worker_threads(a.threads, "--threads", err)?;
-    check_size(&motor, &grid, cols.len(), threads, a.max_points)?;
+    check_size(&motor, &grid, &cols, threads, a.max_points)?;
     let target = OutputTarget::create(&a.output, ".csv")?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start worker threads")?;
     let mut progress = Progress::new(grid.len(), "points", a.quiet);
@@ -199,17 +232,33 @@ fn seconds_per_point(motor: &Motor) -> f64 {
     }
 }
 
-/// The size model of `trum map`: (points, estimated CSV bytes, estimated seconds).
-pub fn size_estimate(motor: &Motor, grid: &Grid, columns: usize, threads: usize) -> (u64, f64, f64) {
+/// Cold solves of one torque line's loaded stall torque: the no-load point, the bracket
+/// and the bisection to a relative 1e-9 (about 30).
+const SOLVES_PER_LINE: f64 = 34.0;
+
+/// The time of one cold solve in warm-started map points ([`seconds_per_point`]): 0.7-3
+/// measured, effect-free and with the shipped `trum60a`'s effects (docs/PERFORMANCE.md,
+/// the cost of `loaded_stall_torque_nm`).
+const COLD_SOLVE_POINTS: f64 = 3.0;
+
+/// The size model of `trum map`: (points, estimated CSV bytes, estimated seconds). The
+/// loaded stall torque adds its bisection once per torque line.
+pub fn size_estimate(motor: &Motor, grid: &Grid, cols: &[MapColumn], threads: usize) -> (u64, f64, f64) {
     let n = grid.len();
-    let bytes = n as f64 * (INPUT_COLUMNS.len() + 1 + columns) as f64 * BYTES_PER_CELL;
-    let secs = n as f64 * seconds_per_point(motor) / threads.max(1) as f64;
+    let bytes = n as f64 * (INPUT_COLUMNS.len() + 1 + cols.len()) as f64 * BYTES_PER_CELL;
+    let lines = if cols.iter().any(|c| matches!(c, MapColumn::LoadedStall)) {
+        n as f64 / grid.torque_nm.n.max(1) as f64
+    } else {
+        0.0
+    };
+    let point_equivalents = n as f64 + lines * SOLVES_PER_LINE * COLD_SOLVE_POINTS;
+    let secs = point_equivalents * seconds_per_point(motor) / threads.max(1) as f64;
     (n, bytes, secs)
 }
 
 /// Refuses a grid above `max_points` before any work, with its size and the flag.
-fn check_size(motor: &Motor, grid: &Grid, columns: usize, threads: usize, max_points: u64) -> Result<()> {
-    let (n, bytes, secs) = size_estimate(motor, grid, columns, threads);
+fn check_size(motor: &Motor, grid: &Grid, cols: &[MapColumn], threads: usize, max_points: u64) -> Result<()> {
+    let (n, bytes, secs) = size_estimate(motor, grid, cols, threads);
     if n > max_points {
         bail!(
             "the grid has {} points ({}): an estimated {} of CSV and {} on {threads} thread{}; that is more than \
@@ -227,19 +276,20 @@ fn check_size(motor: &Motor, grid: &Grid, columns: usize, threads: usize, max_po
 
 /// The CSV header line: inputs, `status`, `warnings` (the motor's `[limits]` keys the
 /// point exceeds, `;`-separated, empty when none), then the quantities.
-pub fn header(cols: &[&Quantity]) -> String {
+pub fn header(cols: &[MapColumn]) -> String {
     let mut h: Vec<&str> = INPUT_COLUMNS.to_vec();
     h.push("status");
     h.push("warnings");
-    h.extend(cols.iter().map(|q| q.name));
+    h.extend(cols.iter().map(MapColumn::name));
     h.join(",") + "\n"
 }
 
 /// Solves and formats one chunk.
-fn chunk_csv(motor: &Motor, prep: &Prepared, grid: &Grid, cols: &[&Quantity], range: std::ops::Range<u64>) -> Vec<u8> {
+fn chunk_csv(motor: &Motor, prep: &Prepared, grid: &Grid, cols: &[MapColumn], range: std::ops::Range<u64>) -> Vec<u8> {
     let mut buf = Vec::with_capacity((range.end - range.start) as usize * (24 * cols.len() + 64));
     let mut fmt = NumberFormatter::new();
     let mut last = ColumnMemo::new(INPUT_COLUMNS.len() + cols.len());
+    let mut line = LineStall::new();
     solve_range(motor, prep, grid, range, |_, op, s| {
         for (c, v) in axis_values(op).into_iter().enumerate() {
             last.push(&mut fmt, &mut buf, c, v);
@@ -251,11 +301,20 @@ fn chunk_csv(motor: &Motor, prep: &Prepared, grid: &Grid, cols: &[&Quantity], ra
             buf.extend_from_slice(s.warnings.to_string().as_bytes());
         }
         let valid = s.status.is_valid();
-        for (c, q) in cols.iter().enumerate() {
+        for (c, col) in cols.iter().enumerate() {
             buf.push(b',');
-            // Invalid points: empty cells (never "NaN"); the status column says why.
-            if valid {
-                last.push(&mut fmt, &mut buf, INPUT_COLUMNS.len() + c, (q.get)(s));
+            match col {
+                // Invalid points: empty cells (never "NaN"); the status column says why.
+                MapColumn::Quantity(q) => {
+                    if valid {
+                        last.push(&mut fmt, &mut buf, INPUT_COLUMNS.len() + c, (q.get)(s));
+                    }
+                }
+                // A property of the line, not of the point: written whatever the point's
+                // status (empty where the rotor does not run at no load).
+                MapColumn::LoadedStall => {
+                    last.push(&mut fmt, &mut buf, INPUT_COLUMNS.len() + c, line.get(prep, motor, op));
+                }
             }
         }
         buf.push(b'\n');
@@ -347,7 +406,7 @@ impl NumberFormatter {
 fn write_map(
     motor: &Motor,
     grid: &Grid,
-    cols: &[&Quantity],
+    cols: &[MapColumn],
     chunk: u64,
     pool: &rayon::ThreadPool,
     w: &mut dyn Write,

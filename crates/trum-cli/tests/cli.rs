@@ -131,6 +131,7 @@ fn map_columns_rows_and_defaults() {
     let (h, rows) = parse_csv(&std::fs::read_to_string(&out).expect("map written"));
     let mut want = vec!["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status", "warnings"];
     want.extend(trum_core::quantities::QUANTITIES.iter().map(|q| q.name));
+    want.push("loaded_stall_torque_nm");
     assert_eq!(h, want);
     assert_eq!(rows.len(), 12);
     // torque fastest, the drive defaults to the preset's [drive], 200 V and 42 kHz
@@ -661,6 +662,112 @@ fn decode_png(bytes: &[u8]) -> (u32, u32, Vec<u8>) {
     assert_eq!(info.color_type, png::ColorType::Rgb);
     buf.truncate(info.buffer_size());
     (info.width, info.height, buf)
+}
+
+/// A map's statuses agree with its `loaded_stall_torque_nm` column (one value per torque
+/// line): running below it, stopped above it, to the bisection's tolerance. generic60 near
+/// clamping (26.87 N, 6.63 V, 40 456.6 Hz: the rotor-at-rest torque 0.181 N·m, the loaded
+/// motor stops at about 0.06 N·m), a line that clamps at no load (100 N: empty column, no
+/// running point), and trum60a at its drive; chunks of 50 points split the lines.
+#[test]
+fn map_statuses_agree_with_the_loaded_stall_torque_column() {
+    let runs = [
+        ["generic60", "26.87", "0:0.1:101", "6.63", "40456.6"],
+        ["generic60", "100", "0:0.1:101", "6.63", "40456.6"],
+        ["trum60a", "100:500:5", "0:2.5:101", "200", "42000"],
+    ];
+    let (mut lines, mut crossings, mut empty) = (0, 0, 0);
+    for [motor, p, torque, v, f] in runs {
+        let out = ok(&[
+            "map",
+            "--motor",
+            motor,
+            "--preload-n",
+            p,
+            "--torque-nm",
+            torque,
+            "--voltage-v",
+            v,
+            "--frequency-hz",
+            f,
+            "--columns",
+            "stall_torque_nm,loaded_stall_torque_nm",
+            "--chunk-points",
+            "50",
+            "-o",
+            "-",
+        ]);
+        let (h, rows) = parse_csv(&out);
+        assert_eq!(h[6..], ["stall_torque_nm", "loaded_stall_torque_nm"]);
+        for line in rows.chunks(101) {
+            lines += 1;
+            let cell = &line[0][7];
+            assert!(line.iter().all(|r| &r[7] == cell), "{motor} {}: one value per line", line[0][0]);
+            if cell.is_empty() {
+                empty += 1;
+                assert!(
+                    line.iter().all(|r| r[4] != "ok"),
+                    "{motor} {}: runs without a loaded stall torque",
+                    line[0][0]
+                );
+                continue;
+            }
+            let t: f64 = cell.parse().expect("number");
+            for r in line {
+                let tq: f64 = r[1].parse().expect("torque");
+                if tq < t * (1.0 - 1e-6) {
+                    assert_eq!(r[4], "ok", "{motor} {r:?} below {t}");
+                } else if tq > t * (1.0 + 1e-6) {
+                    assert_ne!(r[4], "ok", "{motor} {r:?} above {t}");
+                }
+            }
+            crossings += usize::from(line.iter().any(|r| r[4] != "ok"));
+        }
+    }
+    assert_eq!(lines, 7);
+    assert_eq!(empty, 1, "the 100 N line of generic60 clamps");
+    assert!(crossings >= 5, "{crossings} lines reach their loaded stall torque");
+    // the point: its loaded stall torque is far below the rotor-at-rest torque
+    let out = ok(&[
+        "map",
+        "--motor",
+        "generic60",
+        "--preload-n",
+        "26.87",
+        "--torque-nm",
+        "0",
+        "--voltage-v",
+        "6.63",
+        "--frequency-hz",
+        "40456.6",
+        "--columns",
+        "stall_torque_nm,loaded_stall_torque_nm",
+        "-o",
+        "-",
+    ]);
+    let (_, rows) = parse_csv(&out);
+    let (at_rest, loaded): (f64, f64) = (rows[0][6].parse().expect("at rest"), rows[0][7].parse().expect("loaded"));
+    assert!(loaded < 0.5 * at_rest, "{loaded} against {at_rest}");
+    // the same number as `trum point` reports for the point
+    let point = ok(&[
+        "point",
+        "--motor",
+        "generic60",
+        "--preload-n",
+        "26.87",
+        "--voltage-v",
+        "6.63",
+        "--frequency-hz",
+        "40456.6",
+        "--json",
+    ]);
+    let v: serde_json::Value = point.parse().expect("JSON");
+    assert_eq!(v["loaded_stall_torque_nm"].as_f64(), Some(loaded));
+    let unknown = fails(
+        &["map", "--motor", "generic60", "--preload-n", "100", "--columns", "loaded_stall_torqe_nm", "-o", "-"],
+        1,
+    );
+    assert!(unknown.contains("loaded_stall_torque_nm"), "{unknown}");
 }
 
 /// Near clamping the loaded motor stops far below the rotor-at-rest torque at the no-load

@@ -145,6 +145,53 @@ where
     }
 }
 
+/// Name, unit and meaning of the column maps write beside the point quantities: the load
+/// torque at which the loaded motor stops at the point's preload and drive
+/// ([`crate::criterion::loaded_stall_torque_nm`]). It does not depend on the load torque,
+/// so it is one number per torque line.
+pub const LOADED_STALL_COLUMN: (&str, &str, &str) = (
+    "loaded_stall_torque_nm",
+    "N·m",
+    "load torque at which the loaded motor stops (stall or clamp) at this preload and drive",
+);
+
+/// [`crate::criterion::loaded_stall_torque_nm`] of the torque line through each point, for
+/// map writers: the bisection (about 30 cold solves) runs once per (preload, voltage,
+/// frequency) and is reused while consecutive points stay on that line, which they do
+/// along a map's torque axis ([`Grid::point`]). The value is a cold computation, so it
+/// does not depend on where a chunk starts. NaN where the rotor does not run at no load.
+#[derive(Clone, Debug, Default)]
+pub struct LineStall {
+    /// The line's (preload, voltage, frequency) bits and its value.
+    last: Option<([u64; 3], f64)>,
+}
+
+impl LineStall {
+    /// An empty cache.
+    pub fn new() -> Self {
+        LineStall { last: None }
+    }
+
+    /// The loaded stall torque [N·m] of the line through `op` (its load torque is ignored).
+    pub fn get(&mut self, prepared: &Prepared, motor: &Motor, op: &OperatingPoint) -> f64 {
+        let key = [op.preload_n.to_bits(), op.voltage_v.to_bits(), op.frequency_hz.to_bits()];
+        match self.last {
+            Some((k, v)) if k == key => v,
+            _ => {
+                let v = crate::criterion::loaded_stall_torque_nm(
+                    prepared,
+                    motor,
+                    op.preload_n,
+                    op.voltage_v,
+                    op.frequency_hz,
+                );
+                self.last = Some((key, v));
+                v
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -300,5 +347,86 @@ mod tests {
             }
             assert_eq!(next, len, "len {len} chunk {chunk}");
         }
+    }
+
+    /// A map's statuses agree with its per-line loaded stall torque: along every torque
+    /// line, warm-started as maps solve it and cut into chunks that split lines, a point
+    /// runs (`ok`) below the line's loaded stall torque and not above it (outside the
+    /// bisection's relative 1e-9, widened to 1e-6 for the warm start's tolerance), and a
+    /// line with no loaded stall torque has no running point. Every preset at its drive,
+    /// and generic60 near clamping (26.87 N, 6.63 V, 40 456.6 Hz), where the rotor-at-rest
+    /// torque at no load is about three times the torque at which the loaded motor stops.
+    #[test]
+    fn map_statuses_agree_with_the_loaded_stall_torque_of_their_line() {
+        use crate::solve::Status;
+        let mut lines = 0;
+        let mut far_below = false;
+        // lines whose grid has running points below and stopped points above the torque
+        let mut crossings = 0;
+        let mut cases: Vec<(crate::params::Motor, Grid)> = crate::presets::PRESETS
+            .iter()
+            .map(|preset| {
+                let d = preset.drive().map_or((200.0, 43_000.0), |d| (d.voltage_v, d.frequency_hz));
+                let g = Grid {
+                    preload_n: Axis::linspace(20.0, 600.0, 5),
+                    voltage_v: Axis::linspace(0.5 * d.0, d.0, 2),
+                    frequency_hz: Axis::fixed(d.1),
+                    torque_nm: Axis::linspace(0.0, 3.0, 61),
+                };
+                (preset.motor(), g)
+            })
+            .collect();
+        let generic = crate::presets::find("generic60").expect("generic60").motor();
+        cases.push((
+            generic,
+            Grid {
+                preload_n: Axis::fixed(26.87),
+                voltage_v: Axis::fixed(6.63),
+                frequency_hz: Axis::fixed(40_456.6),
+                torque_nm: Axis::linspace(0.0, 0.1, 201),
+            },
+        ));
+        for (motor, g) in &cases {
+            let p = Prepared::new(motor);
+            // chunks of 37 points: lines of 61 and 201 points cross chunk boundaries
+            for c in 0..chunk_count(g.len(), 37) {
+                let mut line = LineStall::new();
+                solve_range(motor, &p, g, chunk_range(g.len(), 37, c), |_, op, s| {
+                    let t = line.get(&p, motor, op);
+                    assert_eq!(
+                        t.to_bits(),
+                        crate::criterion::loaded_stall_torque_nm(
+                            &p,
+                            motor,
+                            op.preload_n,
+                            op.voltage_v,
+                            op.frequency_hz
+                        )
+                        .to_bits()
+                    );
+                    if op.torque_nm == 0.0 {
+                        lines += 1;
+                        far_below |= s.status == Status::Ok && t < 0.5 * s.stall_torque_nm;
+                    }
+                    let ok = s.status == Status::Ok;
+                    if !ok
+                        && op.torque_nm > t
+                        && op.torque_nm - (g.torque_nm.stop - g.torque_nm.start) / (g.torque_nm.n - 1) as f64 <= t
+                    {
+                        crossings += 1;
+                    }
+                    if t.is_nan() {
+                        assert!(!ok, "{}: {op:?} runs on a line with no loaded stall torque", motor.name);
+                    } else if op.torque_nm < t * (1.0 - 1e-6) {
+                        assert!(ok, "{}: {op:?} is {} below the loaded stall torque {t}", motor.name, s.status);
+                    } else if op.torque_nm > t * (1.0 + 1e-6) {
+                        assert!(!ok, "{}: {op:?} runs above the loaded stall torque {t}", motor.name);
+                    }
+                });
+            }
+        }
+        assert!(lines >= 10 * crate::presets::PRESETS.len(), "{lines} lines");
+        assert!(far_below, "no line where the loaded motor stops far below the rotor-at-rest torque");
+        assert!(crossings >= lines / 2, "{crossings} of {lines} lines cross their loaded stall torque");
     }
 }

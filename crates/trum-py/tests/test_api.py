@@ -138,7 +138,7 @@ def test_registries():
 def test_map_columns_and_values(motor):
     d = trum.map(motor, preload_n=trum.linspace(150, 300, 4), voltage_v=200, frequency_hz=43e3, torque_nm=trum.linspace(0.0, 0.3, 7))
     assert list(d)[:6] == ["preload_n", "torque_nm", "voltage_v", "frequency_hz", "status", "warnings"]
-    assert list(d)[6:] == list(trum.QUANTITY_NAMES)
+    assert list(d)[6:] == list(trum.QUANTITY_NAMES) + ["loaded_stall_torque_nm"]
     assert all(len(v) == 28 for v in d.values())
     assert d["torque_nm"][:7].tolist() == pytest.approx(np.linspace(0, 0.3, 7).tolist())
     res = motor.solve(preload_n=d["preload_n"], torque_nm=d["torque_nm"], voltage_v=200, frequency_hz=43e3)
@@ -148,8 +148,32 @@ def test_map_columns_and_values(motor):
     par = trum.map(motor, preload_n=trum.linspace(150, 300, 4), voltage_v=200, frequency_hz=43e3, torque_nm=trum.linspace(0.0, 0.3, 7), parallel=True)
     for k in trum.QUANTITY_NAMES:
         np.testing.assert_array_equal(par[k], d[k])
+    np.testing.assert_array_equal(par["loaded_stall_torque_nm"], d["loaded_stall_torque_nm"])
+    assert "loaded_stall_torque_nm" not in trum.map(motor, preload_n=150, torque_nm=0.1, loaded_stall=False)
     pd = pytest.importorskip("pandas")
-    assert pd.DataFrame(d).shape == (28, 6 + len(trum.QUANTITY_NAMES))
+    assert pd.DataFrame(d).shape == (28, 7 + len(trum.QUANTITY_NAMES))
+
+
+def test_map_status_agrees_with_the_loaded_stall_torque():
+    # generic60 near clamping: at 26.87 N, 6.63 V, 40 456.6 Hz the rotor-at-rest torque at
+    # no load is about three times the load at which the loaded motor stops; at 100 N the
+    # stator clamps (no loaded stall torque, no running point)
+    g = trum.Motor("generic60")
+    t = trum.linspace(0.0, 0.1, 201)
+    d = trum.map(g, preload_n=[26.87, 100.0], voltage_v=6.63, frequency_hz=40456.6, torque_nm=t)
+    loaded = d["loaded_stall_torque_nm"]
+    # one value per line
+    np.testing.assert_array_equal(loaded.reshape(2, 201), np.repeat(loaded[::201, None], 201, axis=1))
+    first = loaded[0]
+    assert 0 < first < 0.5 * d["stall_torque_nm"][0], (first, d["stall_torque_nm"][0])
+    assert np.isnan(loaded[201]) and not np.any(d["status"][201:] == "ok")
+    ok = d["status"] == "ok"
+    tq = d["torque_nm"]
+    assert np.all(ok[tq < loaded * (1 - 1e-6)]) and not np.any(ok[tq > loaded * (1 + 1e-6)])
+    assert ok.any() and not ok.all()
+    # explicit (unevenly spaced) values are solved point by point: the same line values
+    u = trum.map(g, preload_n=[26.87, 100.0], voltage_v=6.63, frequency_hz=40456.6, torque_nm=[0.0, 0.001, 0.08])
+    np.testing.assert_array_equal(u["loaded_stall_torque_nm"], np.repeat(loaded[::201], 3))
 
 
 @pytest.mark.skipif(not os.environ.get("TRUM_BIN"), reason="set TRUM_BIN to a trum CLI binary to compare with it")
@@ -237,7 +261,7 @@ def test_tables_and_reprs(motor):
     pd = pytest.importorskip("pandas")
     d = trum.map(motor, preload_n=[150, 250, 350], torque_nm=trum.linspace(0, 0.6, 7), voltage_v=200, frequency_hz=43e3)
     df = d.to_pandas()
-    assert df.shape == (21, 6 + len(trum.QUANTITY_NAMES)) and str(df["status"].dtype) == "category"
+    assert df.shape == (21, 7 + len(trum.QUANTITY_NAMES)) and str(df["status"].dtype) == "category"
     assert d.shape == (3, 1, 1, 7) and d.swept == ["preload_n", "torque_nm"]
     assert d.fixed == {"voltage_v": 200.0, "frequency_hz": 43e3}
     text = repr(d)

@@ -37,6 +37,21 @@ def test_max_points_must_be_a_whole_number_of_at_least_one(motor, bad):
         motor.solve(preload_n=250, voltage_v=200, frequency_hz=43e3, max_points=bad)
 
 
+def test_a_limit_beyond_the_cores_counter_is_no_limit(motor):
+    for big in (2**64, 10**30):
+        assert trum.map(motor, preload_n=[150, 250], voltage_v=200, frequency_hz=43e3, max_points=big)["status"].size == 2
+        assert motor.solve(preload_n=[150, 250], voltage_v=200, frequency_hz=43e3, max_points=big).status.size == 2
+
+
+def test_a_masked_map_axis_is_refused_naming_the_axis_and_the_entries(motor):
+    p = np.ma.masked_array([100.0, 200.0, 300.0], mask=[False, True, False])
+    with pytest.raises(trum.InputError, match=r"^preload_n: masked entries \(at \[1\]\)"):
+        trum.map(motor, preload_n=p, voltage_v=200, frequency_hz=43e3)
+    # nothing masked: the values
+    d = trum.map(motor, preload_n=np.ma.masked_array([100.0, 300.0], mask=False), voltage_v=200, frequency_hz=43e3)
+    assert d["preload_n"].tolist() == [100.0, 300.0]
+
+
 def test_masked_entries_are_invalid_points_not_solved(motor):
     p = np.ma.masked_array([200.0, -5.0, 300.0], mask=[False, True, False])
     r = motor.solve(preload_n=p, voltage_v=200, frequency_hz=43e3)
@@ -113,3 +128,24 @@ if given is not None:
         m = trum.Motor.from_dict({"preset": "generic60", "name": name})
         assert pickle.loads(pickle.dumps(m)).name == name
         assert trum.Motor.from_toml_str(m.to_toml()).name == name
+
+    @settings(max_examples=25, deadline=None)
+    @given(
+        st.sampled_from(["trum60a", "trum60-qut", "generic60"]),
+        st.floats(min_value=5.0, max_value=600.0),
+        st.floats(min_value=5.0, max_value=300.0),
+        st.floats(min_value=38e3, max_value=46e3),
+    )
+    def test_map_status_agrees_with_its_loaded_stall_torque(preset, preload, voltage, frequency):
+        # along a torque line: ok below the line's loaded stall torque, not ok above it
+        m = trum.Motor(preset)
+        d = trum.map(m, preload_n=preload, voltage_v=voltage, frequency_hz=frequency,
+                     torque_nm=trum.linspace(0.0, 3.0, 31))
+        t = float(d["loaded_stall_torque_nm"][0])
+        assert np.all(d["loaded_stall_torque_nm"] == t) or np.isnan(d["loaded_stall_torque_nm"]).all()
+        ok = d["status"] == "ok"
+        if np.isnan(t):
+            assert not ok.any()
+        else:
+            assert ok[d["torque_nm"] < t * (1 - 1e-6)].all()
+            assert not ok[d["torque_nm"] > t * (1 + 1e-6)].any()

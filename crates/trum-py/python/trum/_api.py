@@ -91,6 +91,8 @@ class MapResult(dict):
         swept = self.swept
         keep = [i for i, a in enumerate(_NESTING) if a in swept]
         units = {q.name: (q.unit, q.doc) for q in quantities()}
+        units["loaded_stall_torque_nm"] = (
+            "N·m", "load torque at which the loaded motor stops (stall or clamp) at this preload and drive")
         axis_units = {"preload_n": "N", "voltage_v": "V", "frequency_hz": "Hz", "torque_nm": "N·m"}
         coords: Dict[str, Any] = {}
         for a in _NESTING:
@@ -201,6 +203,7 @@ def map(  # noqa: A001 - the CLI's name for it
     torque_nm: AxisSpec = 0.0,
     max_points: int = 20_000_000,
     parallel: Optional[bool] = None,
+    loaded_stall: bool = True,
 ) -> MapResult:
     """A full-factorial map over preload × voltage × frequency × torque, as ``trum map``
     computes it. Each axis is a number or explicit values (a list, a NumPy array, a
@@ -211,8 +214,15 @@ def map(  # noqa: A001 - the CLI's name for it
 
     Returns a :class:`MapResult`: flat columns ``{preload_n, torque_nm, voltage_v,
     frequency_hz, status, warnings, <quantities>}`` (``warnings``: the motor's ``[limits]``
-    keys a point exceeds, ``;``-joined, "" when none, as ``trum map`` writes them); points run torque fastest, then frequency,
-    voltage, preload. When every axis is evenly spaced the grid is solved as ``trum map``
+    keys a point exceeds, ``;``-joined, "" when none, as ``trum map`` writes them), then
+    ``loaded_stall_torque_nm``: the load torque at which the loaded motor stops (stall or
+    clamp) on the point's torque line, as ``trum map`` and ``trum point`` report it. A point
+    is ``ok`` below it and not above it; ``stall_torque_nm`` (the rotor-at-rest torque at
+    the point's own amplitude) can be far above it near clamping. It is one bisection of
+    about 30 solves per (preload, voltage, frequency), shared along the torque axis; NaN
+    where the rotor does not run at no load; ``loaded_stall=False`` leaves it out (a map
+    with few torque values per line then costs several times less). Points run torque
+    fastest, then frequency, voltage, preload. When every axis is evenly spaced the grid is solved as ``trum map``
     solves it (warm-started in the same fixed chunks: the CLI's numbers bit for bit, not
     depending on threads); other values are solved point by point from a cold start, as
     ``Motor.solve`` does. Both agree within the solver tolerance.
@@ -250,6 +260,11 @@ def map(  # noqa: A001 - the CLI's name for it
     out["status"] = _STATUS[codes]
     out["warnings"] = warning_words(d["warning_code"])
     out.update(q)
+    if loaded_stall:
+        # one value per torque line, repeated along the torque axis (the fastest)
+        p, v, f = np.meshgrid(ax["preload_n"], ax["voltage_v"], ax["frequency_hz"], indexing="ij")
+        lines = _trum.loaded_stall_lines(m, p.ravel(), v.ravel(), f.ravel(), parallel=parallel)
+        out["loaded_stall_torque_nm"] = np.repeat(lines, ax["torque_nm"].size)
     out.axes = ax
     out.motor = m.name
     out.effects = m.effects

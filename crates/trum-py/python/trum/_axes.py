@@ -52,6 +52,12 @@ def values(name: str, spec: Any) -> np.ndarray:
         return np.array([float(spec)])
     if isinstance(spec, (str, bytes)) or spec is None:
         raise InputError(f"{name}: expected a number or a list/array of numbers, got {spec!r}")
+    if isinstance(spec, np.ma.MaskedArray) and np.ma.is_masked(spec):
+        # a masked entry has no value; a grid point made of it would be computed from the
+        # data underneath the mask
+        at = np.flatnonzero(np.ma.getmaskarray(spec)).tolist()
+        raise InputError(f"{name}: masked entries (at {at[:10]}{' ...' if len(at) > 10 else ''}) have no value to "
+                         "map; drop them (spec.compressed()) or fill them")
     try:
         arr = np.asarray(spec)
     except (TypeError, ValueError):

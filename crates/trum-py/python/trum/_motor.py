@@ -84,7 +84,8 @@ def _max_points(max_points: object) -> int:
         raise ValueError(f"max_points must be a whole number >= 1, got {max_points!r}")
     if max_points < 1:
         raise ValueError(f"max_points must be a whole number >= 1, got {max_points}")
-    return int(max_points)
+    # a limit beyond what the core counts in (u64) is no limit: no point count reaches it
+    return min(int(max_points), 2**64 - 1)
 
 
 class Motor:

@@ -66,6 +66,13 @@ def map_grid(
     max_points: int = 20_000_000,
     parallel: Optional[bool] = None,
 ) -> Dict[str, Any]: ...
+def loaded_stall_lines(
+    motor: Motor,
+    preload_n: npt.NDArray[np.float64],
+    voltage_v: npt.NDArray[np.float64],
+    frequency_hz: npt.NDArray[np.float64],
+    parallel: Optional[bool] = None,
+) -> npt.NDArray[np.float64]: ...
 def criterion(
     motor: Motor,
     voltage_v: Optional[float] = None,
