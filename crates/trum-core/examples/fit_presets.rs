@@ -172,7 +172,7 @@ fn targets_trum60a(m: &Motor, quick: bool) -> Vec<Target> {
             let (_, frac) = region_overlap(r.region_n, (260.0, 320.0));
             t.push(("stall-torque peak [N]".into(), 260.0, peak(&xs, &st), 20.0));
             t.push(("max-efficiency peak [N]".into(), 320.0, peak(&xs, &ef), 20.0));
-            // the target: the region covers at least half of the paper's (no credit
+            // the target: the region covers at least half of the paper's (no credit
             // above half, a steep cost below it)
             t.push(("region overlap with 260-320 N [-] (at least 0.5)".into(), 0.5, frac.min(0.5), 0.05));
             // falling fluctuation: the ratio of the std at 400 N to that at 150 N below 1
