@@ -129,6 +129,32 @@ def png_plot(path, name, xcol, ycol, model, paper_pts):
     print(f"wrote {os.path.relpath(path, ROOT)}", file=sys.stderr)
 
 
+def budget_plot(chen, paper_c):
+    """Why the maximum efficiency falls with preload (docs/PRESETS.md): trum's, the same
+    with a constant loss floor added to every input, and with Chen et al. 2020 eq. 9's
+    viscous loss law in place of trum's interface loss, from the `efficiency_budget`
+    example (`cargo build --release -p trum-core --example efficiency_budget`)."""
+    exe = os.environ.get("TRUM_BUDGET", os.path.join(ROOT, "target", "release", "examples", "efficiency_budget"))
+    if not os.path.exists(exe):
+        print(f"skipped papers_trum60a_efficiency_budget.svg: no {exe}", file=sys.stderr)
+        return
+    print("$ efficiency_budget trum60a 200 42000", file=sys.stderr)
+    text = subprocess.run([exe, "trum60a", "200", "42000"], check=True, capture_output=True, text=True).stdout
+    rows = [line.replace("|", " ").split() for line in text.splitlines()]
+    rows = [r for r in rows if len(r) == 15 and r[0].replace(".", "").isdigit()]
+    f = [float(r[0]) for r in rows]
+    p_out, p_in = [float(r[6]) for r in rows], [float(r[12]) for r in rows]
+    curves = [("trum60a", f, [o / i for o, i in zip(p_out, p_in)], "#1f5fa8")]
+    for p0, colour in ((2.0, "#5dade2"), (5.0, "#85c1e9")):
+        curves.append((f"+ {p0:g} W floor", f, [o / (i + p0) for o, i in zip(p_out, p_in)], colour))
+    curves.append(("eq. 9 loss law", f, [float(r[14]) for r in rows], "#27ae60"))
+    svg_plot(os.path.join(OUT, "papers_trum60a_efficiency_budget.svg"),
+             "TRUM60A at 200 V, 42 kHz: maximum efficiency and its losses",
+             "preload [N]", "maximum efficiency [-]", curves,
+             vlines=[("Chen 2020: peak 320 N", float([r for r in chen if r["quantity"] == "max_efficiency_peak_n"][0]["value"]), paper_c)],
+             ylim=(0.0, 0.55))
+
+
 def num(rows, col):
     return [float(r[col]) if r[col] not in ("", "nan", "NaN") else float("nan") for r in rows]
 
@@ -157,6 +183,7 @@ def main():
     ef = num(opt, "max_efficiency")
     png_plot(os.path.join(OUT, "papers_trum60a_max_efficiency.png"), "TRUM60A 200 V 42 kHz (paper 1 = Chen 2020 peak)", "preload_n", "max_efficiency",
              list(zip(f, ef)), [(320.0, 0.0), (320.0, max(y for y in ef if y == y))])
+    budget_plot(chen, paper_c)
     svg_plot(os.path.join(OUT, "papers_trum60a_region.svg"),
              "TRUM60A at 200 V, 42 kHz: criterion score and optimum region",
              "preload [N]", "score [-]",
