@@ -358,7 +358,10 @@ impl<'a> Scorer<'a> {
                 Ok(c) if !c.abandoned => c.motor.clone(),
                 _ => from.clone(),
             };
-            for v in scan::valleys(&[from], &fit_motor, rows, second) {
+            // (the best valley only, its fit resumed from the lead's calibrated parameters:
+            // a pair's fits are many, and a restart with a slow effect such as
+            // thermal_drift's passes cost a combined campaign a minute)
+            for v in scan::valleys(&[from], &fit_motor, rows, second).into_iter().take(1) {
                 let mut wide = params.clone();
                 scan::widen(&mut wide, second, &v.values);
                 let mut s2 = v.base.clone();
@@ -367,7 +370,7 @@ impl<'a> Scorer<'a> {
                     .params(&wide)
                     .options(&opts.fit)
                     .adding(added)
-                    .start(Start::Restart)
+                    .start(Start::Extending(IRLS_START_RTOL))
                     .run()
                 {
                     let current = match &cal {
