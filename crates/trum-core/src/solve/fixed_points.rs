@@ -597,7 +597,7 @@ pub(super) fn temperature_rise_for_drift(p: &Prepared, loss_w: f64, elapsed_s: f
 /// fit of Press et al. (Numerical Recipes, 2nd ed., §6.2, `erfcc`; relative error below
 /// 1.2e-7), written without the e^(−z²) factor so that it cannot underflow. 1 at z = 0,
 /// falling as 1/(z·√π) for large z.
-fn erfcx(z: f64) -> f64 {
+pub(super) fn erfcx(z: f64) -> f64 {
     let t = 1.0 / (1.0 + 0.5 * z);
     let poly = -1.265_512_23
         + t * (1.000_023_68
