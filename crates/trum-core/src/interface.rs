@@ -1032,8 +1032,10 @@ pub(crate) fn interface_law(p: &Prepared, d: &Drive, ct: &Contact) -> Law {
         }
     }
     if p.truth_b && law.radial_ratio > 0.0 {
-        // the second truth family: radial slip that grows with the preload
-        law.radial_ratio = p.law.radial_ratio * (d.f_n / 200.0).sqrt();
+        // the second truth family: radial slip that grows with the width of a Hertzian
+        // line contact (∝ √F_N) until the contact spans the tooth face at 300 N, then
+        // stays: a kink no power of the preload follows
+        law.radial_ratio = p.law.radial_ratio * (d.f_n.max(0.0) / 300.0).sqrt().min(1.0);
     }
     if !p.truth && p.radial_exponent != 0.0 && law.radial_ratio > 0.0 {
         law.radial_ratio = preload_grown_radial_ratio(p.law.radial_ratio, p.radial_exponent, d.f_n);

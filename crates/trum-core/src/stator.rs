@@ -129,7 +129,11 @@ pub(crate) fn softening_per_w2(p: &Prepared, d: &Drive) -> f64 {
     let growth = if p.truth_b {
         (0.8 * p.beta_gain * d.f_n).exp()
     } else if p.truth {
-        (1.0 + p.beta_gain * d.f_n).powf(1.3)
+        // the first truth family: a Hertzian contact F = c·δ^(3/2) expanded about its
+        // static compression δ0 has a cubic term ∝ δ0^(−3/2) ∝ 1/F_N (Johnson 1985,
+        // Contact Mechanics, the Hertz solution): the contact's share of the softening
+        // falls as it is pressed, where every member of (1 + g·F_N)^n, g ≥ 0, grows
+        1.0 + p.beta_gain * TRUTH_SOFTENING_REFERENCE_N.powi(2) / d.f_n.max(20.0)
     } else if p.beta_exponent != 1.0 {
         hertz_preload_growth(p.beta_gain, p.beta_exponent, d.f_n)
     } else {
@@ -137,6 +141,10 @@ pub(crate) fn softening_per_w2(p: &Prepared, d: &Drive) -> f64 {
     };
     0.75 * p.beta * growth
 }
+
+/// The preload [N] at which the contact's share of the first truth family's softening is
+/// g·F (as in the candidate); it falls as 1/F_N about it (floored at 20 N).
+const TRUTH_SOFTENING_REFERENCE_N: f64 = 200.0;
 
 /// `hertz_softening`'s preload family: the cubic coefficient grows as (1 + g·F_N)^n [-]. The
 /// Hertzian driving-circuit paper (2022, eq. 2-4) takes the contact's cubic term in

@@ -347,6 +347,70 @@ impl<'a> Scorer<'a> {
                     .ok();
             }
         }
+        // A pair's second effect is searched as a single one is: over its whole documented
+        // strength and at its held shapes' levels, from the lead's fit where the pair
+        // starts. The pair fit itself holds that shape at its typical value, the plainest
+        // form, which the data's form of the second effect need not be near.
+        let pair_at_noise = cal.as_ref().is_ok_and(|c| !c.abandoned && c.chi2 <= 1.5 * n_read as f64);
+        if nested.is_some() && effects.len() == 2 && !pair_at_noise {
+            let second = effects[1];
+            let fit_motor = match &cal {
+                Ok(c) if !c.abandoned => c.motor.clone(),
+                _ => from.clone(),
+            };
+            // (the best valley only, its fit resumed from the lead's calibrated parameters:
+            // a pair's fits are many, and a restart with a slow effect such as
+            // thermal_drift's passes cost a combined campaign a minute)
+            for v in scan::valleys(&[from], &fit_motor, rows, second).into_iter().take(1) {
+                let mut wide = params.clone();
+                scan::widen(&mut wide, second, &v.values);
+                let mut s2 = v.base.clone();
+                s2.effects.set(second, &v.values);
+                if let Ok(c2) = Calibration::builder(&s2, rows)
+                    .params(&wide)
+                    .options(&opts.fit)
+                    .adding(added)
+                    .start(Start::Extending(IRLS_START_RTOL))
+                    .run()
+                {
+                    let current = match &cal {
+                        Ok(c) if !c.abandoned => c.chi2,
+                        _ => f64::INFINITY,
+                    };
+                    if !c2.abandoned && c2.chi2 < current {
+                        cal = Ok(c2);
+                    }
+                }
+            }
+        }
+        // A strength that ends on its fit's own bound (8 × typical, or the bound the scan
+        // widened) inside the documented range is fenced in, not where the data put it:
+        // the bound moves out (3 ×, within the range) and the fit resumes from its end,
+        // while that lowers χ² (at most `FENCE_RELEASES` times).
+        let mut params = params;
+        for _ in 0..FENCE_RELEASES {
+            let Ok(c) = cal.as_ref() else { break };
+            if c.abandoned || c.chi2 >= base_cal.chi2 {
+                break;
+            }
+            let mut wide = params.clone();
+            if !release_fences(&mut wide, &c.params, added) {
+                break;
+            }
+            match Calibration::builder(&c.motor, rows)
+                .params(&wide)
+                .options(&opts.fit)
+                .adding(added)
+                .start(Start::Extending(IRLS_START_RTOL))
+                .run()
+            {
+                Ok(c2) if !c2.abandoned && c2.chi2 < c.chi2 - 1.0 => {
+                    cal = Ok(c2);
+                    params = wide;
+                }
+                _ => break,
+            }
+        }
         let mut in_sample = 0;
         let (evidence, fitted, preds, fitted_motor) = match cal {
             // Nested models: the effect at zero strength is the baseline, so a fit that ends
@@ -464,6 +528,33 @@ pub(super) fn added_near_zero(params: &[FitParam], fitted: &[FittedParam], added
     params.iter().zip(fitted).any(|(fp, p)| {
         matches!(fp.param, ParamRef::Effect(e, 0) if added.contains(&e)) && fp.lo == 0.0 && p.value <= 0.01 * fp.hi
     })
+}
+
+/// Most times a fit's fenced strengths are released (each × 3: 8 × typical becomes at
+/// most 216 ×, within the documented range).
+const FENCE_RELEASES: usize = 3;
+
+/// Moves out the fit bound of every strength of the `added` effects that the fit
+/// `fitted` (aligned with `params`) ended on, where the bound lies inside the effect's
+/// documented range: to 3 × the bound, at most the range's end. True when one moved.
+fn release_fences(params: &mut [FitParam], fitted: &[FittedParam], added: &[Effect]) -> bool {
+    let mut moved = false;
+    for (fp, p) in params.iter_mut().zip(fitted) {
+        let ParamRef::Effect(e, i) = fp.param else { continue };
+        let info = &e.info().params[i];
+        if !added.contains(&e) || info.shape || !p.at_bound {
+            continue;
+        }
+        let span = fp.hi - fp.lo;
+        if fp.hi > 0.0 && fp.hi < info.max && p.value >= fp.hi - 0.01 * span {
+            fp.hi = (3.0 * fp.hi).min(info.max);
+            moved = true;
+        } else if fp.lo < 0.0 && fp.lo > info.min && p.value <= fp.lo + 0.01 * span {
+            fp.lo = (3.0 * fp.lo).max(info.min);
+            moved = true;
+        }
+    }
+    moved
 }
 
 /// The fraction of the nominal motor's χ² a strong-effect probe must leave at most to
@@ -598,6 +689,52 @@ mod tests {
     use super::super::tests::{quick, sag_data};
     use super::super::DiagnoseOptions;
     use super::*;
+
+    /// A strength the fit ended on at its own bound is released threefold, within the
+    /// documented range; a strength inside its bounds, a shape, an effect the fit does not
+    /// add, and a bound at the range's end stay.
+    #[test]
+    fn fenced_strengths_are_released_within_their_documented_range() {
+        let on_bound = |params: &[FitParam], which: usize| -> Vec<FittedParam> {
+            params
+                .iter()
+                .enumerate()
+                .map(|(k, fp)| FittedParam {
+                    name: String::new(),
+                    value: if k == which { fp.hi } else { 0.5 * (fp.lo + fp.hi) },
+                    std_error: f64::NAN,
+                    at_bound: k == which,
+                    identifiable: true,
+                    prior_rel_sd: None,
+                })
+                .collect()
+        };
+        let e = Effect::HertzSoftening;
+        let mut params = effect_params(e);
+        let hi = params[0].hi;
+        assert!((hi - 8e18).abs() < 1e6, "{hi}");
+        let fitted = on_bound(&params, 0);
+        assert!(!release_fences(&mut params.clone(), &fitted, &[Effect::VoltageSag]));
+        assert!(release_fences(&mut params, &fitted, &[e]));
+        assert_eq!((params[0].hi, params[1].hi), (3.0 * hi, effect_params(e)[1].hi));
+        // inside its bounds: stays
+        let inside = on_bound(&params, usize::MAX);
+        assert!(!release_fences(&mut params, &inside, &[e]));
+        // radial_friction's fit bound is its documented end (3): nothing to release
+        let mut radial = effect_params(Effect::RadialFriction);
+        assert!(!release_fences(&mut radial.clone(), &on_bound(&radial, 0), &[Effect::RadialFriction]));
+        // the range's end is never passed
+        let mut vs = effect_params(Effect::VoltageSag);
+        for _ in 0..10 {
+            let f = on_bound(&vs, 0);
+            release_fences(&mut vs, &f, &[Effect::VoltageSag]);
+        }
+        assert_eq!(vs[0].hi, Effect::VoltageSag.info().params[0].max);
+        radial[0].hi = 1.0;
+        let fenced = on_bound(&radial, 0);
+        assert!(release_fences(&mut radial, &fenced, &[Effect::RadialFriction]));
+        assert_eq!(radial[0].hi, 3.0);
+    }
 
     /// Preload-torque data with a voltage sag: without a time series `thermal_drift` moves
     /// no prediction, so it is untestable and ranked with the baseline's fit and its

@@ -246,9 +246,13 @@ fn knee_levels(base: &Motor, rows: &[ObservedRow]) -> Vec<f64> {
 /// to move (three times the value, within the valid range).
 pub(crate) fn widen(params: &mut [FitParam], e: Effect, values: &[f64]) {
     for fp in params.iter_mut() {
+        // (a pair's fit also holds the other effect's parameters: only e's are widened)
         let ParamRef::Effect(f, i) = fp.param else { continue };
+        if f != e {
+            continue;
+        }
         let p = &e.info().params[i];
-        if f != e || p.shape {
+        if p.shape {
             continue;
         }
         let v = values[i];
@@ -324,5 +328,18 @@ mod tests {
         assert_eq!(params[0].hi, 5.0);
         // the shape parameter keeps its whole range
         assert_eq!((params[1].lo, params[1].hi), (0.0, 1.0));
+        // in a pair's parameters only the named effect's strengths move, whatever the other
+        // effect's parameter count
+        let mut pair = crate::calibrate::effect_params(Effect::ThermalDrift);
+        pair.extend(crate::calibrate::effect_params(Effect::VoltageSag));
+        let before: Vec<(f64, f64)> = pair.iter().map(|p| (p.lo, p.hi)).collect();
+        widen(&mut pair, Effect::VoltageSag, &[5000.0, 0.0]);
+        for (k, p) in pair.iter().enumerate() {
+            if matches!(p.param, ParamRef::Effect(Effect::VoltageSag, 0)) {
+                assert_eq!(p.hi, 15000.0);
+            } else {
+                assert_eq!((p.lo, p.hi), before[k], "{k}");
+            }
+        }
     }
 }

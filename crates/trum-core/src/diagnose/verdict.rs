@@ -122,7 +122,9 @@ pub(super) fn decide(
         if !supported(bp) {
             return false;
         }
-        let Some(single) = best_single.as_ref() else { return closes(bp) };
+        // (without a supported single, a supported pair; the callers ask whether it closes
+        // the gap or a material part of it)
+        let Some(single) = best_single.as_ref() else { return true };
         if bp.evidence <= single.evidence + 5.0
             || bp.heldout_nrmse_after > single.heldout_nrmse_after
             || bp.heldout_chi2_after > single.heldout_chi2_after
@@ -135,8 +137,25 @@ pub(super) fn decide(
         let real = |before: &[f64], after: &[f64]| bootstrap_shrink(before, after, opts.bootstrap, opts.seed).0 > 0.0;
         (gain_nrmse >= PAIR_GAIN && real(&hs.2, &hp.2)) || (gain_chi2 >= PAIR_GAIN && real(&hs.3, &hp.3))
     };
-    match best_pair.filter(|bp| pair_beats_single(bp) && closes(bp)) {
+    // A pair that beats the best single but does not close the gap is still the best
+    // partial explanation where no single closes it: named with `complete: false`, as a
+    // single would be, when it closes a material part (the data's forms of the two
+    // effects may lie outside their families).
+    let beating = best_pair.filter(|bp| pair_beats_single(bp));
+    let partial_pair = beating.as_ref().filter(|bp| !closes(bp) && !single_closes && material(bp)).cloned();
+    match beating.filter(|bp| closes(bp)).or(partial_pair.clone()) {
         Some(bp) => {
+            if partial_pair.is_some() {
+                complete = false;
+                notes.push(format!(
+                    "{} closes {} % of the held-out gap ({} % of its part beyond the noise) but not all of it, \
+                     more than any single effect: the data's forms of the effects may differ from every \
+                     form their candidates take, or something else remains",
+                    bp.effect,
+                    rounded(100.0 * bp.shrink),
+                    rounded(100.0 * excess_shrink(&bp))
+                ));
+            }
             // name the stronger single effect first
             let ev = |n: &str| ranking.iter().find(|r| r.effect == n).map(|r| r.evidence).unwrap_or(f64::NEG_INFINITY);
             let mut ns: Vec<&str> = bp.effect.split('+').collect();
@@ -225,6 +244,10 @@ mod tests {
         RankEntry { evidence, shrink, ..ranked(effect, chi2, 0.4 * (1.0 - shrink)) }
     }
 
+    fn none_preds() -> BTreeMap<String, Vec<Vec<f64>>> {
+        BTreeMap::new()
+    }
+
     /// With a baseline NRMSE of 0.4 and noise 0.05: the tests of an entry, and the verdict
     /// they give (a closing single; a material but incomplete one; a sliver, which leaves
     /// the gap unexplained with a partial effect; a second single as good, confounded).
@@ -266,6 +289,31 @@ mod tests {
             (v.verdict.as_str(), v.complete, v.partial.as_deref()),
             ("unexplained", false, Some("eccentricity"))
         );
+
+        // no supported single, and a supported pair that closes a material part but not
+        // all of the gap: the pair, incomplete, with a note; the same pair closing it: complete
+        let weak_single = entry("radial_friction", 4.0, 0.3, 5.0);
+        let pair = entry("radial_friction+thermal_drift", 200.0, 0.3, 5.0);
+        assert!(tests.material(&pair) && !tests.closes(&pair));
+        let v = decide(
+            &ctx,
+            &tests,
+            &mut [pair.clone(), weak_single.clone()],
+            &none_preds(),
+            None,
+            false,
+            Some(pair),
+            &none,
+        );
+        assert_eq!((v.verdict.as_str(), v.complete, v.notes.len()), ("radial_friction+thermal_drift", false, 1));
+        let closing_pair = entry("radial_friction+thermal_drift", 200.0, 0.8, 1.5);
+        let v =
+            decide(&ctx, &tests, &mut [closing_pair.clone()], &none_preds(), None, false, Some(closing_pair), &none);
+        assert_eq!((v.verdict.as_str(), v.complete), ("radial_friction+thermal_drift", true));
+        // a pair that is not material: unexplained
+        let sliver_pair = entry("radial_friction+thermal_drift", 200.0, 0.05, 8.0);
+        let v = decide(&ctx, &tests, &mut [sliver_pair.clone()], &none_preds(), None, false, Some(sliver_pair), &none);
+        assert_eq!(v.verdict, "unexplained");
 
         // no supported entry (evidence below 5): unexplained without a partial effect
         let weak = entry("eccentricity", 4.0, 0.8, 1.5);

@@ -9,8 +9,11 @@ use std::f64::consts::PI;
 /// (crate::contact::contact_normal_stiffness_n_per_m); every additive quantity is averaged
 /// over the revolution with the time spent at each angle (∝ 1/Ω), so the energy balance
 /// still holds, and the speed's time-weighted standard deviation is reported. The first
-/// truth family adds a twice-per-revolution component of 30 % (tilted as well as offset
-/// rotor), the second a three-lobed one of 40 %.
+/// truth family adds a twice-per-revolution component of 30 % out of phase with the offset
+/// (a rotor face tilted about an axis at 45° to the offset), the second clips the ripple
+/// at half its peak (the shaft reaches its bearing's axial play, which then carries the
+/// excess force, so the contact's mean preload over a revolution drops too). Neither is a
+/// member of the harmonic family [`runout_shape`]: that one is even in φ with a zero mean.
 /// `solve_at(op, guess)` is the steady-state solve at each preload (the nominal one first,
 /// then the ripple samples in order): [`solve_effects`] in [`solve_prepared`];
 /// crate::sensitivity records those solves, or passes linearised ones.
@@ -34,24 +37,26 @@ pub(crate) fn eccentric_average_with(
         (p.runout_m / (1.0 / motor.assembly.axial_spring_stiffness_n_per_m + 1.0 / kz)).min(0.9 * op.preload_n);
     let mut acc: Option<Solution> = None;
     let mut tsum = 0.0;
-    // Both ripple shapes are even in φ, so sample j and SAMPLES − j see the same preload:
-    // solve j = 0 ..= SAMPLES/2 and count the inner ones twice (5 solves instead of 8, 4 for
-    // the candidate form).
-    let mut speeds = [(0.0, 0.0); SAMPLES / 2 + 1];
+    // A ripple even in φ has sample j and SAMPLES − j at the same preload: solve j = 0 ..=
+    // SAMPLES/2 and count the inner ones twice (5 solves instead of 8, 4 for the candidate
+    // form). The first truth family's is not even: all 8.
+    let even = !p.truth || p.truth_b;
+    let solved = if even { SAMPLES / 2 + 1 } else { SAMPLES };
+    let mut speeds = [(0.0, 0.0); SAMPLES];
     let mut prev = nominal.clone();
-    for (j, sp) in speeds.iter_mut().enumerate() {
+    for (j, sp) in speeds.iter_mut().enumerate().take(solved) {
         let phi = 2.0 * PI * j as f64 / SAMPLES as f64;
         let shape = if p.truth_b {
-            // the second truth family: a three-lobed runout besides the offset
-            (phi.cos() + 0.4 * (3.0 * phi).cos()) / 1.4
+            // the second truth family: the ripple clipped at half its peak
+            phi.cos().min(0.5)
         } else if p.truth {
-            (phi.cos() + 0.3 * (2.0 * phi).cos()) / 1.3
+            (phi.cos() + 0.3 * (2.0 * phi).sin()) / 1.3
         } else if p.runout_harmonics != [0.0, 0.0] {
             runout_shape(phi, p.runout_harmonics)
         } else {
             phi.cos()
         };
-        let count = if j == 0 || j == SAMPLES / 2 { 1.0 } else { 2.0 };
+        let count = if !even || j == 0 || j == SAMPLES / 2 { 1.0 } else { 2.0 };
         let mut o = *op;
         o.preload_n = op.preload_n + ripple * shape;
         // at a quarter turn the candidate's ripple is zero: the nominal solve is that sample
@@ -77,7 +82,7 @@ pub(crate) fn eccentric_average_with(
     }
     let mut out = scale_solution(&acc.unwrap_or(nominal), 1.0 / tsum);
     let mean = out.speed_rad_s;
-    let var: f64 = speeds.iter().map(|&(w, n)| n * (w - mean).powi(2) / w).sum::<f64>() / tsum;
+    let var: f64 = speeds.iter().filter(|s| s.1 > 0.0).map(|&(w, n)| n * (w - mean).powi(2) / w).sum::<f64>() / tsum;
     out.speed_std_rpm = var.sqrt() * RAD_S_TO_RPM;
     out.status = Status::Ok;
     out.efficiency =

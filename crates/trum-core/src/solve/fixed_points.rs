@@ -569,18 +569,44 @@ pub(crate) fn state_map(
 const BRACKET_AFTER: usize = 30;
 
 /// Temperature rise driving `thermal_drift`: Chen et al. 2020 eq. 11 (one lumped capacity)
-/// for the candidate form; the truth form adds a fast near-interface node (40 % of the rise
-/// with a tenth of the time constant), as the paper's sensor behind the teeth sees.
+/// for the candidate form, and its two-node family; the truth forms rise in shapes no sum
+/// of decaying exponentials with positive shares takes (docs/EFFECTS.md):
+/// - first family: two capacities in series, the stator's bulk (time constant τ) warmed
+///   through the layer where the losses are made (τ/4): ΔT = ss·(1 − (τ·e^(−t/τ) −
+///   τ₂·e^(−t/τ₂))/(τ − τ₂)), which starts with zero slope (an S-shaped rise);
+/// - second family: heat diffusing into a thick body from the heated surface with linear
+///   loss there (Carslaw and Jaeger 1959, the semi-infinite solid with surface heat
+///   transfer): ΔT = ss·(1 − e^x·erfc(√x)), x = t/τ, which starts as √t and approaches
+///   its end as 1/√t.
 pub(super) fn temperature_rise_for_drift(p: &Prepared, loss_w: f64, elapsed_s: f64) -> f64 {
     let ss = loss_w / p.alpha_s;
     let tau = p.heat_cap / p.alpha_s;
-    if p.truth {
-        ss * (1.0 - 0.6 * (-elapsed_s / tau).exp() - 0.4 * (-elapsed_s / (0.1 * tau)).exp())
+    if p.truth_b {
+        ss * (1.0 - erfcx((elapsed_s.max(0.0) / tau).sqrt()))
+    } else if p.truth {
+        let tau2 = 0.25 * tau;
+        ss * (1.0 - (tau * (-elapsed_s / tau).exp() - tau2 * (-elapsed_s / tau2).exp()) / (tau - tau2))
     } else if p.thermal_interface != 0.0 {
         two_node_rise(ss, tau, p.thermal_interface, elapsed_s)
     } else {
         ss * (1.0 - (-elapsed_s / tau).exp())
     }
+}
+
+/// The scaled complementary error function e^(z²)·erfc(z) for z ≥ 0, by the Chebyshev
+/// fit of Press et al. (Numerical Recipes, 2nd ed., §6.2, `erfcc`; relative error below
+/// 1.2e-7), written without the e^(−z²) factor so that it cannot underflow. 1 at z = 0,
+/// falling as 1/(z·√π) for large z.
+pub(super) fn erfcx(z: f64) -> f64 {
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let poly = -1.265_512_23
+        + t * (1.000_023_68
+            + t * (0.374_091_96
+                + t * (0.096_784_18
+                    + t * (-0.186_288_06
+                        + t * (0.278_868_07
+                            + t * (-1.135_203_98 + t * (1.488_515_87 + t * (-0.822_152_23 + t * 0.170_872_77))))))));
+    t * poly.exp()
 }
 
 /// `thermal_drift`'s two-node family: the steady rise `ss` [K] reached by a lumped capacity

@@ -360,9 +360,10 @@ fn windows_the_descent_steps_over_still_hold_the_largest_root() {
         ),
         // (the modal projection of the radial-friction paper: the candidate at λ = 1)
         ("trum60a", MODAL_1, false, OperatingPoint::new(194.551, 1.386416, 80.8638, 44049.04), false),
+        // (truth form; at 53.06 N its cubic coefficient is 1.39862e18 N/m³)
         (
             "trum60-qut",
-            "hertz_softening=1.089e18",
+            "hertz_softening=3.4832193326664e17",
             true,
             OperatingPoint::new(53.0628, 0.541305, 182.991, 40875.43),
             false,
@@ -812,4 +813,47 @@ fn clamped_points_are_clamped_over_many_decades_of_every_parameter() {
         }
     }
     assert!(checked > 500 && clamped > 10, "{checked} points, {clamped} clamped");
+}
+
+/// The scaled complementary error function of the diffusive truth-form warm-up agrees
+/// with libm's e^(z²)·erfc(z) to 2e-7 relative on [0, 5], and falls as 1/(z·√π).
+#[test]
+fn scaled_erfc_agrees_with_libm() {
+    for i in 0..=500 {
+        let z = 0.01 * i as f64;
+        let want = (z * z).exp() * libm::erfc(z);
+        assert!((super::fixed_points::erfcx(z) / want - 1.0).abs() < 2e-7, "z = {z}");
+    }
+    let z = 300.0;
+    assert!((super::fixed_points::erfcx(z) * z * std::f64::consts::PI.sqrt() - 1.0).abs() < 1e-5);
+}
+
+/// The truth forms' warm-ups (docs/EFFECTS.md) have the shapes that keep them out of
+/// `thermal_drift`'s two-node family: the series capacities start flat (rise ∝ t², where
+/// every member rises ∝ t), the diffusive one as √t; both reach the same steady rise as
+/// the candidate, the diffusive one slowly (1 − 1/√(πx)).
+#[test]
+fn truth_form_warm_ups_have_their_shapes() {
+    use super::fixed_points::temperature_rise_for_drift as rise;
+    let mut m = motor_with("trum60a", "thermal_drift=-4e-4", false);
+    let cand = Prepared::new(&m);
+    m.effects.set_truth_forms(true);
+    let series = Prepared::new(&m);
+    m.effects.set_truth_form_b(true);
+    let diffusive = Prepared::new(&m);
+    let (loss, tau) = (10.0, cand.heat_cap / cand.alpha_s);
+    let ss = loss / cand.alpha_s;
+    // early: the ratio of the rises at t and 2t (2 for ∝ t, 4 for ∝ t², √2 for ∝ √t)
+    let t = 1e-4 * tau;
+    let ratio = |p: &Prepared| rise(p, loss, 2.0 * t) / rise(p, loss, t);
+    assert!((ratio(&cand) - 2.0).abs() < 1e-3, "{}", ratio(&cand));
+    assert!((ratio(&series) - 4.0).abs() < 1e-2, "{}", ratio(&series));
+    assert!((ratio(&diffusive) - 2f64.sqrt()).abs() < 1e-2, "{}", ratio(&diffusive));
+    // late: all at the steady rise; the diffusive one within 1/√(πx) of it
+    for p in [&cand, &series] {
+        assert!((rise(p, loss, 40.0 * tau) / ss - 1.0).abs() < 1e-9);
+    }
+    let x = 400.0;
+    let left = 1.0 - rise(&diffusive, loss, x * tau) / ss;
+    assert!((left * (std::f64::consts::PI * x).sqrt() - 1.0).abs() < 1e-2, "{left}");
 }
