@@ -429,10 +429,16 @@ pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
     if law.sharpness != 1.0 && law.slip_scale > 0.0 && !law.truth {
         return stick_slip_factors(ct, uc, u, law);
     }
+    factors_about(ct, u, law, nearest_singularity(law, uc, ct.half_angle_rad))
+}
+
+/// [`factors`] of the laws other than the stick-then-slip ones, given the integrand's
+/// nearest singularity `z` ([`nearest_singularity`] at u clamped to [−1, 1]).
+fn factors_about(ct: &Contact, u: f64, law: &Law, z: Option<(f64, f64)>) -> Factors {
     if law.slip_scale > 0.0 && law.radial_ratio == 0.0 && !law.truth {
-        return compliance_factors(ct, uc, u, law);
+        return compliance_factors(ct, u.clamp(-1.0, 1.0), u, law, z);
     }
-    quadrature_factors(ct, u, law)
+    quadrature_factors_about(ct, u, law, z)
 }
 
 /// Nodes of the rules that do not depend on the rotor speed: [0, φ0] in two and in four
@@ -469,7 +475,8 @@ pub(crate) fn factors_reusing(ct: &Contact, u: f64, law: &Law, rule: &mut SpeedF
     // (at u = ±1 the slip vanishes on the axis, at θ = 0 or π, where the traction's
     // derivative in u has a log singularity that the graded rule's panels resolve)
     if !stick_slip && u.abs() < 1.0 {
-        if let Some(z) = nearest_singularity(law, u.clamp(-1.0, 1.0), phi0) {
+        let z = nearest_singularity(law, u.clamp(-1.0, 1.0), phi0);
+        if let Some(z) = z {
             let reach = distance(z, phi0) / phi0;
             if let Some(k) = (0..2).find(|&k| reach >= SPEED_FREE_REACH[k]) {
                 let nodes = rule.0[k].get_or_insert_with(|| {
@@ -485,21 +492,30 @@ pub(crate) fn factors_reusing(ct: &Contact, u: f64, law: &Law, rule: &mut SpeedF
                 return node_sums(nodes, ct.offset, u, law);
             }
         }
+        return factors_about(ct, u, law, z);
     }
     factors(ct, u, law)
 }
 
-/// [`factors`] by the graded rule over the whole contact, for every law: the route of the
-/// laws without a closed-form part, and the independent reference of
-/// [`compliance_factors`] in the tests.
+/// [`factors`] by the graded rule over the whole contact split at θs, for every law: the
+/// independent reference of [`compliance_factors`] and [`factors_reusing`] in the tests.
+#[cfg(test)]
 fn quadrature_factors(ct: &Contact, u: f64, law: &Law) -> Factors {
-    let phi0 = ct.half_angle_rad;
     let uc = u.clamp(-1.0, 1.0);
-    let ts = uc.acos();
     if law.sharpness != 1.0 && law.slip_scale > 0.0 && !law.truth {
         return stick_slip_factors(ct, uc, u, law);
     }
-    if let Some((ends, n)) = nearest_singularity(law, uc, phi0).and_then(|z| graded_ends(ts, phi0, z)) {
+    quadrature_factors_about(ct, u, law, nearest_singularity(law, uc, ct.half_angle_rad))
+}
+
+/// The graded rule over the whole contact split at θs for the laws other than the
+/// stick-then-slip ones, given the integrand's nearest singularity `z`: the route of the
+/// laws without a closed-form part.
+fn quadrature_factors_about(ct: &Contact, u: f64, law: &Law, z: Option<(f64, f64)>) -> Factors {
+    let phi0 = ct.half_angle_rad;
+    let uc = u.clamp(-1.0, 1.0);
+    let ts = uc.acos();
+    if let Some((ends, n)) = z.and_then(|z| graded_ends(ts, phi0, z)) {
         return graded_factors(&ends[..n], ct.offset, u, law);
     }
     let mut nodes = Nodes::new();
@@ -529,14 +545,14 @@ const REACH: f64 = 19.5;
 /// (the contact wider than the band of partial stick) that is a few panels about θs
 /// instead of panels graded across the whole contact, 2-4 times fewer nodes, and the
 /// difference 1 − tanh x = 2e/(1 + e) (e = exp(−2x)) is formed without cancellation.
-/// `uc` is `u` clamped to [−1, 1]. Within 1e-12 of the graded rule over the whole
-/// contact ([`quadrature_factors`], test below).
-fn compliance_factors(ct: &Contact, uc: f64, u: f64, law: &Law) -> Factors {
+/// `uc` is `u` clamped to [−1, 1], `z` the nearest singularity. Within 1e-12 of the graded rule over the whole
+/// contact (`quadrature_factors`, test below).
+fn compliance_factors(ct: &Contact, uc: f64, u: f64, law: &Law, z: Option<(f64, f64)>) -> Factors {
     let (phi0, c, sigma) = (ct.half_angle_rad, ct.offset, law.slip_scale);
     let reach = REACH * sigma;
     // a window over the whole contact saves nothing: the plain rule's one pass is cheaper
     if u + reach >= 1.0 && u - reach <= c.max(-1.0) {
-        return quadrature_factors(ct, u, law);
+        return quadrature_factors_about(ct, u, law, z);
     }
     let ts = uc.acos();
     let (s0, c0) = phi0.sin_cos();
@@ -566,7 +582,7 @@ fn compliance_factors(ct: &Contact, uc: f64, u: f64, law: &Law) -> Factors {
     if np == 0 {
         return f;
     }
-    let graded = nearest_singularity(law, uc, phi0).and_then(|z| graded_ends_in(&plain[..np], z));
+    let graded = z.and_then(|z| graded_ends_in(&plain[..np], z));
     let (ends, n) = graded.unwrap_or_else(|| {
         let mut e = [0.0; MAX_PANELS + 1];
         e[0] = plain[0].0;
