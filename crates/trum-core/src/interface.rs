@@ -177,8 +177,8 @@ fn tanh_nonneg(x: f64) -> f64 {
 /// |r| ≤ ln 2 / 2 (n by the round-to-nearest of adding 1.5·2^52, ln 2 split in two so
 /// n·ln 2 is exact to 2^-60), e^r by its Taylor series to r¹³ (first omitted term below
 /// 5e-18 relative), 2^n put into the exponent bits. Written out inline because glibc's
-/// `exp` with its call took about 50 instructions a node of the saturating laws and this
-/// takes about 25; within 2 ulp of `f64::exp` (test below).
+/// `exp` with its call costs about 50 instructions a node of the saturating laws and this
+/// about 25; within 2 ulp of `f64::exp` (test below).
 #[inline(always)]
 fn exp_nonpos(x: f64) -> f64 {
     const SHIFT: f64 = 6_755_399_441_055_744.0; // 1.5·2^52
@@ -467,8 +467,8 @@ const SPEED_FREE_SUB_PANELS: [usize; 2] = [2, 4];
 /// such speed, the same nodes at every later one) integrates it without the split at θs,
 /// in 24 nodes where the singularity is far, 48 where it is nearer. That saves the nodes'
 /// sines and cosines (about 30 % of a call) at every Newton step of the speed but the
-/// first, and half the node sums where 24 nodes do. Elsewhere, at u = ±1, and for the stick-then-slip laws, [`factors`]. Within 1e-12 of the
-/// graded rule (test below).
+/// first, and half the node sums where 24 nodes do. Elsewhere, at u = ±1, and for the
+/// stick-then-slip laws, [`factors`]. Within 1e-12 of the graded rule (test below).
 pub(crate) fn factors_reusing(ct: &Contact, u: f64, law: &Law, rule: &mut SpeedFreeRule) -> Factors {
     let phi0 = ct.half_angle_rad;
     let stick_slip = law.sharpness != 1.0 && law.slip_scale > 0.0 && !law.truth;
@@ -543,10 +543,11 @@ const REACH: f64 = 19.5;
 /// vanish outside the window |cos θ − u| ≤ [`REACH`]·σ about the stick point θs. The
 /// graded rule ([`graded_ends_in`]) integrates them on the window alone: where σ is small
 /// (the contact wider than the band of partial stick) that is a few panels about θs
-/// instead of panels graded across the whole contact, 2-4 times fewer nodes, and the
-/// difference 1 − tanh x = 2e/(1 + e) (e = exp(−2x)) is formed without cancellation.
-/// `uc` is `u` clamped to [−1, 1], `z` the nearest singularity. Within 1e-12 of the graded rule over the whole
-/// contact (`quadrature_factors`, test below).
+/// however small σ is, instead of panels graded across the whole contact (their number
+/// grows with log(1/σ)), and the difference 1 − tanh x = 2e/(1 + e) (e = exp(−2x)) is
+/// formed without cancellation. `uc` is `u` clamped to [−1, 1], `z` the nearest
+/// singularity. Within 1e-12 of the graded rule over the whole contact
+/// (`quadrature_factors`, test below).
 fn compliance_factors(ct: &Contact, uc: f64, u: f64, law: &Law, z: Option<(f64, f64)>) -> Factors {
     let (phi0, c, sigma) = (ct.half_angle_rad, ct.offset, law.slip_scale);
     let reach = REACH * sigma;
