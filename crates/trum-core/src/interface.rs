@@ -166,11 +166,44 @@ fn tanh_nonneg(x: f64) -> f64 {
         let z = x * x;
         x * (1.0 + z * (-1.0 / 3.0 + z * (2.0 / 15.0 + z * (-17.0 / 315.0 + z * (62.0 / 2835.0)))))
     } else if x < 19.1 {
-        let e = (-2.0 * x).exp();
+        let e = exp_nonpos(-2.0 * x);
         (1.0 - e) / (1.0 + e)
     } else {
         1.0
     }
+}
+
+/// e^x for −708 < x ≤ 0 (the saturations' exp(−2·|slip|/σ)): x = n·ln 2 + r with
+/// |r| ≤ ln 2 / 2 (n by the round-to-nearest of adding 1.5·2^52, ln 2 split in two so
+/// n·ln 2 is exact to 2^-60), e^r by its Taylor series to r¹³ (first omitted term below
+/// 5e-18 relative), 2^n put into the exponent bits. Written out inline because glibc's
+/// `exp` with its call costs about 50 instructions a node of the saturating laws and this
+/// about 25; within 2 ulp of `f64::exp` (test below).
+#[inline(always)]
+fn exp_nonpos(x: f64) -> f64 {
+    const SHIFT: f64 = 6_755_399_441_055_744.0; // 1.5·2^52
+    const LN2_HI: f64 = 6.931_471_803_691_238e-1;
+    const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
+    let t = x * std::f64::consts::LOG2_E + SHIFT;
+    let n = t - SHIFT;
+    let r = (x - n * LN2_HI) - n * LN2_LO;
+    let p = 1.0 / 6_227_020_800.0;
+    let p = p * r + 1.0 / 479_001_600.0;
+    let p = p * r + 1.0 / 39_916_800.0;
+    let p = p * r + 1.0 / 3_628_800.0;
+    let p = p * r + 1.0 / 362_880.0;
+    let p = p * r + 1.0 / 40_320.0;
+    let p = p * r + 1.0 / 5_040.0;
+    let p = p * r + 1.0 / 720.0;
+    let p = p * r + 1.0 / 120.0;
+    let p = p * r + 1.0 / 24.0;
+    let p = p * r + 1.0 / 6.0;
+    let p = p * r + 0.5;
+    let p = p * r + 1.0;
+    let p = p * r + 1.0;
+    // the low bits of t hold n (two's complement): n + 1023 shifted into the exponent
+    let scale = f64::from_bits(t.to_bits().wrapping_add(1023) << 52);
+    p * scale
 }
 
 /// sin y and cos y for |y| ≤ π/4 by their Taylor series to y¹⁷ and y¹⁸ (the first
@@ -388,15 +421,101 @@ fn compliance_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64, weight: f64) 
 /// changes sign, and where the integrand has a complex singularity close to the contact
 /// (the law turns from driving to braking within a narrow band: small ρ or σ, or the
 /// slip nearly vanishes at the crest, u → 1), it grades the panels towards it
-/// ([`nearest_singularity`], [`graded_ends`]).
+/// ([`nearest_singularity`], [`graded_ends`]). The candidate's tanh saturation without
+/// radial slip takes the Coulomb closed forms plus the saturation's difference from them
+/// on a window about θs ([`compliance_factors`]).
 pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
-    let phi0 = ct.half_angle_rad;
     let uc = u.clamp(-1.0, 1.0);
-    let ts = uc.acos();
     if law.sharpness != 1.0 && law.slip_scale > 0.0 && !law.truth {
         return stick_slip_factors(ct, uc, u, law);
     }
-    if let Some((ends, n)) = nearest_singularity(law, uc, phi0).and_then(|z| graded_ends(ts, phi0, z)) {
+    factors_about(ct, u, law, nearest_singularity(law, uc, ct.half_angle_rad))
+}
+
+/// [`factors`] of the laws other than the stick-then-slip ones, given the integrand's
+/// nearest singularity `z` ([`nearest_singularity`] at u clamped to [−1, 1]).
+fn factors_about(ct: &Contact, u: f64, law: &Law, z: Option<(f64, f64)>) -> Factors {
+    if law.slip_scale > 0.0 && law.radial_ratio == 0.0 && !law.truth {
+        return compliance_factors(ct, u.clamp(-1.0, 1.0), u, law, z);
+    }
+    quadrature_factors_about(ct, u, law, z)
+}
+
+/// Nodes of the rules that do not depend on the rotor speed: [0, φ0] in two and in four
+/// equal sub-panels of [`NODES`] Gauss–Legendre nodes, each built once per contact.
+pub(crate) struct SpeedFreeRule([Option<Nodes>; 2]);
+
+impl SpeedFreeRule {
+    /// No nodes yet (built at the first speed that can use them).
+    pub(crate) fn new() -> Self {
+        SpeedFreeRule([None, None])
+    }
+}
+
+/// Least distance of the integrand's nearest singularity from [0, φ0], over φ0, at which a
+/// speed-free rule of `SPEED_FREE_SUB_PANELS[k]` equal sub-panels is used: 3/4 of a
+/// sub-panel's width, 1.5 of its half-widths, which puts the singularity on or outside
+/// the Bernstein ellipse E = 1.5 + √3.25 ≈ 3.3 (12-node error of order E⁻²⁴ ≈ 3e-13, as
+/// the graded rule's panels next to a singularity).
+const SPEED_FREE_REACH: [f64; 2] = [0.375, 0.1875];
+const SPEED_FREE_SUB_PANELS: [usize; 2] = [2, 4];
+
+/// [`factors`] for the rotor-speed solve of one trial (one contact, many speeds u): where
+/// the integrand's nearest complex singularity ([`nearest_singularity`]) is at least a
+/// few sub-panel widths from [0, φ0] ([`SPEED_FREE_REACH`]), the integrand is analytic
+/// and slowly varying on the scale of a sub-panel: the rule `rule` (built at the first
+/// such speed, the same nodes at every later one) integrates it without the split at θs,
+/// in 24 nodes where the singularity is far, 48 where it is nearer. That saves the nodes'
+/// sines and cosines (about 30 % of a call) at every Newton step of the speed but the
+/// first, and half the node sums where 24 nodes do. Elsewhere, at u = ±1, and for the
+/// stick-then-slip laws, [`factors`]. Within 1e-12 of the graded rule (test below).
+pub(crate) fn factors_reusing(ct: &Contact, u: f64, law: &Law, rule: &mut SpeedFreeRule) -> Factors {
+    let phi0 = ct.half_angle_rad;
+    let stick_slip = law.sharpness != 1.0 && law.slip_scale > 0.0 && !law.truth;
+    // (at u = ±1 the slip vanishes on the axis, at θ = 0 or π, where the traction's
+    // derivative in u has a log singularity that the graded rule's panels resolve)
+    if !stick_slip && u.abs() < 1.0 {
+        let z = nearest_singularity(law, u.clamp(-1.0, 1.0), phi0);
+        if let Some(z) = z {
+            let reach = distance(z, phi0) / phi0;
+            if let Some(k) = (0..2).find(|&k| reach >= SPEED_FREE_REACH[k]) {
+                let nodes = rule.0[k].get_or_insert_with(|| {
+                    let mut n = Nodes::new();
+                    if SPEED_FREE_SUB_PANELS[k] == 2 {
+                        n.panels(&[(0.0, phi0, (0.5 * phi0).sin_cos())]);
+                    } else {
+                        let h = 0.5 * phi0;
+                        n.panels(&[(0.0, h, (0.5 * h).sin_cos()), (h, phi0, (0.5 * (h + phi0)).sin_cos())]);
+                    }
+                    n
+                });
+                return node_sums(nodes, ct.offset, u, law);
+            }
+        }
+        return factors_about(ct, u, law, z);
+    }
+    factors(ct, u, law)
+}
+
+/// [`factors`] by the graded rule over the whole contact split at θs, for every law: the
+/// independent reference of [`compliance_factors`] and [`factors_reusing`] in the tests.
+#[cfg(test)]
+fn quadrature_factors(ct: &Contact, u: f64, law: &Law) -> Factors {
+    let uc = u.clamp(-1.0, 1.0);
+    if law.sharpness != 1.0 && law.slip_scale > 0.0 && !law.truth {
+        return stick_slip_factors(ct, uc, u, law);
+    }
+    quadrature_factors_about(ct, u, law, nearest_singularity(law, uc, ct.half_angle_rad))
+}
+
+/// The graded rule over the whole contact split at θs for the laws other than the
+/// stick-then-slip ones, given the integrand's nearest singularity `z`: the route of the
+/// laws without a closed-form part.
+fn quadrature_factors_about(ct: &Contact, u: f64, law: &Law, z: Option<(f64, f64)>) -> Factors {
+    let phi0 = ct.half_angle_rad;
+    let uc = u.clamp(-1.0, 1.0);
+    let ts = uc.acos();
+    if let Some((ends, n)) = z.and_then(|z| graded_ends(ts, phi0, z)) {
         return graded_factors(&ends[..n], ct.offset, u, law);
     }
     let mut nodes = Nodes::new();
@@ -410,6 +529,112 @@ pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
         nodes.panels(&[(0.0, phi0, (0.5 * phi0).sin_cos())]);
     }
     node_sums(&nodes, ct.offset, u, law)
+}
+
+/// Slip speeds beyond REACH·σ saturate the candidate's traction completely:
+/// [`tanh_nonneg`] is exactly 1 above 19.1 (tanh x rounds to 1 there), so outside the
+/// window |cos θ − u| ≤ REACH·σ the saturating law is the Coulomb law to the last bit.
+const REACH: f64 = 19.5;
+
+/// [`factors`] of the candidate saturating law without radial slip (ρ = 0, S = tanh,
+/// Storck and Wallaschek 2003): the Coulomb law's closed forms (torque 2χ(θs) − χ(φ0),
+/// power 2E(θs) − E(φ0), Sun et al. 2021 eq. 10-11) plus the integrals of the saturation's
+/// difference from it, q·(tanh(dt/σ) − sign dt), and of ∂/∂u, −q·(1 − tanh²)/σ, which
+/// vanish outside the window |cos θ − u| ≤ [`REACH`]·σ about the stick point θs. The
+/// graded rule ([`graded_ends_in`]) integrates them on the window alone: where σ is small
+/// (the contact wider than the band of partial stick) that is a few panels about θs
+/// however small σ is, instead of panels graded across the whole contact (their number
+/// grows with log(1/σ)), and the difference 1 − tanh x = 2e/(1 + e) (e = exp(−2x)) is
+/// formed without cancellation. `uc` is `u` clamped to [−1, 1], `z` the nearest
+/// singularity. Within 1e-12 of the graded rule over the whole contact
+/// (`quadrature_factors`, test below).
+fn compliance_factors(ct: &Contact, uc: f64, u: f64, law: &Law, z: Option<(f64, f64)>) -> Factors {
+    let (phi0, c, sigma) = (ct.half_angle_rad, ct.offset, law.slip_scale);
+    let reach = REACH * sigma;
+    // a window over the whole contact saves nothing: the plain rule's one pass is cheaper
+    if u + reach >= 1.0 && u - reach <= c.max(-1.0) {
+        return quadrature_factors_about(ct, u, law, z);
+    }
+    let ts = uc.acos();
+    let (s0, c0) = phi0.sin_cos();
+    // the Coulomb part, sign(cos θ − u) = +1 on [0, θs) and −1 beyond
+    let te = ts.min(phi0);
+    let (se, ce) = if ts < phi0 { (((1.0 - uc) * (1.0 + uc)).sqrt(), uc) } else { (s0, c0) };
+    let chi = |t: f64, s: f64| s - t * c;
+    let e_int = |t: f64, s: f64, co: f64| 0.5 * t + 0.5 * s * co - c * s;
+    let mut f = Factors {
+        torque: 2.0 * chi(te, se) - chi(phi0, s0),
+        power: 2.0 * e_int(te, se, ce) - e_int(phi0, s0, c0),
+        ..Factors::default()
+    };
+    // the window, split at θs
+    let lo = if u + reach >= 1.0 { 0.0 } else { (u + reach).acos() };
+    let hi = if u - reach <= -1.0 { phi0 } else { (u - reach).acos().min(phi0) };
+    let mut plain = [(0.0, 0.0); 2];
+    let mut np = 0;
+    if te > lo {
+        plain[np] = (lo, te);
+        np += 1;
+    }
+    if ts < phi0 && hi > ts {
+        plain[np] = (ts, hi);
+        np += 1;
+    }
+    if np == 0 {
+        return f;
+    }
+    let graded = z.and_then(|z| graded_ends_in(&plain[..np], z));
+    let (ends, n) = graded.unwrap_or_else(|| {
+        let mut e = [0.0; MAX_PANELS + 1];
+        e[0] = plain[0].0;
+        for (k, &(_, b)) in plain[..np].iter().enumerate() {
+            e[k + 1] = b;
+        }
+        (e, np + 1)
+    });
+    let panel = |a: f64, b: f64| (a, b, (0.5 * (a + b)).sin_cos());
+    for k in (0..n - 1).step_by(2) {
+        let mut nodes = Nodes::new();
+        if k + 2 < n {
+            nodes.panels(&[panel(ends[k], ends[k + 1]), panel(ends[k + 1], ends[k + 2])]);
+        } else {
+            nodes.panels(&[panel(ends[k], ends[k + 1])]);
+        }
+        f.add(&compliance_window_sums(&nodes, c, u, sigma));
+    }
+    f
+}
+
+/// The node sums of [`compliance_factors`]: q·(tanh x − sign x) and q·∂tanh(x)/∂u with
+/// x = (cos θ − u)/σ, and the same times cos θ. A node with x = +0 (cos θ rounded onto u)
+/// counts as beyond θs, where the Coulomb part takes the sign −1.
+fn compliance_window_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64) -> Factors {
+    let inv_s = 1.0 / slip_scale;
+    let (mut t, mut t_u, mut p, mut p_u) = (0.0, 0.0, 0.0, 0.0);
+    for k in 0..nodes.len {
+        let (co, w) = (nodes.cos[k], nodes.weight[k]);
+        let wq = w * (co - c).max(0.0);
+        let x = (co - u) * inv_s;
+        let ax = x.abs();
+        // 1 − tanh|x| and 1 − tanh²|x|
+        let (a, sech2) = if ax < 0.02 {
+            let th = tanh_nonneg(ax);
+            (1.0 - th, 1.0 - th * th)
+        } else if ax < 19.1 {
+            let e = exp_nonpos(-2.0 * ax);
+            let r = 1.0 / (1.0 + e);
+            (2.0 * e * r, 4.0 * e * r * r)
+        } else {
+            (0.0, 0.0)
+        };
+        let d = if x > 0.0 { -a } else { a };
+        let dg = -sech2 * inv_s;
+        t += wq * d;
+        t_u += wq * dg;
+        p += wq * d * co;
+        p_u += wq * dg * co;
+    }
+    Factors { torque: t, power: p, radial: 0.0, torque_du: t_u, power_du: p_u, radial_du: 0.0 }
 }
 
 /// [`factors`] on the graded panels between `ends`, two panels at a time (one node array
@@ -713,13 +938,20 @@ fn arccos_near(u: f64, sin_ts: f64, dc: C64) -> C64 {
 /// amplitude trial returning two rotor speeds depending on its start:
 /// tests/solver_convergence.rs.)
 fn graded_ends(ts: f64, phi0: f64, z: (f64, f64)) -> Option<([f64; MAX_PANELS + 1], usize)> {
+    let split = ts > 0.0 && ts < phi0;
+    let plain: &[(f64, f64)] = if split { &[(0.0, ts), (ts, phi0)] } else { &[(0.0, phi0)] };
+    graded_ends_in(plain, z)
+}
+
+/// [`graded_ends`] on the contiguous panels `plain` (one or two, ascending) instead of the
+/// plain rule's panels of [0, φ0]: the same grading about `z` inside each.
+fn graded_ends_in(plain: &[(f64, f64)], z: (f64, f64)) -> Option<([f64; MAX_PANELS + 1], usize)> {
     let mut ends = [0.0; MAX_PANELS + 1];
+    ends[0] = plain[0].0;
     // ends in ascending order, panel by panel: graded ends below its nearest point (made
     // nearest first, stored reversed), the point itself, graded ends above it, its far end
     let mut n = 1;
     let mut graded = 0;
-    let split = ts > 0.0 && ts < phi0;
-    let plain: &[(f64, f64)] = if split { &[(0.0, ts), (ts, phi0)] } else { &[(0.0, phi0)] };
     let dist = |x: f64| ((z.0 - x) * (z.0 - x) + z.1 * z.1).sqrt().max(MIN_FEATURE_WIDTH);
     for &(p, q) in plain {
         let mut near = z.0.clamp(p, q);
@@ -904,8 +1136,9 @@ pub(crate) fn general_interface(
     ts_guess: Option<f64>,
 ) -> (f64, f64, bool, Factors, f64) {
     let visc = p.dr * v0 / p.r0;
+    let rule = std::cell::RefCell::new(SpeedFreeRule::new());
     let f = |u: f64| {
-        let fac = factors(ct, u, law);
+        let fac = factors_reusing(ct, u, law, &mut rule.borrow_mut());
         (tscale * fac.torque - d.t_load - visc * u, fac)
     };
     // Bracket [lo, hi] with f(lo) ≥ 0 > f(hi). f(1) (the rotor at crest speed) is only
@@ -1108,6 +1341,21 @@ mod tests {
             assert!(rel <= 6e-15 || a == b, "x {x}: {a} vs {b}");
         }
         assert_eq!(tanh_nonneg(0.0), 0.0);
+        eprintln!("worst relative difference {worst:.2e}");
+    }
+
+    #[test]
+    fn inline_exp_matches_the_library() {
+        let mut worst: f64 = 0.0;
+        for i in 0..=400_000 {
+            let x = -40.0 * (i as f64 / 400_000.0).powi(2);
+            let (a, b) = (exp_nonpos(x), x.exp());
+            let rel = (a - b).abs() / b;
+            worst = worst.max(rel);
+            assert!(rel <= 2.0 * f64::EPSILON, "x {x}: {a} vs {b}");
+        }
+        assert_eq!(exp_nonpos(0.0), 1.0);
+        assert!((exp_nonpos(-700.0) / (-700.0f64).exp() - 1.0).abs() < 1e-15);
         eprintln!("worst relative difference {worst:.2e}");
     }
 
@@ -1408,6 +1656,112 @@ mod tests {
             assert!(!(ts > 0.0 && ts < phi0) || e.contains(&ts), "θs {ts} missing: {e:?}");
         }
         assert!(graded > 100_000, "{graded}");
+    }
+
+    /// The saturating law by its Coulomb closed forms plus the windowed difference
+    /// (`compliance_factors`) against the graded rule over the whole contact
+    /// (`quadrature_factors`, an independent route: no closed form, the saturation itself at
+    /// every node), over slip scales from 1e-7 (a step at θs) to 3 (the window is the whole
+    /// contact), contacts from narrow to full and rotor speeds from rest past the crest:
+    /// torque and power within 1e-12 of their scale, the derivatives within 1e-12 of that
+    /// over σ.
+    #[test]
+    fn windowed_compliance_factors_agree_with_the_whole_contact_rule() {
+        let mut worst: f64 = 0.0;
+        for &sigma in &[1e-7, 1e-5, 3e-4, 0.003, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 3.0] {
+            let law = Law { radial_ratio: 0.0, slip_scale: sigma, truth: false, sharpness: 1.0 };
+            for &y in &[0.02, 0.3, 0.7, 1.0, 1.5, 2.0, 3.0, 3.2, 4.0, 6.0] {
+                let ct = contact_from_ratio(y);
+                for &u in &[
+                    0.0,
+                    1e-9,
+                    0.05,
+                    0.3,
+                    0.5,
+                    0.7,
+                    0.8,
+                    0.9,
+                    0.95,
+                    0.99,
+                    0.999,
+                    0.999_999,
+                    1.0 - 1e-9,
+                    1.0,
+                    1.0 + 1e-12,
+                ] {
+                    let (a, b) = (factors(&ct, u, &law), quadrature_factors(&ct, u, &law));
+                    let scale = b.torque.abs().max(b.power.abs()).max(1e-3);
+                    for (k, (x, z)) in
+                        [(a.torque, b.torque), (a.power, b.power), (a.torque_du, b.torque_du), (a.power_du, b.power_du)]
+                            .into_iter()
+                            .enumerate()
+                    {
+                        let sc = if k < 2 { scale } else { scale / sigma };
+                        let err = (x - z).abs() / sc;
+                        worst = worst.max(err);
+                        assert!(err <= 1e-12, "σ={sigma} y={y} u={u} [{k}]: windowed {x} vs whole contact {z}");
+                    }
+                    assert_eq!((a.radial, a.radial_du), (0.0, 0.0));
+                }
+            }
+        }
+        eprintln!("windowed against whole-contact rule: worst relative difference {worst:.1e}");
+    }
+
+    /// The speed-free rule (`factors_reusing`, its nodes built at one speed and kept for
+    /// the others) against the graded rule split at θs (`quadrature_factors`) over the laws
+    /// of both forms, contacts from narrow to full and rotor speeds from rest to the crest,
+    /// the rule's nodes first built at each of three speeds: within 1e-12 of the torque and
+    /// power scale, the derivatives (which only steer the Newton steps) within 1e-10 of
+    /// theirs (3.6e-11 at ρ = 0.5, σ = 0.2 next to the crest); and the speed-free rule taken at
+    /// some of them (it would not be tested otherwise).
+    #[test]
+    fn speed_free_rule_agrees_with_the_split_rule() {
+        let law =
+            |rho: f64, sigma: f64, truth: bool| Law { radial_ratio: rho, slip_scale: sigma, truth, sharpness: 1.0 };
+        let laws = [
+            law(1.0, 0.0, false),
+            law(0.3, 0.0, false),
+            law(1.5, 0.0, false),
+            law(0.05, 0.0, false),
+            law(2.0, 0.0, false),
+            law(0.0, 0.2, false),
+            law(0.0, 0.5, false),
+            law(0.0, 0.05, false),
+            law(1.0, 0.0, true),
+            law(0.3, 0.0, true),
+            law(0.0, 0.3, true),
+            law(0.5, 0.2, false),
+            law(1.0, 0.1, true),
+        ];
+        let (mut worst, mut reused): (f64, usize) = (0.0, 0);
+        for l in laws {
+            for &y in &[0.02, 0.3, 1.0, 2.0, 3.0, 4.0, 6.0] {
+                let ct = contact_from_ratio(y);
+                for &first in &[0.0, 0.5, 0.95] {
+                    let mut rule = SpeedFreeRule::new();
+                    factors_reusing(&ct, first, &l, &mut rule);
+                    for &u in &[0.0, 0.1, 0.3, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 0.99, 0.999, 1.0] {
+                        let (a, b) = (factors_reusing(&ct, u, &l, &mut rule), quadrature_factors(&ct, u, &l));
+                        let z = nearest_singularity(&l, u, ct.half_angle_rad);
+                        reused += usize::from(
+                            z.is_some_and(|z| distance(z, ct.half_angle_rad) >= 0.1875 * ct.half_angle_rad),
+                        );
+                        let scale = b.torque.abs().max(b.power.abs()).max(1e-3);
+                        for (x, w) in [(a.torque, b.torque), (a.power, b.power), (a.radial, b.radial)] {
+                            worst = worst.max((x - w).abs() / scale);
+                            assert!((x - w).abs() <= 1e-12 * scale, "{l:?} y={y} u={u}: {x} vs {w}");
+                        }
+                        for (x, w) in [(a.torque_du, b.torque_du), (a.power_du, b.power_du), (a.radial_du, b.radial_du)]
+                        {
+                            assert!((x - w).abs() <= 1e-10 * w.abs().max(scale), "{l:?} y={y} u={u}: {x} vs {w}");
+                        }
+                    }
+                }
+            }
+        }
+        assert!(reused > 1000, "{reused}");
+        eprintln!("speed-free rule against the split rule: worst relative difference {worst:.1e} ({reused} reused)");
     }
 
     #[test]

@@ -195,7 +195,16 @@ pub(super) fn trial(
         rf = 0.0;
     } else {
         let law = interface_law(p, d, &ct);
-        let (t, v, st, fac, t0) = general_interface(p, d, &ct, tscale, v0, &law, ts_guess.map(|g| g.0));
+        // Without a neighbour's stick angle (a cold point's first trial), the Coulomb
+        // law's at this amplitude (one closed-form Newton solve) starts the speed solve
+        // nearer its root than the bracket [0, 1] it would search otherwise: the root is
+        // unique (the torque falls with the rotor speed), so the start changes only the
+        // integrals it takes.
+        let guess = ts_guess.map(|g| g.0).or_else(|| {
+            let visc = p.dr * v0 / p.r0;
+            contact::stick_half_angle_sin_cos(&ct, (s0, c0), tscale, d.t_load, visc, None).map(|r| r.0)
+        });
+        let (t, v, st, fac, t0) = general_interface(p, d, &ct, tscale, v0, &law, guess);
         (ts, vr, stalled, tf, pf, rf, tf0) = (t, v, st, fac.torque, fac.power, fac.radial, t0);
         (dpf, carry) = (f64::NAN, [None; 2]);
     }
