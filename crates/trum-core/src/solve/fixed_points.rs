@@ -445,6 +445,11 @@ fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<S
         // that finds no root costs 289 trials instead of 682)
         let ratio = if hi > 1e-3 * bound { SAG_SCAN_RATIO } else { 0.8 };
         let w = (ratio * hi).max(tiny);
+        if w >= hi {
+            // a subnormal amplitude that the step no longer lowers (0.8 × 5e-324 rounds
+            // back to 5e-324): the scan cannot go on, and there is no amplitude left to find
+            return None;
+        }
         let e = h(w);
         let hw = e.0;
         if !hw.is_finite() {
