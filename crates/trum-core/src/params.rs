@@ -320,8 +320,11 @@ pub fn tolerances_from_toml_str(
         let x = match v {
             toml::Value::Integer(i) => *i as f64,
             toml::Value::Float(x) => *x,
-            _ if !tolerance_keys().contains(&key) => return Err(err(check_tolerance(&key, 0.0).unwrap_err())),
-            _ => return Err(err("expected a number (relative standard deviation, 0 or inf)".into())),
+            _ => {
+                // an unknown key is named as such before its value's type
+                check_tolerance(&key, 0.0).map_err(&err)?;
+                return Err(err("expected a number (relative standard deviation, 0 or inf)".into()));
+            }
         };
         check_tolerance(&key, x).map_err(err)?;
         out.insert(key, x);
