@@ -5,6 +5,7 @@
 //! which differ in form from the candidates the diagnosis fits — and every reading gets
 //! realistic noise. Reproducible from the seed.
 
+use crate::effects::Effects;
 use crate::error::TrumError;
 use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
@@ -68,10 +69,18 @@ pub struct SynthConfig {
     pub voltage_v: f64,
     /// Drive frequency of the fixed-drive campaigns [Hz].
     pub frequency_hz: f64,
-    /// Use the truth forms of the effects (default) rather than the candidate forms.
+    /// Use the truth forms of the effects (default) rather than the candidate forms, for
+    /// every effect but those of `nominal_effects`.
     pub truth_forms: bool,
     /// With `truth_forms`: the second family of truth forms (docs/EFFECTS.md).
     pub truth_form_b: bool,
+    /// The effects of the nominal model the data are to be diagnosed against (a motor
+    /// file's or preset's own). An effect the simulated motor has switched on with the
+    /// same parameters as here is part of that model, not unknown physics, and is
+    /// simulated in its candidate form, the form the model has; every other effect (one
+    /// added to the motor, or given other parameters) is the bench's unknown physics and
+    /// takes its truth form (with `truth_forms`). None by default: every effect in truth form.
+    pub nominal_effects: Effects,
     /// Optional columns to leave out (to mimic a poorer bench).
     pub omit: Vec<Observable>,
     /// What the bench adds to its readings besides their noise (none by default).
@@ -158,6 +167,7 @@ impl Default for SynthConfig {
             frequency_hz: 43_000.0,
             truth_forms: true,
             truth_form_b: false,
+            nominal_effects: Effects::none(),
             omit: Vec::new(),
             artefacts: Artefacts::default(),
         }
@@ -209,7 +219,8 @@ pub const PERTURBED: [(&str, f64); 11] = [
     ("electrical.feedback_gain_v_per_m", 1.0),
 ];
 
-/// The true motor: `motor` with its uncertain parameters perturbed.
+/// The true motor: `motor` with its uncertain parameters perturbed, its effects in the
+/// forms `cfg` gives (truth forms for all but the nominal model's own).
 pub fn true_motor(motor: &Motor, cfg: &SynthConfig) -> Motor {
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.motor_seed.unwrap_or(cfg.seed) ^ 0x005e_ed0f_7e57);
     let mut m = motor.clone();
@@ -223,6 +234,11 @@ pub fn true_motor(motor: &Motor, cfg: &SynthConfig) -> Motor {
     m.effects.set_truth_forms(cfg.truth_forms);
     if cfg.truth_forms && cfg.truth_form_b {
         m.effects.set_truth_form_b(true);
+    }
+    for e in m.effects.active() {
+        if cfg.nominal_effects.get(e) == m.effects.get(e) {
+            m.effects.set_truth_form(e, false);
+        }
     }
     m
 }
