@@ -889,4 +889,41 @@ mod tests {
             .to_string();
         assert!(err.contains("missing parameter 'stiffness_scale'"), "{err}");
     }
+
+    /// The global setters set every effect's form (a motor file's `form` key, before or
+    /// after the effects, means the same); one effect's form is set apart from the others',
+    /// and the family of the truth forms is shared.
+    #[test]
+    fn truth_forms_are_chosen_per_effect() {
+        let read = |text: &str| {
+            let t: toml::Table = text.parse().expect("toml");
+            let fx = t.get("effects").and_then(|v| v.as_table()).expect("[effects]");
+            Effects::from_toml_table(fx, text, "m.toml").expect("valid")
+        };
+        for text in
+            ["[effects]\nform = \"truth-b\"\nvoltage_sag = 100\n", "[effects]\nvoltage_sag = 100\nform = \"truth-b\"\n"]
+        {
+            let fx = read(text);
+            assert!(fx.truth_forms() && fx.truth_form_b(), "{text}");
+            assert!(ALL.iter().all(|&e| fx.is_truth_form(e) && fx.is_truth_form_b(e)), "{text}");
+            assert_eq!(read(&fx.to_toml()), fx, "round trip");
+        }
+        let mut fx = Effects::none();
+        fx.set_strength(Effect::VoltageSag, 100.0);
+        fx.set_strength(Effect::RadialFriction, 0.3);
+        assert!(!ALL.iter().any(|&e| fx.is_truth_form(e)));
+        fx.set_truth_form_b(true);
+        fx.set_truth_form(Effect::RadialFriction, false);
+        assert!(fx.is_truth_form_b(Effect::VoltageSag) && fx.is_truth_form(Effect::ThermalDrift));
+        assert!(!fx.is_truth_form(Effect::RadialFriction) && !fx.is_truth_form_b(Effect::RadialFriction));
+        assert!(!fx.truth_forms() && !fx.truth_form_b());
+        assert!(fx.to_string().ends_with("[truth forms b: voltage_sag]"), "{fx}");
+        // a mix is written as candidate (the `form` key sets every effect)
+        assert!(!fx.to_toml().contains("form ="), "{}", fx.to_toml());
+        fx.set_truth_forms(false);
+        assert!(!ALL.iter().any(|&e| fx.is_truth_form(e)) && !fx.to_string().contains("truth"));
+        fx.set_truth_form(Effect::VoltageSag, true);
+        assert!(fx.is_truth_form(Effect::VoltageSag) && !fx.is_truth_form_b(Effect::VoltageSag));
+        assert!(fx.to_string().ends_with("[truth forms: voltage_sag]"), "{fx}");
+    }
 }

@@ -429,4 +429,46 @@ mod tests {
         assert!(ws.iter().all(|r| r.time_series && r.readings.iter().any(|x| x.0 == Observable::TemperatureC)));
         assert!(Campaign::from_name("bogus").unwrap_err().to_string().contains("valid campaigns are"));
     }
+
+    /// The nominal model's own effects keep their candidate form (the form the model a
+    /// diagnosis starts from has); an added effect, or an own one at another strength, is
+    /// the bench's unknown physics and takes its truth form.
+    #[test]
+    fn own_effects_keep_their_candidate_form_and_added_ones_take_their_truth_form() {
+        use crate::effects::Effect;
+        let mut m = crate::calibrate::tests::reference_motor();
+        m.effects.set_strength(Effect::PreloadStiffening, 0.2);
+        let cfg = SynthConfig {
+            campaign: Campaign::PreloadTorque,
+            noise: 0.0,
+            nominal_effects: m.effects.clone(),
+            ..SynthConfig::default()
+        };
+        let candidate = SynthConfig { truth_forms: false, ..cfg.clone() };
+        let all_truth = SynthConfig { nominal_effects: Effects::none(), ..cfg.clone() };
+        // the own effect alone: the data are the candidate forms' data, bit for bit, and
+        // differ from those of its truth form
+        assert!(!true_motor(&m, &cfg).effects.is_truth_form(Effect::PreloadStiffening));
+        let own = synthesize(&m, &cfg).unwrap();
+        assert_eq!(own, synthesize(&m, &candidate).unwrap());
+        assert_ne!(own, synthesize(&m, &all_truth).unwrap());
+        // an added effect takes its truth form, the own one stays candidate: the data differ
+        // from both the all-candidate and the all-truth data
+        let mut added = m.clone();
+        added.effects.set_strength(Effect::VoltageSag, 200.0);
+        let t = true_motor(&added, &cfg).effects;
+        assert!(t.is_truth_form(Effect::VoltageSag) && !t.is_truth_form(Effect::PreloadStiffening));
+        let mixed = synthesize(&added, &cfg).unwrap();
+        assert_ne!(mixed, synthesize(&added, &candidate).unwrap());
+        assert_ne!(mixed, synthesize(&added, &all_truth).unwrap());
+        // the second family for the added effect only
+        let b = true_motor(&added, &SynthConfig { truth_form_b: true, ..cfg.clone() }).effects;
+        assert!(b.is_truth_form_b(Effect::VoltageSag) && !b.is_truth_form(Effect::PreloadStiffening));
+        // the own effect at another strength is not the model's: truth form
+        let mut changed = m.clone();
+        changed.effects.set_strength(Effect::PreloadStiffening, 0.4);
+        assert!(true_motor(&changed, &cfg).effects.is_truth_form(Effect::PreloadStiffening));
+        // with --candidate-forms nothing takes a truth form
+        assert!(!true_motor(&added, &candidate).effects.is_truth_form(Effect::VoltageSag));
+    }
 }
