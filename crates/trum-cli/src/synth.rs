@@ -105,19 +105,10 @@ pub fn parse_omit(spec: Option<&str>) -> Result<Vec<Observable>> {
 
 pub fn run(a: &SynthArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
     let (motor, _) = a.motor.load()?;
-    // Truth forms apply to every switched-on effect, the motor's own (a paper preset's
-    // contact stiffening) included: a diagnosis against the same motor then sees their
-    // form difference as a gap. Said before the data are written.
+    // The motor file's (or preset's) own effects are part of the nominal model a diagnosis
+    // of these data starts from: they keep their candidate forms; only what --effect adds
+    // or changes takes a truth form.
     let own = crate::motor::load_motor(&a.motor.motor)?.0.effects;
-    if !a.candidate_forms && !own.is_none() {
-        writeln!(
-            err,
-            "warning: the motor's own effects ({}) are simulated in their truth forms too, so a diagnosis against \
-             this motor can name them; use --candidate-forms, or a motor file without effects, for data whose only \
-             unmodelled effects are those given with --effect",
-            own.active().iter().map(|e| e.name()).collect::<Vec<_>>().join(", ")
-        )?;
-    }
     for (flag, v) in [("--voltage-v", a.voltage_v), ("--frequency-hz", a.frequency_hz)] {
         if !(v.is_finite() && v > 0.0) {
             bail!("{flag} {v} must be a finite number > 0");
@@ -133,6 +124,7 @@ pub fn run(a: &SynthArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
         frequency_hz: a.frequency_hz,
         truth_forms: !a.candidate_forms,
         truth_form_b: a.truth_forms_b,
+        nominal_effects: own,
         omit: parse_omit(a.omit.as_deref())?,
         artefacts: Artefacts::parse(a.artefacts.as_deref().unwrap_or("")).map_err(|e| anyhow!("--artefacts: {e}"))?,
     };
@@ -143,12 +135,24 @@ pub fn run(a: &SynthArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
     let m = to_measurements(&rows).map_err(|e| anyhow!("{e}"))?;
     write_atomic(&a.output, ".csv", &m.to_csv_string(), out)?;
     if a.output.as_os_str() != "-" {
-        let forms = if motor.effects.is_none() {
-            ""
-        } else if a.candidate_forms {
-            " (candidate forms)"
-        } else {
-            " (truth forms)"
+        let truth = trum_core::synth::true_motor(&motor, &cfg).effects;
+        let forms = |truth_form: bool| {
+            let names: Vec<&str> = motor
+                .effects
+                .active()
+                .into_iter()
+                .filter(|&e| truth.is_truth_form(e) == truth_form)
+                .map(|e| e.name())
+                .collect();
+            names.join(", ")
+        };
+        let forms = match (forms(true), forms(false)) {
+            (t, c) if t.is_empty() && c.is_empty() => String::new(),
+            (t, c) if t.is_empty() => format!(" (candidate forms: {c})"),
+            (t, c) if c.is_empty() => format!(" ({} forms: {t})", if a.truth_forms_b { "truth-b" } else { "truth" }),
+            (t, c) => {
+                format!(" ({} forms: {t}; candidate forms: {c})", if a.truth_forms_b { "truth-b" } else { "truth" })
+            }
         };
         writeln!(
             err,

@@ -334,3 +334,51 @@ fn diagnose_errors_are_clear() {
     );
     assert!(e.contains("no data rows"), "{e}");
 }
+
+/// A preset's own effects (`trum60a`: `preload_stiffening`, `radial_friction`) are part of
+/// the model a diagnosis against that preset refits: `trum synth` simulates them in their
+/// candidate forms, so data with nothing added are diagnosed `none`; an effect added with
+/// `--effect` still takes its truth form.
+#[test]
+fn a_presets_own_effects_are_synthesised_in_candidate_form() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let data = path(d, "own.csv");
+    let o = trum(&[
+        "synth",
+        "--motor",
+        "trum60a",
+        "--campaign",
+        "preload-torque",
+        "--noise",
+        "1",
+        "--seed",
+        "3",
+        "-o",
+        &data,
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(err.contains("(candidate forms: radial_friction, preload_stiffening)"), "{err}");
+    let out = ok(&["diagnose", "--motor", "trum60a", "--data", &data]);
+    assert!(out.contains("verdict     none"), "{out}");
+    let added = path(d, "added.csv");
+    let o = trum(&[
+        "synth",
+        "--motor",
+        "trum60a",
+        "--campaign",
+        "stability",
+        "--noise",
+        "0",
+        "--seed",
+        "3",
+        "--effect",
+        "voltage_sag=100",
+        "-o",
+        &added,
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(err.contains("(truth forms: voltage_sag; candidate forms: radial_friction, preload_stiffening)"), "{err}");
+}

@@ -414,9 +414,10 @@ pub fn valid_names() -> String {
 pub struct Effects {
     on: [bool; N_EFFECTS],
     values: [[f64; MAX_PARAMS]; N_EFFECTS],
-    truth: bool,
-    /// With `truth`: the second family of bench-truth forms (docs/EFFECTS.md), held out of
-    /// every tuning of the diagnosis.
+    /// Per effect (registry order): its bench-truth form instead of its candidate form.
+    truth: [bool; N_EFFECTS],
+    /// For the effects in truth form: the second family of bench-truth forms
+    /// (docs/EFFECTS.md), held out of every tuning of the diagnosis.
     truth_b: bool,
     instrument: Instrument,
 }
@@ -465,26 +466,46 @@ impl Effects {
         Effects::default()
     }
 
-    /// Use the bench-truth forms of the effects (different in form from the candidate
-    /// forms that calibration and diagnosis fit; see docs/EFFECTS.md). `trum synth` uses
-    /// them by default so a diagnosis cannot pass by recognising its own formulas.
+    /// Use the bench-truth forms of every effect (different in form from the candidate
+    /// forms that calibration and diagnosis fit; see docs/EFFECTS.md), or none. `trum synth`
+    /// uses them for the effects it adds so a diagnosis cannot pass by recognising its own
+    /// formulas.
     pub fn set_truth_forms(&mut self, on: bool) {
-        self.truth = on;
+        self.truth = [on; N_EFFECTS];
         self.truth_b &= on;
     }
 
-    /// Use the second family of bench-truth forms (`true`) or the first (`false`); either
-    /// switches the truth forms on. The second family differs in form from the first and
-    /// from every candidate; the blind benchmark keeps it, and its artefacts, out of every
-    /// tuning of the diagnosis (docs/DIAGNOSIS.md).
+    /// Use the second family of bench-truth forms (`true`) or the first (`false`) for every
+    /// effect; either switches the truth forms of every effect on. The second family differs
+    /// in form from the first and from every candidate; the blind benchmark keeps it, and
+    /// its artefacts, out of every tuning of the diagnosis (docs/DIAGNOSIS.md).
     pub fn set_truth_form_b(&mut self, on: bool) {
-        self.truth = true;
+        self.truth = [true; N_EFFECTS];
         self.truth_b = on;
     }
 
-    /// True when the second family of bench-truth forms is in use.
+    /// Use effect `e`'s bench-truth form (`true`, of the family the others' truth forms
+    /// use: [`Effects::set_truth_form_b`]) or its candidate form (`false`), whether or not
+    /// it is switched on; the other effects keep theirs.
+    pub fn set_truth_form(&mut self, e: Effect, on: bool) {
+        self.truth[e as usize] = on;
+    }
+
+    /// True when effect `e` takes a bench-truth form (either family).
+    #[inline]
+    pub fn is_truth_form(&self, e: Effect) -> bool {
+        self.truth[e as usize]
+    }
+
+    /// True when effect `e` takes the second family of bench-truth forms.
+    #[inline]
+    pub fn is_truth_form_b(&self, e: Effect) -> bool {
+        self.truth[e as usize] && self.truth_b
+    }
+
+    /// True when every effect takes the second family of bench-truth forms.
     pub fn truth_form_b(&self) -> bool {
-        self.truth && self.truth_b
+        self.truth_forms() && self.truth_b
     }
 
     /// The bench's instrument artefacts (nuisance parameters of a fit).
@@ -497,9 +518,9 @@ impl Effects {
         &mut self.instrument
     }
 
-    /// True when the bench-truth forms are in use.
+    /// True when every effect takes its bench-truth form.
     pub fn truth_forms(&self) -> bool {
-        self.truth
+        self.truth.iter().all(|&t| t)
     }
 
     /// True when no effect is switched on.
@@ -714,7 +735,11 @@ impl Effects {
 
     /// `[effects]` section in TOML (empty string when none is on).
     pub fn to_toml(&self) -> String {
-        let form = match (self.truth, self.truth_b) {
+        // the `form` key sets every effect's form: a mix (synthetic data's true motor) is
+        // written as the forms of its switched-on effects when they agree, else candidate
+        let active = self.active();
+        let truth = if active.is_empty() { self.truth_forms() } else { active.iter().all(|&e| self.is_truth_form(e)) };
+        let form = match (truth, self.truth_b) {
             (true, true) => "form = \"truth-b\"\n",
             (true, false) => "form = \"truth\"\n",
             _ => "",
@@ -760,8 +785,12 @@ impl fmt::Display for Effects {
             })
             .collect();
         f.write_str(&parts.join(" + "))?;
-        if self.truth {
-            f.write_str(if self.truth_b { " [truth forms b]" } else { " [truth forms]" })?;
+        let truth: Vec<&str> = self.active().into_iter().filter(|&e| self.is_truth_form(e)).map(|e| e.name()).collect();
+        let family = if self.truth_b { " [truth forms b" } else { " [truth forms" };
+        if truth.len() == self.active().len() && self.truth_forms() {
+            write!(f, "{family}]")?;
+        } else if !truth.is_empty() {
+            write!(f, "{family}: {}]", truth.join(", "))?;
         }
         Ok(())
     }
@@ -859,5 +888,42 @@ mod tests {
             .expect_err("the strength left out")
             .to_string();
         assert!(err.contains("missing parameter 'stiffness_scale'"), "{err}");
+    }
+
+    /// The global setters set every effect's form (a motor file's `form` key, before or
+    /// after the effects, means the same); one effect's form is set apart from the others',
+    /// and the family of the truth forms is shared.
+    #[test]
+    fn truth_forms_are_chosen_per_effect() {
+        let read = |text: &str| {
+            let t: toml::Table = text.parse().expect("toml");
+            let fx = t.get("effects").and_then(|v| v.as_table()).expect("[effects]");
+            Effects::from_toml_table(fx, text, "m.toml").expect("valid")
+        };
+        for text in
+            ["[effects]\nform = \"truth-b\"\nvoltage_sag = 100\n", "[effects]\nvoltage_sag = 100\nform = \"truth-b\"\n"]
+        {
+            let fx = read(text);
+            assert!(fx.truth_forms() && fx.truth_form_b(), "{text}");
+            assert!(ALL.iter().all(|&e| fx.is_truth_form(e) && fx.is_truth_form_b(e)), "{text}");
+            assert_eq!(read(&fx.to_toml()), fx, "round trip");
+        }
+        let mut fx = Effects::none();
+        fx.set_strength(Effect::VoltageSag, 100.0);
+        fx.set_strength(Effect::RadialFriction, 0.3);
+        assert!(!ALL.iter().any(|&e| fx.is_truth_form(e)));
+        fx.set_truth_form_b(true);
+        fx.set_truth_form(Effect::RadialFriction, false);
+        assert!(fx.is_truth_form_b(Effect::VoltageSag) && fx.is_truth_form(Effect::ThermalDrift));
+        assert!(!fx.is_truth_form(Effect::RadialFriction) && !fx.is_truth_form_b(Effect::RadialFriction));
+        assert!(!fx.truth_forms() && !fx.truth_form_b());
+        assert!(fx.to_string().ends_with("[truth forms b: voltage_sag]"), "{fx}");
+        // a mix is written as candidate (the `form` key sets every effect)
+        assert!(!fx.to_toml().contains("form ="), "{}", fx.to_toml());
+        fx.set_truth_forms(false);
+        assert!(!ALL.iter().any(|&e| fx.is_truth_form(e)) && !fx.to_string().contains("truth"));
+        fx.set_truth_form(Effect::VoltageSag, true);
+        assert!(fx.is_truth_form(Effect::VoltageSag) && !fx.is_truth_form_b(Effect::VoltageSag));
+        assert!(fx.to_string().ends_with("[truth forms: voltage_sag]"), "{fx}");
     }
 }

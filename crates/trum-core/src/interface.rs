@@ -18,6 +18,7 @@
 
 use crate::contact;
 use crate::contact::Contact;
+use crate::effects::Effect;
 use crate::solve::trial::Drive;
 use crate::solve::Prepared;
 use std::f64::consts::PI;
@@ -30,9 +31,12 @@ pub struct Law {
     pub radial_ratio: f64,
     /// σ: slip-speed scale of the saturation over the crest speed [-].
     pub slip_scale: f64,
-    /// Use the bench-truth forms (radius-resolved radial slip, algebraic saturation)
-    /// instead of the candidate forms the diagnosis fits. See docs/EFFECTS.md.
+    /// Use the bench-truth form of the saturation (algebraic) instead of the candidate
+    /// form the diagnosis fits (`tangential_compliance`'s). See docs/EFFECTS.md.
     pub truth: bool,
+    /// Use the bench-truth form of the radial slip (radius-resolved) instead of the
+    /// candidate form (`radial_friction`'s). See docs/EFFECTS.md.
+    pub truth_radial: bool,
     /// n: sharpness of the candidate saturation's turn from stick to slip,
     /// S(x) = tanh(xⁿ)^(1/n) [-]; 1 is tanh (`tangential_compliance`'s `stick_sharpness`).
     pub sharpness: f64,
@@ -1002,7 +1006,7 @@ const WIDTH_NODES: [(f64, f64); 5] = [
 /// the radial slope ∂R/∂r of the mode shape, hence ρ, varies linearly across the contact
 /// width (±40 % between inner and outer edge); otherwise one ρ.
 fn radii(law: &Law) -> impl Iterator<Item = (f64, f64)> + '_ {
-    let resolved = law.truth && law.radial_ratio > 0.0;
+    let resolved = law.truth_radial && law.radial_ratio > 0.0;
     let width =
         WIDTH_NODES.iter().filter(move |_| resolved).map(|&(y, w)| (law.radial_ratio * (1.0 + 0.4 * y), 0.5 * w));
     width.chain(std::iter::once((law.radial_ratio, 1.0)).filter(move |_| !resolved))
@@ -1258,19 +1262,19 @@ pub(crate) fn interface_law(p: &Prepared, d: &Drive, ct: &Contact) -> Law {
         // its normal deflection W·(1 − c) before it slips, at the wave's frequency,
         // relative to the crest speed k·h0·ω·W.
         law.slip_scale = p.compliance * d.mu * (1.0 - ct.offset.max(-1.0)) / (p.k * p.h0);
-        if p.truth_b {
+        if p.truth_b(Effect::TangentialCompliance) {
             // the second truth family: a layer whose shear deflection before slip grows
             // with the square root of its normal deflection
             law.slip_scale = p.compliance * d.mu * 0.7 * (1.0 - ct.offset.max(-1.0)).sqrt() / (p.k * p.h0);
         }
     }
-    if p.truth_b && law.radial_ratio > 0.0 {
+    if p.truth_b(Effect::RadialFriction) && law.radial_ratio > 0.0 {
         // the second truth family: radial slip that grows with the width of a Hertzian
         // line contact (∝ √F_N) until the contact spans the tooth face at 300 N, then
         // stays: a kink no power of the preload follows
         law.radial_ratio = p.law.radial_ratio * (d.f_n.max(0.0) / 300.0).sqrt().min(1.0);
     }
-    if !p.truth && p.radial_exponent != 0.0 && law.radial_ratio > 0.0 {
+    if !p.truth(Effect::RadialFriction) && p.radial_exponent != 0.0 && law.radial_ratio > 0.0 {
         law.radial_ratio = preload_grown_radial_ratio(p.law.radial_ratio, p.radial_exponent, d.f_n);
     }
     law
@@ -1389,14 +1393,14 @@ mod tests {
     #[test]
     fn node_angles_by_angle_addition_match_direct_evaluation() {
         for law in [
-            Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 0.7, slip_scale: 0.0, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 0.0, slip_scale: 0.03, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 0.3, slip_scale: 0.02, truth: true, sharpness: 1.0 },
-            Law { radial_ratio: 0.0, slip_scale: 0.2, truth: true, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.7, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.03, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.3, slip_scale: 0.02, truth: true, truth_radial: true, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.2, truth: true, truth_radial: true, sharpness: 1.0 },
         ] {
             for &y in &[0.05, 0.8, 2.0, 3.1, 5.0] {
                 let ct = contact_from_ratio(y);
@@ -1422,7 +1426,7 @@ mod tests {
 
     #[test]
     fn coulomb_limit_reproduces_the_closed_forms() {
-        let law = Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false, sharpness: 1.0 };
+        let law = Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 };
         for &y in &[0.3, 1.5, 3.0, 4.0] {
             let ct = contact_from_ratio(y);
             for &u in &[0.0f64, 0.2, 0.6, 0.95] {
@@ -1446,11 +1450,11 @@ mod tests {
     fn torque_derivative_matches_central_differences() {
         let mut worst: f64 = 0.0;
         for law in [
-            Law { radial_ratio: 0.5, slip_scale: 0.0, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 0.0, slip_scale: 0.05, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 0.3, slip_scale: 0.02, truth: true, sharpness: 1.0 },
-            Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.5, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.05, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.3, slip_scale: 0.02, truth: true, truth_radial: true, sharpness: 1.0 },
+            Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false, truth_radial: false, sharpness: 1.0 },
         ] {
             for (&y, &u) in [0.8, 1.5].iter().flat_map(|y| [0.1, 0.5, 0.9, 0.99, 0.999].iter().map(move |u| (y, u))) {
                 let ct = contact_from_ratio(y);
@@ -1498,25 +1502,25 @@ mod tests {
     fn factors_agree_with_adaptive_quadrature_of_their_integrals() {
         use crate::quad::integrate;
         let laws = [
-            (Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 0.3, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.02, truth: false, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 0.003, slip_scale: 0.0, truth: true, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.003, truth: true, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.2, truth: false, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 0.5, slip_scale: 0.0, truth: true, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.05, truth: true, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 0.0, slip_scale: 0.1, truth: false, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 1.0, slip_scale: 0.0, truth: true, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 0.5, slip_scale: 0.02, truth: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0035, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.3, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.003, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.02, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.003, slip_scale: 0.0, truth: true, truth_radial: true, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.003, truth: true, truth_radial: true, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.2, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.5, slip_scale: 0.0, truth: true, truth_radial: true, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.05, truth: true, truth_radial: true, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.0, slip_scale: 0.1, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 1.0, slip_scale: 0.0, truth: true, truth_radial: true, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 0.5, slip_scale: 0.02, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-12),
             // nearer than MIN_FEATURE_WIDTH (graded as that far), or at u = 1 exactly
-            (Law { radial_ratio: 1e-7, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 1.5e-9),
-            (Law { radial_ratio: 0.0, slip_scale: 1e-7, truth: false, sharpness: 1.0 }, 1.5e-12),
-            (Law { radial_ratio: 1e-14, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 3e-8),
+            (Law { radial_ratio: 1e-7, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-9),
+            (Law { radial_ratio: 0.0, slip_scale: 1e-7, truth: false, truth_radial: false, sharpness: 1.0 }, 1.5e-12),
+            (Law { radial_ratio: 1e-14, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 }, 3e-8),
         ];
         for (law, tol) in laws {
             let (mut worst, mut worst_mid): (f64, f64) = (0.0, 0.0);
@@ -1591,11 +1595,11 @@ mod tests {
     #[test]
     fn the_nearest_singularity_is_a_zero_of_the_slip() {
         let laws = [
-            Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 0.0, slip_scale: 0.02, truth: false, sharpness: 1.0 },
-            Law { radial_ratio: 0.3, slip_scale: 0.01, truth: true, sharpness: 1.0 },
+            Law { radial_ratio: 0.05, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.0, slip_scale: 0.02, truth: false, truth_radial: false, sharpness: 1.0 },
+            Law { radial_ratio: 0.3, slip_scale: 0.01, truth: true, truth_radial: true, sharpness: 1.0 },
         ];
         for law in laws {
             let kappa = law.slip_scale * if law.truth { 1.0 } else { std::f64::consts::FRAC_PI_2 };
@@ -1627,13 +1631,19 @@ mod tests {
                 assert!(step <= 0.01 * im, "{law:?} u={u}: ({re}, {im}) is {step} from a zero");
             }
         }
-        let z =
-            nearest_singularity(&Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false, sharpness: 1.0 }, -0.6, 1.0)
-                .expect("a zero");
+        let z = nearest_singularity(
+            &Law { radial_ratio: 1.0, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+            -0.6,
+            1.0,
+        )
+        .expect("a zero");
         assert!((z.1 - 0.5108).abs() < 1e-3, "{z:?}");
-        let z =
-            nearest_singularity(&Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false, sharpness: 1.0 }, 0.0, 1.0)
-                .expect("a zero");
+        let z = nearest_singularity(
+            &Law { radial_ratio: 1.5, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+            0.0,
+            1.0,
+        )
+        .expect("a zero");
         assert_eq!(z.0, 0.0, "{z:?}");
     }
 
@@ -1669,7 +1679,7 @@ mod tests {
     fn windowed_compliance_factors_agree_with_the_whole_contact_rule() {
         let mut worst: f64 = 0.0;
         for &sigma in &[1e-7, 1e-5, 3e-4, 0.003, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 3.0] {
-            let law = Law { radial_ratio: 0.0, slip_scale: sigma, truth: false, sharpness: 1.0 };
+            let law = Law { radial_ratio: 0.0, slip_scale: sigma, truth: false, truth_radial: false, sharpness: 1.0 };
             for &y in &[0.02, 0.3, 0.7, 1.0, 1.5, 2.0, 3.0, 3.2, 4.0, 6.0] {
                 let ct = contact_from_ratio(y);
                 for &u in &[
@@ -1717,8 +1727,13 @@ mod tests {
     /// some of them (it would not be tested otherwise).
     #[test]
     fn speed_free_rule_agrees_with_the_split_rule() {
-        let law =
-            |rho: f64, sigma: f64, truth: bool| Law { radial_ratio: rho, slip_scale: sigma, truth, sharpness: 1.0 };
+        let law = |rho: f64, sigma: f64, truth: bool| Law {
+            radial_ratio: rho,
+            slip_scale: sigma,
+            truth,
+            truth_radial: truth,
+            sharpness: 1.0,
+        };
         let laws = [
             law(1.0, 0.0, false),
             law(0.3, 0.0, false),
@@ -1767,8 +1782,16 @@ mod tests {
     #[test]
     fn radial_slip_lowers_torque_and_dissipates() {
         let ct = contact_from_ratio(1.5);
-        let base = factors(&ct, 0.5, &Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false, sharpness: 1.0 });
-        let rad = factors(&ct, 0.5, &Law { radial_ratio: 0.5, slip_scale: 0.0, truth: false, sharpness: 1.0 });
+        let base = factors(
+            &ct,
+            0.5,
+            &Law { radial_ratio: 0.0, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+        );
+        let rad = factors(
+            &ct,
+            0.5,
+            &Law { radial_ratio: 0.5, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
+        );
         assert!(rad.torque < base.torque);
         assert!(rad.radial > 0.0);
         // dissipation ∫ μ p |s| ≥ 0: power − u·torque
@@ -1813,8 +1836,13 @@ mod tests {
     #[test]
     fn stick_slip_factors_agree_with_adaptive_quadrature() {
         use crate::quad::integrate;
-        let law =
-            |rho: f64, sigma: f64, n: f64| Law { radial_ratio: rho, slip_scale: sigma, truth: false, sharpness: n };
+        let law = |rho: f64, sigma: f64, n: f64| Law {
+            radial_ratio: rho,
+            slip_scale: sigma,
+            truth: false,
+            truth_radial: false,
+            sharpness: n,
+        };
         let laws =
             [law(0.0, 0.02, 2.0), law(0.0, 0.02, 4.0), law(0.0, 0.2, 3.0), law(0.0, 0.003, 4.0), law(0.3, 0.05, 2.0)];
         let mut worst: f64 = 0.0;

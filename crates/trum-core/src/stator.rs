@@ -11,6 +11,7 @@
 //! not in the baseline.
 
 use crate::contact::{self, Contact};
+use crate::effects::Effect;
 use crate::solve::bracket::SignBracket;
 use crate::solve::trial::Drive;
 use crate::solve::Prepared;
@@ -126,9 +127,9 @@ pub fn width_integrated_modal_projection(c: f64) -> f64 {
 /// The Hertzian driving-circuit paper (2022): the softening cubic term by harmonic balance,
 /// k − (3/4)·β·W²; this returns (3/4)·β·(its growth with the preload) [N/m³].
 pub(crate) fn softening_per_w2(p: &Prepared, d: &Drive) -> f64 {
-    let growth = if p.truth_b {
+    let growth = if p.truth_b(Effect::HertzSoftening) {
         (0.8 * p.beta_gain * d.f_n).exp()
-    } else if p.truth {
+    } else if p.truth(Effect::HertzSoftening) {
         // the first truth family: a Hertzian contact F = c·δ^(3/2) expanded about its
         // static compression δ0 has a cubic term ∝ δ0^(−3/2) ∝ 1/F_N (Johnson 1985,
         // Contact Mechanics, the Hertz solution): the contact's share of the softening
@@ -163,11 +164,11 @@ pub(crate) fn modal_stiffness(p: &Prepared, d: &Drive, w: f64, ct: &Contact, a: 
     if p.stiffening != 0.0 {
         let layer = p.n * p.kf / p.k;
         k_eff += p.stiffening
-            * if p.truth_b {
+            * if p.truth_b(Effect::PreloadStiffening) {
                 // the second truth family: the axial form of the contact stiffness with a
                 // layer that stiffens as it is pressed
                 a * ct.chi0() / w * (1.0 + d.f_n / 300.0)
-            } else if p.truth {
+            } else if p.truth(Effect::PreloadStiffening) {
                 layer * width_integrated_modal_projection(ct.offset)
             } else {
                 // Sun et al. 2021 eq. 8: k_s' = (2 n k_f / k)·[sin(kx0) − kx0·cos(kx0)] =
@@ -209,7 +210,7 @@ pub(crate) fn stiffness_crossing(p: &Prepared, d: &Drive, w_top: f64) -> Option<
         // the truth form's softening is also ∝ W² (its preload growth differs)
         (false, true) => (detuning > 0.0).then(|| (detuning / softening_per_w2(p, d)).sqrt())?,
         // (Sun et al. 2021 eq. 8 alone: A·χ(φ0)/W = F/W)
-        (true, false) if !p.truth && p.modal_fraction == 0.0 => {
+        (true, false) if !p.truth(Effect::PreloadStiffening) && p.modal_fraction == 0.0 => {
             (detuning < 0.0).then(|| p.stiffening * d.f_n / -detuning)?
         }
         _ => {

@@ -5,6 +5,7 @@
 //! which differ in form from the candidates the diagnosis fits — and every reading gets
 //! realistic noise. Reproducible from the seed.
 
+use crate::effects::Effects;
 use crate::error::TrumError;
 use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
@@ -68,10 +69,18 @@ pub struct SynthConfig {
     pub voltage_v: f64,
     /// Drive frequency of the fixed-drive campaigns [Hz].
     pub frequency_hz: f64,
-    /// Use the truth forms of the effects (default) rather than the candidate forms.
+    /// Use the truth forms of the effects (default) rather than the candidate forms, for
+    /// every effect but those of `nominal_effects`.
     pub truth_forms: bool,
     /// With `truth_forms`: the second family of truth forms (docs/EFFECTS.md).
     pub truth_form_b: bool,
+    /// The effects of the nominal model the data are to be diagnosed against (a motor
+    /// file's or preset's own). An effect the simulated motor has switched on with the
+    /// same parameters as here is part of that model, not unknown physics, and is
+    /// simulated in its candidate form, the form the model has; every other effect (one
+    /// added to the motor, or given other parameters) is the bench's unknown physics and
+    /// takes its truth form (with `truth_forms`). None by default: every effect in truth form.
+    pub nominal_effects: Effects,
     /// Optional columns to leave out (to mimic a poorer bench).
     pub omit: Vec<Observable>,
     /// What the bench adds to its readings besides their noise (none by default).
@@ -158,6 +167,7 @@ impl Default for SynthConfig {
             frequency_hz: 43_000.0,
             truth_forms: true,
             truth_form_b: false,
+            nominal_effects: Effects::none(),
             omit: Vec::new(),
             artefacts: Artefacts::default(),
         }
@@ -209,7 +219,8 @@ pub const PERTURBED: [(&str, f64); 11] = [
     ("electrical.feedback_gain_v_per_m", 1.0),
 ];
 
-/// The true motor: `motor` with its uncertain parameters perturbed.
+/// The true motor: `motor` with its uncertain parameters perturbed, its effects in the
+/// forms `cfg` gives (truth forms for all but the nominal model's own).
 pub fn true_motor(motor: &Motor, cfg: &SynthConfig) -> Motor {
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.motor_seed.unwrap_or(cfg.seed) ^ 0x005e_ed0f_7e57);
     let mut m = motor.clone();
@@ -223,6 +234,11 @@ pub fn true_motor(motor: &Motor, cfg: &SynthConfig) -> Motor {
     m.effects.set_truth_forms(cfg.truth_forms);
     if cfg.truth_forms && cfg.truth_form_b {
         m.effects.set_truth_form_b(true);
+    }
+    for e in m.effects.active() {
+        if cfg.nominal_effects.get(e) == m.effects.get(e) {
+            m.effects.set_truth_form(e, false);
+        }
     }
     m
 }
@@ -412,5 +428,47 @@ mod tests {
         let ws = synthesize(&m, &SynthConfig { campaign: Campaign::WarmUp, ..SynthConfig::default() }).unwrap();
         assert!(ws.iter().all(|r| r.time_series && r.readings.iter().any(|x| x.0 == Observable::TemperatureC)));
         assert!(Campaign::from_name("bogus").unwrap_err().to_string().contains("valid campaigns are"));
+    }
+
+    /// The nominal model's own effects keep their candidate form (the form the model a
+    /// diagnosis starts from has); an added effect, or an own one at another strength, is
+    /// the bench's unknown physics and takes its truth form.
+    #[test]
+    fn own_effects_keep_their_candidate_form_and_added_ones_take_their_truth_form() {
+        use crate::effects::Effect;
+        let mut m = crate::calibrate::tests::reference_motor();
+        m.effects.set_strength(Effect::PreloadStiffening, 0.2);
+        let cfg = SynthConfig {
+            campaign: Campaign::PreloadTorque,
+            noise: 0.0,
+            nominal_effects: m.effects.clone(),
+            ..SynthConfig::default()
+        };
+        let candidate = SynthConfig { truth_forms: false, ..cfg.clone() };
+        let all_truth = SynthConfig { nominal_effects: Effects::none(), ..cfg.clone() };
+        // the own effect alone: the data are the candidate forms' data, bit for bit, and
+        // differ from those of its truth form
+        assert!(!true_motor(&m, &cfg).effects.is_truth_form(Effect::PreloadStiffening));
+        let own = synthesize(&m, &cfg).unwrap();
+        assert_eq!(own, synthesize(&m, &candidate).unwrap());
+        assert_ne!(own, synthesize(&m, &all_truth).unwrap());
+        // an added effect takes its truth form, the own one stays candidate: the data differ
+        // from both the all-candidate and the all-truth data
+        let mut added = m.clone();
+        added.effects.set_strength(Effect::VoltageSag, 200.0);
+        let t = true_motor(&added, &cfg).effects;
+        assert!(t.is_truth_form(Effect::VoltageSag) && !t.is_truth_form(Effect::PreloadStiffening));
+        let mixed = synthesize(&added, &cfg).unwrap();
+        assert_ne!(mixed, synthesize(&added, &candidate).unwrap());
+        assert_ne!(mixed, synthesize(&added, &all_truth).unwrap());
+        // the second family for the added effect only
+        let b = true_motor(&added, &SynthConfig { truth_form_b: true, ..cfg.clone() }).effects;
+        assert!(b.is_truth_form_b(Effect::VoltageSag) && !b.is_truth_form(Effect::PreloadStiffening));
+        // the own effect at another strength is not the model's: truth form
+        let mut changed = m.clone();
+        changed.effects.set_strength(Effect::PreloadStiffening, 0.4);
+        assert!(true_motor(&changed, &cfg).effects.is_truth_form(Effect::PreloadStiffening));
+        // with --candidate-forms nothing takes a truth form
+        assert!(!true_motor(&added, &candidate).effects.is_truth_form(Effect::VoltageSag));
     }
 }

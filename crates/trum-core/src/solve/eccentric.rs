@@ -2,6 +2,7 @@
 //! varies with its angle.
 
 use super::{map_solution, OperatingPoint, Prepared, Solution, Status, RAD_S_TO_RPM};
+use crate::effects::Effect;
 use crate::params::Motor;
 use std::f64::consts::PI;
 
@@ -40,16 +41,16 @@ pub(crate) fn eccentric_average_with(
     // A ripple even in φ has sample j and SAMPLES − j at the same preload: solve j = 0 ..=
     // SAMPLES/2 and count the inner ones twice (5 solves instead of 8, 4 for the candidate
     // form). The first truth family's is not even: all 8.
-    let even = !p.truth || p.truth_b;
+    let even = !p.truth(Effect::Eccentricity) || p.truth_b(Effect::Eccentricity);
     let solved = if even { SAMPLES / 2 + 1 } else { SAMPLES };
     let mut speeds = [(0.0, 0.0); SAMPLES];
     let mut prev = nominal.clone();
     for (j, sp) in speeds.iter_mut().enumerate().take(solved) {
         let phi = 2.0 * PI * j as f64 / SAMPLES as f64;
-        let shape = if p.truth_b {
+        let shape = if p.truth_b(Effect::Eccentricity) {
             // the second truth family: the ripple clipped at half its peak
             phi.cos().min(0.5)
-        } else if p.truth {
+        } else if p.truth(Effect::Eccentricity) {
             (phi.cos() + 0.3 * (2.0 * phi).sin()) / 1.3
         } else if p.runout_harmonics != [0.0, 0.0] {
             runout_shape(phi, p.runout_harmonics)
@@ -60,7 +61,7 @@ pub(crate) fn eccentric_average_with(
         let mut o = *op;
         o.preload_n = op.preload_n + ripple * shape;
         // at a quarter turn the candidate's ripple is zero: the nominal solve is that sample
-        let s = if !p.truth && p.runout_harmonics[0] == 0.0 && 4 * j == SAMPLES {
+        let s = if !p.truth(Effect::Eccentricity) && p.runout_harmonics[0] == 0.0 && 4 * j == SAMPLES {
             nominal.clone()
         } else {
             solve_at(&o, Some(&prev))

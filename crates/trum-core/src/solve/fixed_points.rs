@@ -8,6 +8,7 @@ use super::descent::{amplitude_rtol, solve_drive, solve_drive_below, WarmTop};
 use super::finish::{clamped_trial, finish, rest_torque_factor};
 use super::trial::{sagged_voltage_at, sagged_voltage_v, trial, Drive, Trial};
 use super::{OperatingPoint, Prepared, Solution, Status};
+use crate::effects::Effect;
 use crate::stator;
 
 /// Effects that depend on the solution itself (temperature from the losses, electrode
@@ -586,9 +587,9 @@ const BRACKET_AFTER: usize = 30;
 pub(super) fn temperature_rise_for_drift(p: &Prepared, loss_w: f64, elapsed_s: f64) -> f64 {
     let ss = loss_w / p.alpha_s;
     let tau = p.heat_cap / p.alpha_s;
-    if p.truth_b {
+    if p.truth_b(Effect::ThermalDrift) {
         ss * (1.0 - erfcx((elapsed_s.max(0.0) / tau).sqrt()))
-    } else if p.truth {
+    } else if p.truth(Effect::ThermalDrift) {
         let tau2 = 0.25 * tau;
         ss * (1.0 - (tau * (-elapsed_s / tau).exp() - tau2 * (-elapsed_s / tau2).exp()) / (tau - tau2))
     } else if p.thermal_interface != 0.0 {

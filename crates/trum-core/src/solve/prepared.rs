@@ -2,7 +2,7 @@
 
 use super::{iterated, OperatingPoint, Solution};
 use crate::contact;
-use crate::effects::Effect;
+use crate::effects::{Effect, ALL, N_EFFECTS};
 use crate::params::Motor;
 use crate::stator;
 
@@ -75,10 +75,11 @@ pub struct Prepared {
     /// `eccentricity`: twice- and three-times-per-revolution ripple relative to the
     /// once-per-revolution one [-].
     pub(crate) runout_harmonics: [f64; 2],
-    /// Effects in their truth forms (synthetic bench data) instead of the candidate forms.
-    pub(crate) truth: bool,
-    /// With `truth`: the second family of truth forms (docs/EFFECTS.md).
-    pub(crate) truth_b: bool,
+    /// Per effect (registry order): its truth form (synthetic bench data) instead of its
+    /// candidate form ([`Prepared::truth`]).
+    pub(crate) truth_of: [bool; N_EFFECTS],
+    /// Per effect: the second family of truth forms (docs/EFFECTS.md).
+    pub(crate) truth_b_of: [bool; N_EFFECTS],
     /// Whether solutions report the stall torque. For the generalised interface it costs a
     /// numerical integral per solve (the rotor at rest) that the speed solve itself rarely
     /// needs; calibration reads only the observables and leaves it out
@@ -117,7 +118,8 @@ impl Prepared {
             law: crate::interface::Law {
                 radial_ratio: fx.value(Effect::RadialFriction, 0),
                 slip_scale: 0.0,
-                truth: fx.truth_forms(),
+                truth: fx.is_truth_form(Effect::TangentialCompliance),
+                truth_radial: fx.is_truth_form(Effect::RadialFriction),
                 sharpness: if fx.is_on(Effect::TangentialCompliance) {
                     fx.value(Effect::TangentialCompliance, 1)
                 } else {
@@ -133,10 +135,22 @@ impl Prepared {
             thermal_interface: fx.value(Effect::ThermalDrift, 3),
             sag_knee_a: fx.value(Effect::VoltageSag, 1),
             runout_harmonics: [fx.value(Effect::Eccentricity, 1), fx.value(Effect::Eccentricity, 2)],
-            truth: fx.truth_forms(),
-            truth_b: fx.truth_form_b(),
+            truth_of: ALL.map(|e| fx.is_truth_form(e)),
+            truth_b_of: ALL.map(|e| fx.is_truth_form_b(e)),
             stall_torque: true,
         }
+    }
+
+    /// True when effect `e` takes a truth form (either family).
+    #[inline]
+    pub(crate) fn truth(&self, e: Effect) -> bool {
+        self.truth_of[e as usize]
+    }
+
+    /// True when effect `e` takes the second family of truth forms.
+    #[inline]
+    pub(crate) fn truth_b(&self, e: Effect) -> bool {
+        self.truth_b_of[e as usize]
     }
 
     /// The same motor with `stall_torque_nm` left NaN wherever it would cost an integral

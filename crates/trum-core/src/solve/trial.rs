@@ -5,6 +5,7 @@
 
 use super::{OperatingPoint, Prepared, Solution};
 use crate::contact::{self, Contact};
+use crate::effects::Effect;
 use crate::interface::{coulomb_interface, general_interface, interface_law, AngleCarry};
 use crate::stator::{self, modal_stiffness};
 
@@ -116,9 +117,9 @@ impl Drive {
     pub(crate) fn warm(&mut self, p: &Prepared, rise_k: f64) {
         // (the second truth family: a sensitivity that saturates over about 25 K)
         let law = |x: f64| {
-            if p.truth_b {
+            if p.truth_b(Effect::ThermalDrift) {
                 (1.0 + x * 25.0 * (rise_k / 25.0).tanh()).max(0.05)
-            } else if p.truth {
+            } else if p.truth(Effect::ThermalDrift) {
                 (x * rise_k).exp()
             } else {
                 (1.0 + x * rise_k).max(0.05)
@@ -140,9 +141,9 @@ pub(super) fn sagged_voltage_v(p: &Prepared, op: &OperatingPoint, s: &Solution) 
 pub(super) fn sagged_voltage_at(p: &Prepared, op: &OperatingPoint, (yr, yi): (f64, f64)) -> f64 {
     // (the second truth family: an output resistance that grows with the load current, as
     // a driver's saturating magnetics give)
-    let (zr, zi) = if p.truth_b {
+    let (zr, zi) = if p.truth_b(Effect::VoltageSag) {
         (p.sag_ohm * (0.4 + 4.5 * p.sag_ohm * yr.hypot(yi)), 0.0)
-    } else if p.truth {
+    } else if p.truth(Effect::VoltageSag) {
         (p.sag_ohm, 0.5 * p.sag_ohm)
     } else if p.sag_knee_a > 0.0 {
         return knee_sagged_voltage_v(op.voltage_v, p.sag_ohm, p.sag_knee_a, (yr, yi));
