@@ -181,7 +181,7 @@ def test_map_is_the_clis_map_bit_for_bit(motor):
     # 3 × 2 × 700 = 4200 points: two of the core's chunks, the second starting mid-row
     cli = shutil.which(os.environ["TRUM_BIN"]) or os.environ["TRUM_BIN"]
     out = subprocess.run([cli, "map", "--motor", "trum60a", "--preload-n", "100:400:3", "--voltage-v", "180:220:2",
-                          "--torque-nm", "0:1.4:700", "--columns", "speed_rpm,efficiency,amplitude_m", "-o", "-"],
+                          "--frequency-hz", "43000", "--torque-nm", "0:1.4:700", "--columns", "speed_rpm,efficiency,amplitude_m", "-o", "-"],
                          check=True, capture_output=True, text=True).stdout
     rows = list(csv.DictReader(io.StringIO(out)))
     d = trum.map(motor, preload_n=trum.linspace(100, 400, 3), voltage_v=trum.linspace(180, 220, 2), frequency_hz=43e3, torque_nm=trum.linspace(0, 1.4, 700))
