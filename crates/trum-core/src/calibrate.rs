@@ -36,6 +36,8 @@ pub enum InstrumentParam {
     SpeedStdFloorRpm,
     /// [`crate::effects::Instrument::torque_offset_nm`].
     TorqueOffsetNm,
+    /// [`crate::effects::Instrument::temperature_offset_k`].
+    TemperatureOffsetK,
 }
 
 impl ParamRef {
@@ -46,6 +48,7 @@ impl ParamRef {
             ParamRef::Effect(e, i) => format!("effects.{}.{}", e.name(), e.info().params[*i].name),
             ParamRef::Instrument(InstrumentParam::SpeedStdFloorRpm) => "bench.speed_std_floor_rpm".into(),
             ParamRef::Instrument(InstrumentParam::TorqueOffsetNm) => "bench.torque_offset_nm".into(),
+            ParamRef::Instrument(InstrumentParam::TemperatureOffsetK) => "bench.temperature_offset_k".into(),
         }
     }
 
@@ -55,6 +58,7 @@ impl ParamRef {
             ParamRef::Effect(e, i) => m.effects.value(*e, *i),
             ParamRef::Instrument(InstrumentParam::SpeedStdFloorRpm) => m.effects.instrument().speed_std_floor_rpm,
             ParamRef::Instrument(InstrumentParam::TorqueOffsetNm) => m.effects.instrument().torque_offset_nm,
+            ParamRef::Instrument(InstrumentParam::TemperatureOffsetK) => m.effects.instrument().temperature_offset_k,
         }
     }
 
@@ -70,6 +74,9 @@ impl ParamRef {
                 m.effects.instrument_mut().speed_std_floor_rpm = v
             }
             ParamRef::Instrument(InstrumentParam::TorqueOffsetNm) => m.effects.instrument_mut().torque_offset_nm = v,
+            ParamRef::Instrument(InstrumentParam::TemperatureOffsetK) => {
+                m.effects.instrument_mut().temperature_offset_k = v
+            }
         }
     }
 }
@@ -213,6 +220,9 @@ pub fn baseline_params_with(
     if let Some(fp) = torque_offset_param(rows, overrides) {
         out.push(fp);
     }
+    if let Some(fp) = temperature_offset_param(rows, overrides) {
+        out.push(fp);
+    }
     out.extend(own_effect_params(motor));
     out
 }
@@ -282,6 +292,42 @@ fn torque_offset_param(rows: &[ObservedRow], overrides: &std::collections::BTree
         lo: -half,
         // (the bounded transform keeps a fit strictly inside: no load below zero)
         hi: half.min(lowest),
+        log: false,
+        prior: sd.is_finite().then_some(Prior { centre: 0.0, sd }),
+    })
+}
+
+/// Default prior standard deviation of the temperature reading's offset [K]: a class-1
+/// thermocouple is good to ±1.5 K (IEC 60584-1), a class-B resistance thermometer to
+/// ±0.3 K plus 0.5 % of the temperature (IEC 60751); the ambient sensor it is read against
+/// has its own error.
+pub const TEMPERATURE_OFFSET_SD_K: f64 = 1.0;
+
+/// The temperature reading's offset (a bench nuisance), where the stator temperature is
+/// read at least three times: a Gaussian prior centred on zero with a standard deviation of
+/// [`TEMPERATURE_OFFSET_SD_K`], bounded at ±5 standard deviations (at least ±5 K). A
+/// tolerance in the motor file's `[tolerances]` under `bench.temperature_offset_k` (in K)
+/// replaces the prior's width; 0 holds the offset at zero, `inf` fits it without a prior.
+/// The offset moves the readings, never the stator's temperature: effects that follow the
+/// temperature (`thermal_drift`) see the model's.
+fn temperature_offset_param(
+    rows: &[ObservedRow],
+    overrides: &std::collections::BTreeMap<String, f64>,
+) -> Option<FitParam> {
+    let key = "bench.temperature_offset_k";
+    let n = rows.iter().flat_map(|r| &r.readings).filter(|x| x.0 == Observable::TemperatureC).count();
+    if n < 3 {
+        return None;
+    }
+    let sd = overrides.get(key).copied().unwrap_or(TEMPERATURE_OFFSET_SD_K);
+    if sd.is_nan() || sd <= 0.0 {
+        return None;
+    }
+    let half = if sd.is_finite() { (5.0 * sd).max(5.0) } else { 20.0 };
+    Some(FitParam {
+        param: ParamRef::Instrument(InstrumentParam::TemperatureOffsetK),
+        lo: -half,
+        hi: half,
         log: false,
         prior: sd.is_finite().then_some(Prior { centre: 0.0, sd }),
     })

@@ -436,6 +436,12 @@ pub struct Instrument {
     /// mounting by a fraction of a percent of its full scale, which on a steep
     /// speed-torque line is a speed error of the order of the readings' own noise.
     pub torque_offset_nm: f64,
+    /// Offset of the stator temperature reading [K]: the sensor shows the stator's
+    /// temperature plus this. A thermocouple or a resistance thermometer read against an
+    /// ambient sensor elsewhere is off by up to about 1.5 K (a class-1 thermocouple's
+    /// tolerance, IEC 60584-1), which on a warm-up of a few kelvin is a gap far beyond a
+    /// reading's noise.
+    pub temperature_offset_k: f64,
 }
 
 impl Instrument {
@@ -455,6 +461,7 @@ impl Instrument {
             crate::observable::Observable::SpeedStdRpm if self.speed_std_floor_rpm > 0.0 => {
                 model.hypot(self.speed_std_floor_rpm)
             }
+            crate::observable::Observable::TemperatureC => model + self.temperature_offset_k,
             _ => model,
         }
     }

@@ -102,14 +102,23 @@ pub struct Artefacts {
     pub torque_offset_nm: f64,
     /// Resolution of the speed readings [rev/min] (0: none): readings are rounded to it.
     pub speed_quantum_rpm: f64,
+    /// Offset of the stator temperature sensor [K]: it reads the stator's temperature
+    /// plus this.
+    pub temperature_offset_k: f64,
     /// Fraction of readings replaced by gross outliers (a reading off by 5-15 of its σ).
     pub outlier_fraction: f64,
 }
 
 impl Artefacts {
     /// Names of the artefacts as written in `name=value` lists.
-    pub const NAMES: [&'static str; 5] =
-        ["readback_rel", "speed_std_floor_rpm", "torque_offset_nm", "speed_quantum_rpm", "outlier_fraction"];
+    pub const NAMES: [&'static str; 6] = [
+        "readback_rel",
+        "speed_std_floor_rpm",
+        "torque_offset_nm",
+        "speed_quantum_rpm",
+        "outlier_fraction",
+        "temperature_offset_k",
+    ];
 
     /// Parses `name=value,...` (e.g. `readback_rel=0.005,speed_std_floor_rpm=0.3`); the
     /// error names the bad item and lists the valid names.
@@ -132,6 +141,7 @@ impl Artefacts {
                 "torque_offset_nm" => &mut a.torque_offset_nm,
                 "speed_quantum_rpm" => &mut a.speed_quantum_rpm,
                 "outlier_fraction" => &mut a.outlier_fraction,
+                "temperature_offset_k" => &mut a.temperature_offset_k,
                 other => {
                     return Err(TrumError::input(format!(
                         "unknown bench artefact '{other}'; valid names are: {}",
@@ -364,6 +374,9 @@ pub fn synthesize(motor: &Motor, cfg: &SynthConfig) -> Result<Vec<SynthRow>, Tru
                     let mut v = o.predict(&s, ambient);
                     if o == Observable::SpeedStdRpm && art.speed_std_floor_rpm > 0.0 {
                         v = v.hypot(art.speed_std_floor_rpm);
+                    }
+                    if o == Observable::TemperatureC {
+                        v += art.temperature_offset_k;
                     }
                     let mut x = v + noise.gauss(reading_noise(o, v));
                     if art.outlier_fraction > 0.0 && bench.random::<f64>() < art.outlier_fraction {
