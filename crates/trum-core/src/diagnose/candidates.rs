@@ -233,7 +233,7 @@ impl<'a> Scorer<'a> {
             cal.as_ref().is_ok_and(|c| c.params.iter().any(|p| p.at_bound && !p.name.starts_with("effects.")));
         let second_start = !at_noise && (first_ev <= 5.0 || on_bound) && !collapsed;
         if second_start {
-            let mut s1 = motor.clone();
+            let mut s1 = with_bench(motor, start);
             for &e in effects {
                 s1.effects.set(e, &e.info().with_primary(e.info().params[0].typical));
             }
@@ -272,7 +272,7 @@ impl<'a> Scorer<'a> {
                 // same strengths as the one before it is not probed again)
                 let mut starts: Vec<Motor> = Vec::new();
                 for x in [1.0, 2.0, 4.0, 8.0] {
-                    let m = strong_start(motor, effects, &params, x);
+                    let m = strong_start(&with_bench(motor, start), effects, &params, x);
                     let seen = starts.last().is_some_and(|l| l.effects.to_string() == m.effects.to_string());
                     if !(seen || (x == 1.0 && second_start)) {
                         starts.push(m);
@@ -311,7 +311,7 @@ impl<'a> Scorer<'a> {
             for v in valleys {
                 let mut wide = params.clone();
                 scan::widen(&mut wide, effects[0], &v.values);
-                let mut s2 = v.base.clone();
+                let mut s2 = with_bench(&v.base, start);
                 s2.effects.set(effects[0], &v.values);
                 if let Ok(c2) = Calibration::builder(&s2, rows)
                     .params(&wide)
@@ -481,6 +481,20 @@ impl<'a> Scorer<'a> {
         };
         (entry, preds, fitted_motor)
     }
+}
+
+/// `motor` with the bench's nuisance parameters of the calibrated baseline `calibrated`
+/// (the speed-std instrument's floor, the torque and temperature offsets). They are the
+/// bench's, not the motor's, and every fit estimates them anew; a fit started from the
+/// nominal motor would start them at zero, the floor on its bound, where its transformed
+/// gradient vanishes and a first step can throw it to the other bound: a
+/// `tangential_compliance` fit from the scan's valley ended with the floor at its upper
+/// bound, 50 % above every reading, which cost it nothing in χ² but most of its held-out
+/// NRMSE (the speed std's readings spread little, so its scale is small).
+fn with_bench(motor: &Motor, calibrated: &Motor) -> Motor {
+    let mut m = motor.clone();
+    *m.effects.instrument_mut() = *calibrated.effects.instrument();
+    m
 }
 
 /// The scored models' held-out predictions and full-data fits, by name.

@@ -86,8 +86,19 @@ impl<'a> Context<'a> {
             }
             None => (unscaled, groups.to_vec(), None),
         };
-        let n_read: usize = unscaled.iter().map(|r| r.readings.len()).sum();
         let scaled = noise_scaled(&unscaled, &est);
+        // Gross outliers that stand alone off their neighbours are the bench's, not the
+        // motor's: left out of every fit and every held-out figure. (The fits' Huber loss
+        // bounds their pull, but one such reading held out can be most of a held-out NRMSE,
+        // which is not clipped, and so decide a shrink.)
+        let spikes = crate::noise::isolated_spikes(&scaled, &groups);
+        let (unscaled, scaled) = if spikes.is_empty() {
+            (unscaled, scaled)
+        } else {
+            bench_notes.push(spikes_note(&spikes, &scaled, sample.as_deref()));
+            (without_readings(unscaled, &spikes), without_readings(scaled, &spikes))
+        };
+        let n_read: usize = unscaled.iter().map(|r| r.readings.len()).sum();
         let rows = &scaled[..];
         let noise_scale: Vec<(String, f64, usize)> =
             est.iter().map(|(&o, n)| (o.column().to_string(), applied_factor(&est, o), n.residuals)).collect();
@@ -149,6 +160,40 @@ impl<'a> Context<'a> {
             notes,
         })
     }
+}
+
+/// `rows` without the readings `drop` (row index, quantity).
+fn without_readings(mut rows: Vec<ObservedRow>, drop: &[(usize, Observable)]) -> Vec<ObservedRow> {
+    for &(i, o) in drop {
+        if let Some(r) = rows.get_mut(i) {
+            r.readings.retain(|x| x.0 != o);
+        }
+    }
+    rows
+}
+
+/// The note naming the isolated spikes left out (`rows` the fits' rows; `sample` maps them
+/// to the input's rows).
+fn spikes_note(spikes: &[(usize, Observable)], rows: &[ObservedRow], sample: Option<&[usize]>) -> String {
+    let shown: Vec<String> = spikes
+        .iter()
+        .take(8)
+        .map(|&(i, o)| {
+            let value = rows[i].readings.iter().find(|x| x.0 == o).map(|x| x.1).unwrap_or(f64::NAN);
+            let row = sample.map_or(i, |s| s[i]) + 1;
+            format!("{} = {value} in data row {row}", o.column())
+        })
+        .collect();
+    let more =
+        if spikes.len() > shown.len() { format!(" and {} more", spikes.len() - shown.len()) } else { String::new() };
+    format!(
+        "{} reading(s) stand alone off their neighbours (more than {} standard deviations off the curve through \
+         four neighbouring readings of their quantity, while the row's other readings lie on theirs): gross \
+         outliers of the bench, left out of every fit and held-out figure: {}{more}",
+        spikes.len(),
+        crate::noise::SPIKE_Z,
+        shown.join("; ")
+    )
 }
 
 /// What the data cannot show, in notes: the operating coordinates that never vary and the

@@ -30,6 +30,15 @@ const MAX_FACTOR: f64 = 100.0;
 /// Ratio between neighbouring strengths of the grid (√10: two points a decade).
 const GRID_RATIO: f64 = 3.162_277_660_168_379;
 
+/// A strength inside the scanned series whose χ² is below this fraction of the series' χ²
+/// at its weakest strength is a valley of the effect's own, handed back as a start even
+/// where it is not lower than the fit: from the nominal motor, whose parameters differ from
+/// the motor's by its spread, a strong effect's valley stays above a calibrated fit that
+/// has bent the baseline's parameters to mimic part of it, and the fit from the
+/// calibrated baseline can collapse onto zero strength where a fit from that valley
+/// reaches the noise.
+const OWN_VALLEY_LEFT: f64 = 0.5;
+
 /// A start found by the scan.
 #[derive(Clone, Debug)]
 pub(crate) struct Valley {
@@ -203,7 +212,10 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
                 }
                 let lower = p.3 < fit_chi2 - 4.0;
                 let fenced = p.1 > 8.0 && p.3 < inside - 4.0;
-                if lower || fenced {
+                // a valley of the effect's own: inside the series, and the effect there
+                // removes most of what the base misses at its weakest strength
+                let own = i > 0 && p.3 < OWN_VALLEY_LEFT * s[0].3;
+                if lower || fenced || own {
                     found.push(Valley { base: (*base).clone(), values: p.2.clone(), chi2: p.3 });
                 }
             }

@@ -1,0 +1,169 @@
+#!/usr/bin/env python3
+"""Bench artefacts that neither half of the blind benchmark simulates, and what the
+diagnosis makes of them (docs/DIAGNOSIS.md, "Bench-artefact stress set").
+
+Each case is a `trum synth` file of the frozen reference motor (tests/data/motors/ring60.toml,
+every parameter perturbed as in the blind benchmark) that this script then alters as a
+bench would: gains of the speed, torque, power or feedback readings, read-back noise of
+the preload or the frequency, a quantised torque, an offset of the temperature sensor,
+heavy-tailed speed noise, cells left empty, noise three times the nominal. Null cases
+must come out `none`; effect cases (each effect at about twice its typical strength in
+its first truth form, with two artefacts drawn at random and the development half's own)
+should name the effect. The cases are a development set: the diagnosis was changed after
+they were first run.
+
+    cargo build --release -p trum-cli
+    python3 benches/stress_artefacts.py            # every case, two at a time
+    python3 benches/stress_artefacts.py null_      # the cases whose name contains null_
+    TRUM=path/to/trum python3 benches/stress_artefacts.py
+
+Prints one line per case (verdict, complete, confounded set, the baseline's held-out NRMSE,
+the three strongest candidates) and the counts; the work files go to a temporary folder.
+"""
+
+import csv
+import json
+import math
+import os
+import random
+import subprocess
+import sys
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TRUM = os.environ.get("TRUM", os.path.join(ROOT, "target", "release", "trum"))
+MOTOR = os.path.join(ROOT, "tests", "data", "motors", "ring60.toml")
+DEV_ARTEFACTS = "readback_rel=0.004,speed_std_floor_rpm=0.3,outlier_fraction=0.01"
+
+
+def scale(column, factor):
+    return lambda rows, rng: alter(rows, column, lambda v: v * factor)
+
+
+def jitter(column, rel):
+    return lambda rows, rng: alter(rows, column, lambda v: v * (1.0 + rel * rng.gauss(0.0, 1.0)))
+
+
+def alter(rows, column, fn):
+    for row in rows:
+        if row.get(column, "") != "":
+            row[column] = repr(fn(float(row[column])))
+
+
+def heavy_tail(rows, rng):
+    # Student-t noise with 3 degrees of freedom, 0.7 rpm scale, added to the speed
+    def noisy(v):
+        t = rng.gauss(0.0, 1.0) / math.sqrt(max(1e-3, rng.gammavariate(1.5, 1.0 / 1.5)))
+        return max(0.0, v + 0.7 * t)
+
+    alter(rows, "speed_rpm", noisy)
+
+
+def missing(rows, rng):
+    for row in rows:
+        for column in ("input_power_w", "current_a", "feedback_v", "efficiency"):
+            if column in row and rng.random() < 0.15:
+                row[column] = ""
+
+
+ARTEFACTS = {
+    "speed_gain": scale("speed_rpm", 1.03),
+    "torque_gain": scale("torque_nm", 1.04),
+    "power_gain": scale("input_power_w", 1.05),
+    "feedback_gain": scale("feedback_v", 0.95),
+    "preload_readback": jitter("preload_n", 0.01),
+    "freq_readback": jitter("frequency_hz", 0.0003),
+    "torque_quant": lambda rows, rng: alter(rows, "torque_nm", lambda v: round(v / 0.01) * 0.01),
+    "temp_offset": lambda rows, rng: alter(rows, "temperature_c", lambda v: v + 1.5),
+    "heavy_tail": heavy_tail,
+    "missing": missing,
+}
+
+EFFECTS = {
+    "radial_friction": "radial_friction=2",
+    "preload_stiffening": "preload_stiffening=0.1",
+    "hertz_softening": "hertz_softening:beta_n_per_m3=2e18,preload_gain_per_n=0.008",
+    "thermal_drift": "thermal_drift:stiffness_coefficient_per_k=-8e-4,friction_coefficient_per_k=-4e-3,"
+    "damping_coefficient_per_k=4e-3",
+    "voltage_sag": "voltage_sag=300",
+    "eccentricity": "eccentricity=4e-5",
+    "tangential_compliance": "tangential_compliance=2",
+}
+
+
+def cases():
+    """(name, truth, artefacts, campaign, seed, effect argument, noise, synth extras)."""
+    out = []
+    seed = 7100
+    for art in ARTEFACTS:
+        for campaign in ("preload-torque", "combined"):
+            seed += 1
+            out.append((f"null_{art}_{campaign}", "none", [art], campaign, seed, None, 1, []))
+    out.append(("null_noise3_preload-torque", "none", [], "preload-torque", 7201, None, 3, []))
+    out.append(("null_noise3_combined", "none", [], "combined", 7202, None, 3, []))
+    out.append(("null_freq_sweep_gain", "none", ["feedback_gain", "freq_readback"], "frequency-sweep", 7203, None, 1, []))
+    out.append(("null_warm_up_temp_offset", "none", ["temp_offset"], "warm-up", 7204, None, 1, []))
+    rng = random.Random(11)
+    seed = 8100
+    for effect, arg in EFFECTS.items():
+        for campaign in ("combined", "preload-torque"):
+            seed += 1
+            arts = rng.sample(sorted(ARTEFACTS), 2)
+            out.append((f"{effect}_{campaign}", effect, arts, campaign, seed, arg, 1, ["--artefacts", DEV_ARTEFACTS]))
+    return out
+
+
+def run(case, work):
+    name, truth, arts, campaign, seed, effect, noise, extra = case
+    path = os.path.join(work, name + ".csv")
+    cmd = [TRUM, "synth", "--motor", MOTOR, "--campaign", campaign, "--noise", str(noise), "--seed", str(seed)]
+    cmd += ["-o", path] + extra + (["--effect", effect] if effect else [])
+    subprocess.run(cmd, check=True, capture_output=True)
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    rng = random.Random(seed)
+    for art in arts:
+        ARTEFACTS[art](rows, rng)
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+    out = os.path.join(work, name + ".json")
+    t0 = time.time()
+    done = subprocess.run([TRUM, "diagnose", "--motor", MOTOR, "--data", path, "--json", out, "-q"], capture_output=True, text=True)
+    seconds = time.time() - t0
+    if done.returncode != 0:
+        return name, truth, arts, None, seconds, done.stderr.strip()
+    with open(out) as f:
+        return name, truth, arts, json.load(f), seconds, ""
+
+
+def main():
+    wanted = sys.argv[1:]
+    todo = [c for c in cases() if not wanted or any(w in c[0] for w in wanted)]
+    right = {"null": [0, 0], "effect": [0, 0]}
+    with tempfile.TemporaryDirectory() as work, ThreadPoolExecutor(2) as pool:
+        for name, truth, arts, d, seconds, err in pool.map(lambda c: run(c, work), todo):
+            if d is None:
+                print(f"{name}: diagnosis failed: {err}")
+                continue
+            kind = "null" if truth == "none" else "effect"
+            ok = d["verdict"] == truth or truth in d["confounded_with"]
+            right[kind][0] += ok
+            right[kind][1] += 1
+            top = ", ".join(f"{r['effect']} {r['evidence']:.0f}/{r['shrink']:.2f}" for r in d["ranking"][:3])
+            print(
+                f"{name} [{'+'.join(arts) or '-'}]: {d['verdict']} complete={d['complete']} "
+                f"confounded={d['confounded_with']} base NRMSE {d['gap']['baseline_heldout_nrmse']:.3f} "
+                f"| {top} | {seconds:.1f} s{'' if ok else '  <- miss'}",
+                flush=True,
+            )
+    for kind, (ok, n) in right.items():
+        if n:
+            print(f"{kind} cases right: {ok} of {n}")
+
+
+if __name__ == "__main__":
+    main()
