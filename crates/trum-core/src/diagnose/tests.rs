@@ -11,8 +11,12 @@ use crate::calibrate::{residuals, Calibration, FittedParam, ParamRef};
 use crate::synth::{synthesize, Campaign, SynthConfig};
 
 pub(super) fn data(m: &Motor, noise: f64, seed: u64) -> (Vec<ObservedRow>, Vec<String>) {
-    let cfg = SynthConfig { campaign: Campaign::PreloadTorque, noise, seed, ..SynthConfig::default() };
-    let rows = synthesize(m, &cfg).expect("synth");
+    synthesized(m, &SynthConfig { campaign: Campaign::PreloadTorque, noise, seed, ..SynthConfig::default() })
+}
+
+/// The rows and runs of a synthetic campaign of `m`.
+fn synthesized(m: &Motor, cfg: &SynthConfig) -> (Vec<ObservedRow>, Vec<String>) {
+    let rows = synthesize(m, cfg).expect("synth");
     (rows.iter().map(|r| r.observed()).collect(), rows.iter().map(|r| r.run_id.clone()).collect())
 }
 
@@ -122,9 +126,7 @@ fn the_noise_nrmse_is_what_a_model_without_error_scores() {
     for campaign in [Campaign::PreloadTorque, Campaign::Combined] {
         for seed in [1, 2, 3] {
             let cfg = SynthConfig { campaign, noise: 1.0, seed, ..SynthConfig::default() };
-            let synth = synthesize(&m, &cfg).expect("synth");
-            let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
-            let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+            let (rows, groups) = synthesized(&m, &cfg);
             let d = diagnose(&m, &rows, &groups, &opts).expect("diagnosis");
             let ratio = d.noise_nrmse / d.baseline_heldout_nrmse;
             assert!(
@@ -283,9 +285,7 @@ fn the_motors_own_effect_is_refitted_in_the_baseline_not_named() {
         truth_forms: false,
         ..SynthConfig::default()
     };
-    let synth = synthesize(&truth, &cfg).expect("synth");
-    let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
-    let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+    let (rows, groups) = synthesized(&truth, &cfg);
     let d = diagnose(&nominal, &rows, &groups, &quick(false)).expect("diagnosis");
     assert_eq!(d.verdict, "none", "{:?}", d.ranking);
     assert!(d.ranking.iter().all(|r| r.effect != "voltage_sag"));
@@ -331,9 +331,7 @@ fn diagnosed_single(
     let mut truth = nominal.clone();
     truth.effects.set_strength(effect, strength);
     let cfg = SynthConfig { campaign, noise, seed, ..SynthConfig::default() };
-    let synth = synthesize(&truth, &cfg).expect("synth");
-    let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
-    let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+    let (rows, groups) = synthesized(&truth, &cfg);
     let opts = DiagnoseOptions {
         candidates: candidates.to_vec(),
         try_pairs: false,
@@ -662,9 +660,7 @@ fn a_temperature_sensor_offset_is_the_benchs_not_a_gap() {
         artefacts: crate::synth::Artefacts { temperature_offset_k: 1.5, ..Default::default() },
         ..SynthConfig::default()
     };
-    let synth = synthesize(&nominal, &cfg).expect("synth");
-    let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
-    let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+    let (rows, groups) = synthesized(&nominal, &cfg);
     let opts = DiagnoseOptions { bootstrap: 50, try_pairs: false, ..DiagnoseOptions::default() };
     let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
     assert_eq!(d.verdict, "none", "{:?}", d.ranking);
@@ -699,9 +695,7 @@ fn a_strong_compliance_is_reached_from_its_own_valley() {
             .expect("artefacts"),
         ..SynthConfig::default()
     };
-    let synth = synthesize(&truth, &cfg).expect("synth");
-    let rows: Vec<ObservedRow> = synth.iter().map(|r| r.observed()).collect();
-    let groups: Vec<String> = synth.iter().map(|r| r.run_id.clone()).collect();
+    let (rows, groups) = synthesized(&truth, &cfg);
     let opts = DiagnoseOptions {
         candidates: vec![Effect::TangentialCompliance, Effect::VoltageSag, Effect::ThermalDrift],
         try_pairs: false,
