@@ -432,6 +432,42 @@ mod tests {
         assert!(isolated_spikes(&rows, &g).is_empty());
     }
 
+    /// Rows with repeated, unordered and non-finite coordinates, non-finite and zero
+    /// readings and noise levels, in runs of every size: the search returns without a
+    /// panic, names only readings that exist, and never more than 5 % of them.
+    #[test]
+    fn isolated_spikes_hold_on_degenerate_rows() {
+        use rand::RngExt;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let odd = [0.0, -0.0, 1e-300, 1e308, f64::NAN, f64::INFINITY, -1.0, 5e-324];
+        for _ in 0..300 {
+            let n = rng.random_range(0..40);
+            let mut pick = |typical: f64| {
+                if rng.random::<f64>() < 0.1 {
+                    odd[rng.random_range(0..odd.len())]
+                } else {
+                    typical * (1.0 + rng.random::<f64>())
+                }
+            };
+            let rows: Vec<ObservedRow> = (0..n)
+                .map(|_| ObservedRow {
+                    op: OperatingPoint::new(pick(100.0), (pick(0.1) * 10.0).round() / 10.0, pick(200.0), 43e3),
+                    readings: vec![
+                        (Observable::SpeedRpm, pick(100.0), pick(1.0)),
+                        (Observable::FeedbackV, pick(50.0), pick(0.5)),
+                    ],
+                    ambient_c: 25.0,
+                    speed_std_clipped: false,
+                })
+                .collect();
+            let groups: Vec<String> = (0..n).map(|i| format!("r{}", i % 3)).collect();
+            let found = isolated_spikes(&rows, &groups);
+            let readings = 2 * n;
+            assert!(found.len() <= ((0.05 * readings as f64) as usize).max(1));
+            assert!(found.iter().all(|&(i, o)| i < n && rows[i].readings.iter().any(|x| x.0 == o)));
+        }
+    }
+
     #[test]
     fn recovers_the_noise_factor_on_a_curved_run() {
         for (true_sd, stated) in [(1.0, 1.0), (0.5, 1.0), (2.0, 1.0)] {
