@@ -306,13 +306,30 @@ fn probe_crossing(trials: &mut Trials, hi: &mut Trial) -> (Option<Trial>, Option
     };
     let t = trials.eval(ws);
     if t.w < t.w_next {
-        let found = highest_window(p, d, ws, vec![*hi, t], 40, 1.0 - MULTI_BRANCH_STEP, &mut |w| trials.eval(w));
+        let found =
+            highest_window(p, d, ws, vec![*hi, t], 40, 1.0 - MULTI_BRANCH_STEP, probe_split(), &mut |w| trials.eval(w));
         let (tl, top) = found.unwrap_or((t, *hi));
         *hi = top;
         (Some(tl), None)
     } else {
         (None, Some(t))
     }
+}
+
+/// The split of the crossing probe's window search: `Split::Bounded` (the midpoint where
+/// a test asks for it, to compare the two).
+fn probe_split() -> Split {
+    #[cfg(test)]
+    if MIDPOINT_PROBE.with(std::cell::Cell::get) {
+        return Split::Midpoint;
+    }
+    Split::Bounded
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Set by a test: the crossing probe splits its intervals at their midpoints.
+    pub(super) static MIDPOINT_PROBE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// The windows of r < 0 at the stiffness crossing `spike`, which the descent is about to
@@ -323,7 +340,7 @@ fn probe_crossing(trials: &mut Trials, hi: &mut Trial) -> (Option<Trial>, Option
 fn windows_at_crossing(trials: &mut Trials, spike: Trial, mut above: Vec<Trial>) -> Option<(Trial, Trial)> {
     let (p, d) = (trials.p, trials.d);
     above.push(spike);
-    highest_window(p, d, spike.w, above, 40, 0.0, &mut |w| trials.eval(w)).or_else(|| {
+    highest_window(p, d, spike.w, above, 40, 0.0, Split::Midpoint, &mut |w| trials.eval(w)).or_else(|| {
         // the fold window's trials, to rule out a window above the one it found
         let mut seen = vec![spike];
         let tm = fold_window(p, d, &spike, &mut |w| {
@@ -332,7 +349,7 @@ fn windows_at_crossing(trials: &mut Trials, spike: Trial, mut above: Vec<Trial>)
             t
         })?;
         seen.retain(|t| t.w >= tm.w);
-        highest_window(p, d, spike.w, seen, 40, 0.0, &mut |w| trials.eval(w))
+        highest_window(p, d, spike.w, seen, 40, 0.0, Split::Midpoint, &mut |w| trials.eval(w))
     })
 }
 
@@ -600,6 +617,7 @@ fn highest_window(
     mut probes: Vec<Trial>,
     budget: usize,
     resolved: f64,
+    split: Split,
     eval: &mut dyn FnMut(f64) -> Trial,
 ) -> Option<(Trial, Trial)> {
     let theta_v = p.theta * d.v;
@@ -610,6 +628,8 @@ fn highest_window(
     };
     probes.sort_by(|a, b| a.w.total_cmp(&b.w));
     let mut spent = 0;
+    // whether the latest new probe was a bound step (`Split::Bounded`)
+    let mut bound_step = false;
     'refine: loop {
         // top down: a probe with r < 0 is the answer once every interval above it is clear
         for j in (0..probes.len()).rev() {
@@ -628,10 +648,97 @@ fn highest_window(
                 return Some((probes[k], probes[k + 1]));
             }
             spent += 1;
-            let t = eval(0.5 * (probes[j - 1].w + probes[j].w));
+            let x = match split {
+                Split::Bounded if above_crossing(ws, &probes[j - 1]) => {
+                    let x = bounded_split(p, d, &probes, j, !bound_step);
+                    bound_step = x.1;
+                    x.0
+                }
+                _ => None,
+            };
+            let t = eval(x.unwrap_or(0.5 * (probes[j - 1].w + probes[j].w)));
             probes.insert(j, t);
             continue 'refine;
         }
         return None;
     }
+}
+
+/// How [`highest_window`] splits an interval it cannot rule out.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) enum Split {
+    /// At its midpoint.
+    Midpoint,
+    /// Above the crossing, where the bound on G is known in closed form but for Im Z:
+    /// alternately at the lowest amplitude the bound rules out from the interval's upper
+    /// probe ([`clear_from`]) and at the secant root through the two probes above
+    /// (`bounded_split`); the midpoint where neither lies inside.
+    Bounded,
+}
+
+/// True when the probe `z` lies at or above the stiffness crossing `ws`, where Re Z ≤ 0.
+fn above_crossing(ws: f64, z: &Trial) -> bool {
+    z.w >= ws
+}
+
+/// The next probe inside the interval (`probes[j − 1]`, `probes[j]`) that
+/// [`highest_window`] cannot rule out, every interval above `probes[j]` ruled out
+/// (r ≥ 0 at `probes[j]`), for the split `Split::Bounded`: (the amplitude [m] or `None`
+/// for the midpoint, whether it is a bound step).
+///
+/// A bound step (`bound` true, or no secant inside): the lowest amplitude from which the
+/// interval up to `probes[j]` is ruled out ([`clear_from`]), so that the probe there rules
+/// out all of it above (r ≥ 0 there by the same bound). Its rate is that of Im Z's fall
+/// between the probes: a seventh of the distance to the root a step at trum60a as shipped.
+/// A secant step: the root of the secant of r through `probes[j]` and the probe above it,
+/// both r ≥ 0 and above the root; it lands a hair below the root (r < 0: the lower end of
+/// a narrow bracket) or above it (a probe the next bound step rules out from).
+fn bounded_split(p: &Prepared, d: &Drive, probes: &[Trial], j: usize, bound: bool) -> (Option<f64>, bool) {
+    let (z1, z2) = (&probes[j - 1], &probes[j]);
+    let inside = |x: f64| (x > z1.w && x < z2.w).then_some(x);
+    if !bound {
+        if let Some(z3) = probes.get(j + 1) {
+            let (r2, r3) = (z2.w - z2.w_next, z3.w - z3.w_next);
+            if r3 > r2 {
+                if let Some(x) = inside(z2.w - r2 * (z3.w - z2.w) / (r3 - r2)) {
+                    return (Some(x), false);
+                }
+            }
+        }
+    }
+    (clear_from(p, d, z1.w, z2).and_then(inside), true)
+}
+
+/// The lowest amplitude W in [`lo`, `top.w`] [m] from which no root of r = W − G(W) lies
+/// up to the probe `top` by the bound of [`highest_window`] above the crossing
+/// (W·hypot(Re Z(W), Im Z(top)) ≥ Θ·V; Re Z falls with W there, so the left side rises
+/// with W and the interval above W is ruled out as a whole). Re Z is the elastic detuning
+/// ([`elastic_detuning`], a contact solve without the interface integrals). Illinois
+/// regula falsi to 1e-4 relative, returning the end where the bound holds; `None` where
+/// it holds at `lo` already or nowhere.
+fn clear_from(p: &Prepared, d: &Drive, lo: f64, top: &Trial) -> Option<f64> {
+    let theta_v = p.theta * d.v;
+    let f = |w: f64| w * elastic_detuning(p, d, w).hypot(top.z.1) - theta_v;
+    let (f_lo, f_hi) = (f(lo), f(top.w));
+    if !(f_lo < 0.0 && f_hi >= 0.0) {
+        return None;
+    }
+    let mut b = SignBracket { neg: Some((lo, f_lo)), pos: Some((top.w, f_hi.max(f64::MIN_POSITIVE))), last_side: 0 };
+    for _ in 0..60 {
+        let (a, c) = (b.neg?.0, b.pos?.0);
+        if c - a <= 1e-4 * c {
+            break;
+        }
+        let x = b.regula_falsi()?;
+        let fx = f(x);
+        if fx.is_nan() {
+            return None;
+        }
+        if fx >= 0.0 {
+            b.record(x, fx.max(f64::MIN_POSITIVE), true);
+        } else {
+            b.record(x, fx, true);
+        }
+    }
+    Some(b.pos?.0)
 }
