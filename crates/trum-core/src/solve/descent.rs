@@ -489,7 +489,11 @@ pub(super) fn solve_drive_below(
         let next = match lo {
             // Newton with the trial's exact slope where its step stays inside [lo, hi],
             // else regula falsi (Illinois) there.
-            Some(l) => match cur.newton().filter(|&x| x > l.w && x < hi.w) {
+            Some(l) => match cur
+                .newton()
+                .or_else(|| multi_branch.then(|| secant(&cur, prev)).flatten())
+                .filter(|&x| x > l.w && x < hi.w)
+            {
                 Some(x) => x,
                 None => bracket.regula_falsi().unwrap_or(0.5 * (l.w + hi.w)),
             },
@@ -518,6 +522,14 @@ pub(super) fn solve_drive_below(
     // Use the trial consistent with the converged amplitude for every output.
     let status = if cur.stalled { Status::Stall } else { Status::Ok };
     finish(p, d, op, &cur, status, evals)
+}
+
+/// The root of the secant of r = W − G(W) through the trials `cur` and `prev`, where `cur`
+/// has the smaller |r| (at most half of `prev`'s: the iterates close in on a root).
+fn secant(cur: &Trial, prev: Option<Trial>) -> Option<f64> {
+    let pv = prev?;
+    let (rc, rp) = (cur.w - cur.w_next, pv.w - pv.w_next);
+    (rc.abs() <= 0.5 * rp.abs() && rc != rp).then(|| cur.w - rc * (cur.w - pv.w) / (rc - rp)).filter(|x| x.is_finite())
 }
 
 /// A trial with r = W − G(W) < 0 just below the stiffness crossing `spike` (where r ≥ 0),
