@@ -187,11 +187,7 @@ fn warm_top(trials: &mut Trials, top: &WarmTop, rtol: f64) -> (Trial, Option<Tri
 /// the bracket is then grown.
 fn descent_top(trials: &mut Trials, warm: Option<Trial>, detuning: f64, w_hi0: f64) -> Trial {
     let (p, d) = (trials.p, trials.d);
-    let w_cold = if (p.stiffening == 0.0 || detuning >= 0.0) && (p.beta == 0.0 || detuning <= 0.0) {
-        p.theta * d.v / detuning.hypot(d.omega * d.c)
-    } else {
-        w_hi0
-    };
+    let w_cold = cold_top(p, d, detuning, w_hi0);
     let mut hi = match warm {
         Some(t) => t,
         None => trials.eval(w_cold),
@@ -202,6 +198,47 @@ fn descent_top(trials: &mut Trials, warm: Option<Trial>, detuning: f64, w_hi0: f
         grow += 1;
     }
     hi
+}
+
+/// The amplitude [m] a cold descent starts from ([`descent_top`]): Θ·V/|k − mω² + iωc| where
+/// the W-dependent stiffness cannot move the mode towards the drive, else `w_hi0` =
+/// Θ·V/(ω·c).
+fn cold_top(p: &Prepared, d: &Drive, detuning: f64, w_hi0: f64) -> f64 {
+    if (p.stiffening == 0.0 || detuning >= 0.0) && (p.beta == 0.0 || detuning <= 0.0) {
+        p.theta * d.v / detuning.hypot(d.omega * d.c)
+    } else {
+        w_hi0
+    }
+}
+
+/// The crossing probe of a cold multi-branch descent started without the trial at the cold
+/// top `w_cold` [m]: (a top to descend from, the trial at the stiffness crossing).
+///
+/// Friction damping is ≥ 0, so Im Z ≥ ω·c at every W, and with the elastic detuning
+/// ([`elastic_detuning`], exact) G(W) ≤ Θ·V/hypot(Re Z(W), ω·c) needs no interface
+/// integral. Where that bound puts r ≥ 0 at `w_cold` (the cold descent's top, which then
+/// needs no growing), the crossing is the one [`probe_crossing`] finds from it, and its
+/// trial is taken first. With r < 0 there, the top is the trial at the lowest amplitude
+/// the bound rules out above the crossing ([`clear_from`] with Im Z = ω·c; r ≥ 0 there),
+/// a few per cent above the largest root at `trum60a` as shipped, instead of the cold top
+/// 60-100× above it: one trial fewer than descending from `w_cold`, whose trial only
+/// serves the same bound. `(None, crossing)` where the descent goes on from the cold top
+/// as usual (the crossing's trial, if taken, reused by [`probe_crossing`]).
+fn cold_crossing(trials: &mut Trials, w_cold: f64) -> (Option<Trial>, Option<Trial>) {
+    let (p, d) = (trials.p, trials.d);
+    let damping = d.omega * d.c;
+    if !(w_cold * elastic_detuning(p, d, w_cold).hypot(damping) >= p.theta * d.v) {
+        return (None, None);
+    }
+    let Some(ws) = stiffness_crossing(p, d, w_cold) else {
+        return (None, None);
+    };
+    let t = trials.eval(ws);
+    if !(t.w < t.w_next) {
+        return (None, Some(t));
+    }
+    let top = clear_from(p, d, ws, w_cold, damping).map(|w| trials.eval(w)).filter(|u| u.w >= u.w_next);
+    (top, Some(t))
 }
 
 /// The first amplitude below the top `hi` (before any step cap).
@@ -299,12 +336,20 @@ impl StepCap {
 ///
 /// So the descent from the top goes on down to the crossing, and only there are the
 /// windows searched, the highest first ([`windows_at_crossing`]).
-fn probe_crossing(trials: &mut Trials, hi: &mut Trial) -> (Option<Trial>, Option<Trial>) {
+fn probe_crossing(
+    trials: &mut Trials,
+    hi: &mut Trial,
+    w_top: f64,
+    known: Option<Trial>,
+) -> (Option<Trial>, Option<Trial>) {
     let (p, d) = (trials.p, trials.d);
-    let Some(ws) = stiffness_crossing(p, d, hi.w) else {
+    let Some(ws) = stiffness_crossing(p, d, w_top) else {
         return (None, None);
     };
-    let t = trials.eval(ws);
+    let t = match known.filter(|t| t.w == ws) {
+        Some(t) => t,
+        None => trials.eval(ws),
+    };
     if t.w < t.w_next {
         let found =
             highest_window(p, d, ws, vec![*hi, t], 40, 1.0 - MULTI_BRANCH_STEP, probe_split(), &mut |w| trials.eval(w));
@@ -316,20 +361,31 @@ fn probe_crossing(trials: &mut Trials, hi: &mut Trial) -> (Option<Trial>, Option
     }
 }
 
-/// The split of the crossing probe's window search: `Split::Bounded` (the midpoint where
-/// a test asks for it, to compare the two).
-fn probe_split() -> Split {
+/// Whether a multi-branch descent uses the bound on G that needs no interface integral
+/// ([`cold_crossing`], `Split::Bounded`, secant steps inside the bracket): always, but where
+/// a test asks for the descent without it, the reference it is compared with.
+fn bounded() -> bool {
     #[cfg(test)]
-    if MIDPOINT_PROBE.with(std::cell::Cell::get) {
-        return Split::Midpoint;
+    if REFERENCE_DESCENT.with(std::cell::Cell::get) {
+        return false;
     }
-    Split::Bounded
+    true
+}
+
+/// The split of the crossing probe's window search.
+fn probe_split() -> Split {
+    if bounded() {
+        Split::Bounded
+    } else {
+        Split::Midpoint
+    }
 }
 
 #[cfg(test)]
 thread_local! {
-    /// Set by a test: the crossing probe splits its intervals at their midpoints.
-    pub(super) static MIDPOINT_PROBE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Set by a test: multi-branch descents run without the bound ([`bounded`]): from the
+    /// cold top's trial, midpoint splits, regula falsi inside the bracket.
+    pub(super) static REFERENCE_DESCENT: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// The windows of r < 0 at the stiffness crossing `spike`, which the descent is about to
@@ -436,12 +492,21 @@ pub(super) fn solve_drive_below(
     let warm = warm_trial.filter(|t| t.w >= t.w_next);
     let below = below.filter(|_| warm.is_some());
     let detuning = d.ks - p.m * d.omega * d.omega;
-    let mut hi = descent_top(&mut trials, warm, detuning, w_hi0);
+    let multi_branch = p.stiffening != 0.0 || p.beta != 0.0;
+    let w_cold = cold_top(p, d, detuning, w_hi0);
+    let (bounded_top, crossing) =
+        if multi_branch && warm.is_none() && bounded() { cold_crossing(&mut trials, w_cold) } else { (None, None) };
+    let mut hi = match bounded_top {
+        Some(t) => t,
+        None => descent_top(&mut trials, warm, detuning, w_hi0),
+    };
+    // (a top found by the bound stands for the cold top, where r ≥ 0 by the same bound)
+    let w_top = if bounded_top.is_some() { w_cold } else { hi.w };
     let mut lo: Option<Trial> = below;
     let start = first_step(warm, below, &hi);
-    let multi_branch = p.stiffening != 0.0 || p.beta != 0.0;
-    let cap = StepCap::new(p, detuning, hi.w);
-    let (cur, mut spike) = if multi_branch { probe_crossing(&mut trials, &mut hi) } else { (None, None) };
+    let cap = StepCap::new(p, detuning, w_top);
+    let (cur, mut spike) =
+        if multi_branch { probe_crossing(&mut trials, &mut hi, w_top, crossing) } else { (None, None) };
     // the descent's trials above the crossing (r ≥ 0 at each); no allocation without one
     let mut above = Vec::new();
     if spike.is_some() {
@@ -491,7 +556,7 @@ pub(super) fn solve_drive_below(
             // else regula falsi (Illinois) there.
             Some(l) => match cur
                 .newton()
-                .or_else(|| multi_branch.then(|| secant(&cur, prev)).flatten())
+                .or_else(|| (multi_branch && bounded()).then(|| secant(&cur, prev)).flatten())
                 .filter(|&x| x > l.w && x < hi.w)
             {
                 Some(x) => x,
@@ -720,33 +785,35 @@ fn bounded_split(p: &Prepared, d: &Drive, probes: &[Trial], j: usize, secant: bo
     let (z1, z2) = (&probes[j - 1], &probes[j]);
     let inside = |x: f64| (x > z1.w && x < z2.w).then_some(x);
     if secant {
-        if let Some(z3) = probes.get(j + 1) {
+        // (the probe above, else the one below where r < 0 there: regula falsi)
+        if let Some(z3) = probes.get(j + 1).or(Some(z1).filter(|z| z.w < z.w_next)) {
             let (r2, r3) = (z2.w - z2.w_next, z3.w - z3.w_next);
-            if r3 > r2 {
+            if r3 != r2 {
                 if let Some(x) = inside(z2.w - r2 * (z3.w - z2.w) / (r3 - r2)) {
                     return (x, true);
                 }
             }
         }
     }
-    (clear_from(p, d, z1.w, z2).and_then(inside).map_or(mid, |x| x.min(mid)), false)
+    (clear_from(p, d, z1.w, z2.w, z2.z.1).and_then(inside).map_or(mid, |x| x.min(mid)), false)
 }
 
-/// The lowest amplitude W in [`lo`, `top.w`] [m] from which no root of r = W − G(W) lies
-/// up to the probe `top` by the bound of [`highest_window`] above the crossing
-/// (W·hypot(Re Z(W), Im Z(top)) ≥ Θ·V; Re Z falls with W there, so the left side rises
-/// with W and the interval above W is ruled out as a whole). Re Z is the elastic detuning
-/// ([`elastic_detuning`], a contact solve without the interface integrals). Illinois
-/// regula falsi to 1e-4 relative, returning the end where the bound holds; `None` where
-/// it holds at `lo` already or nowhere.
-fn clear_from(p: &Prepared, d: &Drive, lo: f64, top: &Trial) -> Option<f64> {
+/// The lowest amplitude W in [`lo`, `hi`] [m] from which no root of r = W − G(W) lies up
+/// to `hi` by the bound of [`highest_window`] above the crossing, `im_z` [N/m] a lower
+/// bound of Im Z on [W, `hi`] (Im Z at a probe `hi`: friction damping falls with W):
+/// W·hypot(Re Z(W), `im_z`) ≥ Θ·V. Re Z falls with W above the crossing, so the left side
+/// rises with W and the interval above W is ruled out as a whole. Re Z is the elastic
+/// detuning ([`elastic_detuning`], a contact solve without the interface integrals).
+/// Illinois regula falsi to 1e-4 relative, returning the end where the bound holds;
+/// `None` where it holds at `lo` already or nowhere.
+fn clear_from(p: &Prepared, d: &Drive, lo: f64, hi: f64, im_z: f64) -> Option<f64> {
     let theta_v = p.theta * d.v;
-    let f = |w: f64| w * elastic_detuning(p, d, w).hypot(top.z.1) - theta_v;
-    let (f_lo, f_hi) = (f(lo), f(top.w));
+    let f = |w: f64| w * elastic_detuning(p, d, w).hypot(im_z) - theta_v;
+    let (f_lo, f_hi) = (f(lo), f(hi));
     if !(f_lo < 0.0 && f_hi >= 0.0) {
         return None;
     }
-    let mut b = SignBracket { neg: Some((lo, f_lo)), pos: Some((top.w, f_hi.max(f64::MIN_POSITIVE))), last_side: 0 };
+    let mut b = SignBracket { neg: Some((lo, f_lo)), pos: Some((hi, f_hi.max(f64::MIN_POSITIVE))), last_side: 0 };
     for _ in 0..60 {
         let (a, c) = (b.neg?.0, b.pos?.0);
         if c - a <= 1e-4 * c {
