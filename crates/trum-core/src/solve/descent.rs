@@ -227,18 +227,20 @@ fn cold_top(p: &Prepared, d: &Drive, detuning: f64, w_hi0: f64) -> f64 {
 fn cold_crossing(trials: &mut Trials, w_cold: f64) -> (Option<Trial>, Option<Trial>) {
     let (p, d) = (trials.p, trials.d);
     let damping = d.omega * d.c;
-    if !(w_cold * elastic_detuning(p, d, w_cold).hypot(damping) >= p.theta * d.v) {
+    // (false for a NaN too)
+    let ruled_out = w_cold * elastic_detuning(p, d, w_cold).hypot(damping) >= p.theta * d.v;
+    if !ruled_out {
         return (None, None);
     }
     let Some(ws) = stiffness_crossing(p, d, w_cold) else {
         return (None, None);
     };
     let t = trials.eval(ws);
-    if !(t.w < t.w_next) {
-        return (None, Some(t));
+    if t.w < t.w_next {
+        let top = clear_from(p, d, ws, w_cold, damping).map(|w| trials.eval(w)).filter(|u| u.w >= u.w_next);
+        return (top, Some(t));
     }
-    let top = clear_from(p, d, ws, w_cold, damping).map(|w| trials.eval(w)).filter(|u| u.w >= u.w_next);
-    (top, Some(t))
+    (None, Some(t))
 }
 
 /// The first amplitude below the top `hi` (before any step cap).
@@ -691,6 +693,7 @@ fn fold_window(p: &Prepared, d: &Drive, spike: &Trial, eval: &mut dyn FnMut(f64)
 /// (generic60, stiffening 3.3 and compliance 1 in truth form: 7× over 0.2 % of W), so the
 /// bound above the crossing is not proven there; on dense grids of 18 configurations no
 /// interval it rules out holds r < 0.
+#[allow(clippy::too_many_arguments)]
 fn highest_window(
     p: &Prepared,
     d: &Drive,
