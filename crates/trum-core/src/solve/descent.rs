@@ -174,9 +174,9 @@ fn warm_top(trials: &mut Trials, top: &WarmTop, rtol: f64) -> (Trial, Option<Tri
     (top, Some(b))
 }
 
-/// The top of the descent, a trial with r(W) ≥ 0: the `warm` one, else the cold bound,
-/// raised by half while r < 0 (at most 60 times). `detuning` = k − m·ω² [N/m], `w_hi0` =
-/// Θ·V/(ω·c) [m].
+/// The top of the descent, a trial with r(W) ≥ 0: the `warm` one, else the cold bound
+/// ([`cold_top`]), raised by half while r < 0 (at most 60 times). `detuning` = k − m·ω²
+/// [N/m], `w_hi0` = Θ·V/(ω·c) [m].
 ///
 /// Without preload stiffening or Hertz softening the modal stiffness does not depend on
 /// W, and the friction damping c_t·ω is ≥ 0 (the wave gives power to friction and rotor
@@ -186,11 +186,9 @@ fn warm_top(trials: &mut Trials, top: &WarmTop, rtol: f64) -> (Trial, Option<Tri
 /// resonance, softening (≤ 0) above it. Softening could in principle exceed either bound;
 /// the bracket is then grown.
 fn descent_top(trials: &mut Trials, warm: Option<Trial>, detuning: f64, w_hi0: f64) -> Trial {
-    let (p, d) = (trials.p, trials.d);
-    let w_cold = cold_top(p, d, detuning, w_hi0);
     let mut hi = match warm {
         Some(t) => t,
-        None => trials.eval(w_cold),
+        None => trials.eval(cold_top(trials.p, trials.d, detuning, w_hi0)),
     };
     let mut grow = 0;
     while hi.w < hi.w_next && grow < 60 {
@@ -224,6 +222,8 @@ fn cold_top(p: &Prepared, d: &Drive, detuning: f64, w_hi0: f64) -> f64 {
 /// 60-100× above it: one trial fewer than descending from `w_cold`, whose trial only
 /// serves the same bound. `(None, crossing)` where the descent goes on from the cold top
 /// as usual (the crossing's trial, if taken, reused by [`probe_crossing`]).
+// (not inlined: the descents of other stators keep their code as it is)
+#[inline(never)]
 fn cold_crossing(trials: &mut Trials, w_cold: f64) -> (Option<Trial>, Option<Trial>) {
     let (p, d) = (trials.p, trials.d);
     let damping = d.omega * d.c;
@@ -495,15 +495,24 @@ pub(super) fn solve_drive_below(
     let below = below.filter(|_| warm.is_some());
     let detuning = d.ks - p.m * d.omega * d.omega;
     let multi_branch = p.stiffening != 0.0 || p.beta != 0.0;
-    let w_cold = cold_top(p, d, detuning, w_hi0);
-    let (bounded_top, crossing) =
-        if multi_branch && warm.is_none() && bounded() { cold_crossing(&mut trials, w_cold) } else { (None, None) };
-    let mut hi = match bounded_top {
-        Some(t) => t,
-        None => descent_top(&mut trials, warm, detuning, w_hi0),
+    // (a top found by the bound stands for the cold top `w_top`, where r ≥ 0 by the same
+    // bound)
+    let (mut hi, w_top, crossing) = match multi_branch && warm.is_none() && bounded() {
+        true => {
+            let w_cold = cold_top(p, d, detuning, w_hi0);
+            match cold_crossing(&mut trials, w_cold) {
+                (Some(top), crossing) => (top, w_cold, crossing),
+                (None, crossing) => {
+                    let hi = descent_top(&mut trials, warm, detuning, w_hi0);
+                    (hi, hi.w, crossing)
+                }
+            }
+        }
+        false => {
+            let hi = descent_top(&mut trials, warm, detuning, w_hi0);
+            (hi, hi.w, None)
+        }
     };
-    // (a top found by the bound stands for the cold top, where r ≥ 0 by the same bound)
-    let w_top = if bounded_top.is_some() { w_cold } else { hi.w };
     let mut lo: Option<Trial> = below;
     let start = first_step(warm, below, &hi);
     let cap = StepCap::new(p, detuning, w_top);
