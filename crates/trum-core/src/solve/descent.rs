@@ -319,6 +319,9 @@ impl StepCap {
 
 /// The probe of the stiffness crossing below the top `hi` of a multi-branch descent:
 /// (the lower end of a bracket, the crossing's trial with r ≥ 0), at most one of them.
+/// The crossing is searched below `w_top` [m] (the cold top where `hi` is a top the bound
+/// found, [`cold_crossing`]); `known`: (the top it was found from, the crossing's trial)
+/// where [`cold_crossing`] has taken it.
 ///
 /// G peaks in a spike where the W-dependent stiffness cancels the detuning k − mω²,
 /// narrower than any step cap (10 % wide in W at generic60, β = 3e17). Where the spike
@@ -342,13 +345,18 @@ fn probe_crossing(
     trials: &mut Trials,
     hi: &mut Trial,
     w_top: f64,
-    known: Option<Trial>,
+    known: Option<(f64, Trial)>,
 ) -> (Option<Trial>, Option<Trial>) {
     let (p, d) = (trials.p, trials.d);
-    let Some(ws) = stiffness_crossing(p, d, w_top) else {
-        return (None, None);
+    // (a crossing trial known from the same top: its amplitude is the crossing)
+    let (ws, known) = match known.filter(|k| k.0 == w_top) {
+        Some((_, t)) => (t.w, Some(t)),
+        None => match stiffness_crossing(p, d, w_top) {
+            Some(ws) => (ws, None),
+            None => return (None, None),
+        },
     };
-    let t = match known.filter(|t| t.w == ws) {
+    let t = match known {
         Some(t) => t,
         None => trials.eval(ws),
     };
@@ -501,10 +509,10 @@ pub(super) fn solve_drive_below(
         true => {
             let w_cold = cold_top(p, d, detuning, w_hi0);
             match cold_crossing(&mut trials, w_cold) {
-                (Some(top), crossing) => (top, w_cold, crossing),
+                (Some(top), crossing) => (top, w_cold, crossing.map(|t| (w_cold, t))),
                 (None, crossing) => {
                     let hi = descent_top(&mut trials, warm, detuning, w_hi0);
-                    (hi, hi.w, crossing)
+                    (hi, hi.w, crossing.map(|t| (w_cold, t)))
                 }
             }
         }
