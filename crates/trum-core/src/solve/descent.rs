@@ -175,8 +175,7 @@ fn warm_top(trials: &mut Trials, top: &WarmTop, rtol: f64) -> (Trial, Option<Tri
 }
 
 /// The top of the descent, a trial with r(W) ≥ 0: the `warm` one, else the cold bound
-/// ([`cold_top`]), raised by half while r < 0 (at most 60 times). `detuning` = k − m·ω²
-/// [N/m], `w_hi0` = Θ·V/(ω·c) [m].
+/// `w_cold()` [m] ([`cold_top`]), raised by half while r < 0 (at most 60 times).
 ///
 /// Without preload stiffening or Hertz softening the modal stiffness does not depend on
 /// W, and the friction damping c_t·ω is ≥ 0 (the wave gives power to friction and rotor
@@ -185,10 +184,10 @@ fn warm_top(trials: &mut Trials, top: &WarmTop, rtol: f64) -> (Trial, Option<Tri
 /// stiffness only moves the mode away from the drive: stiffening (≥ 0) below the
 /// resonance, softening (≤ 0) above it. Softening could in principle exceed either bound;
 /// the bracket is then grown.
-fn descent_top(trials: &mut Trials, warm: Option<Trial>, detuning: f64, w_hi0: f64) -> Trial {
+fn descent_top(trials: &mut Trials, warm: Option<Trial>, w_cold: impl FnOnce() -> f64) -> Trial {
     let mut hi = match warm {
         Some(t) => t,
-        None => trials.eval(cold_top(trials.p, trials.d, detuning, w_hi0)),
+        None => trials.eval(w_cold()),
     };
     let mut grow = 0;
     while hi.w < hi.w_next && grow < 60 {
@@ -220,28 +219,33 @@ fn cold_top(p: &Prepared, d: &Drive, detuning: f64, w_hi0: f64) -> f64 {
 /// the bound rules out above the crossing ([`clear_from`] with Im Z = ω·c; r ≥ 0 there),
 /// a few per cent above the largest root at `trum60a` as shipped, instead of the cold top
 /// 60-100× above it: one trial fewer than descending from `w_cold`, whose trial only
-/// serves the same bound. `(None, crossing)` where the descent goes on from the cold top
-/// as usual (the crossing's trial, if taken, reused by [`probe_crossing`]).
+/// serves the same bound. Otherwise no top: the descent goes on from the cold top as
+/// usual, and what was found from `w_cold` ([`Known`]) spares [`probe_crossing`] the
+/// search.
 // (not inlined: the descents of other stators keep their code as it is)
 #[inline(never)]
-fn cold_crossing(trials: &mut Trials, w_cold: f64) -> (Option<Trial>, Option<Trial>) {
+fn cold_crossing(trials: &mut Trials, w_cold: f64) -> (Option<Trial>, Known) {
     let (p, d) = (trials.p, trials.d);
+    let Some(ws) = stiffness_crossing(p, d, w_cold) else {
+        return (None, Some((w_cold, None)));
+    };
     let damping = d.omega * d.c;
     // (false for a NaN too)
     let ruled_out = w_cold * elastic_detuning(p, d, w_cold).hypot(damping) >= p.theta * d.v;
     if !ruled_out {
         return (None, None);
     }
-    let Some(ws) = stiffness_crossing(p, d, w_cold) else {
-        return (None, None);
-    };
     let t = trials.eval(ws);
     if t.w < t.w_next {
         let top = clear_from(p, d, ws, w_cold, damping).map(|w| trials.eval(w)).filter(|u| u.w >= u.w_next);
-        return (top, Some(t));
+        return (top, Some((w_cold, Some(t))));
     }
-    (None, Some(t))
+    (None, Some((w_cold, Some(t))))
 }
+
+/// The stiffness crossing as [`cold_crossing`] found it: (the top it searched below [m],
+/// the trial at the crossing, `None` where there is none), or `None` where it did not look.
+type Known = Option<(f64, Option<Trial>)>;
 
 /// The first amplitude below the top `hi` (before any step cap).
 ///
@@ -320,8 +324,8 @@ impl StepCap {
 /// The probe of the stiffness crossing below the top `hi` of a multi-branch descent:
 /// (the lower end of a bracket, the crossing's trial with r ≥ 0), at most one of them.
 /// The crossing is searched below `w_top` [m] (the cold top where `hi` is a top the bound
-/// found, [`cold_crossing`]); `known`: (the top it was found from, the crossing's trial)
-/// where [`cold_crossing`] has taken it.
+/// found, [`cold_crossing`]); `known`: what [`cold_crossing`] found, used where it
+/// searched below the same top.
 ///
 /// G peaks in a spike where the W-dependent stiffness cancels the detuning k − mω²,
 /// narrower than any step cap (10 % wide in W at generic60, β = 3e17). Where the spike
@@ -341,16 +345,12 @@ impl StepCap {
 ///
 /// So the descent from the top goes on down to the crossing, and only there are the
 /// windows searched, the highest first ([`windows_at_crossing`]).
-fn probe_crossing(
-    trials: &mut Trials,
-    hi: &mut Trial,
-    w_top: f64,
-    known: Option<(f64, Trial)>,
-) -> (Option<Trial>, Option<Trial>) {
+fn probe_crossing(trials: &mut Trials, hi: &mut Trial, w_top: f64, known: &Known) -> (Option<Trial>, Option<Trial>) {
     let (p, d) = (trials.p, trials.d);
-    // (a crossing trial known from the same top: its amplitude is the crossing)
+    // (found from the same top: no crossing, or its trial, whose amplitude is the crossing)
     let (ws, known) = match known.filter(|k| k.0 == w_top) {
-        Some((_, t)) => (t.w, Some(t)),
+        Some((_, Some(t))) => (t.w, Some(t)),
+        Some((_, None)) => return (None, None),
         None => match stiffness_crossing(p, d, w_top) {
             Some(ws) => (ws, None),
             None => return (None, None),
@@ -509,15 +509,15 @@ pub(super) fn solve_drive_below(
         true => {
             let w_cold = cold_top(p, d, detuning, w_hi0);
             match cold_crossing(&mut trials, w_cold) {
-                (Some(top), crossing) => (top, w_cold, crossing.map(|t| (w_cold, t))),
-                (None, crossing) => {
-                    let hi = descent_top(&mut trials, warm, detuning, w_hi0);
-                    (hi, hi.w, crossing.map(|t| (w_cold, t)))
+                (Some(top), known) => (top, w_cold, known),
+                (None, known) => {
+                    let hi = descent_top(&mut trials, warm, || w_cold);
+                    (hi, hi.w, known)
                 }
             }
         }
         false => {
-            let hi = descent_top(&mut trials, warm, detuning, w_hi0);
+            let hi = descent_top(&mut trials, warm, || cold_top(p, d, detuning, w_hi0));
             (hi, hi.w, None)
         }
     };
@@ -525,7 +525,9 @@ pub(super) fn solve_drive_below(
     let start = first_step(warm, below, &hi);
     let cap = StepCap::new(p, detuning, w_top);
     let (cur, mut spike) =
-        if multi_branch { probe_crossing(&mut trials, &mut hi, w_top, crossing) } else { (None, None) };
+        if multi_branch { probe_crossing(&mut trials, &mut hi, w_top, &crossing) } else { (None, None) };
+    // secant steps inside the bracket where the descent met a stiffness crossing
+    let secants = (cur.is_some() || spike.is_some()) && bounded();
     // the descent's trials above the crossing (r ≥ 0 at each); no allocation without one
     let mut above = Vec::new();
     if spike.is_some() {
@@ -575,7 +577,7 @@ pub(super) fn solve_drive_below(
             // else regula falsi (Illinois) there.
             Some(l) => match cur
                 .newton()
-                .or_else(|| (multi_branch && bounded()).then(|| secant(&cur, prev)).flatten())
+                .or_else(|| secants.then(|| secant(&cur, prev)).flatten())
                 .filter(|&x| x > l.w && x < hi.w)
             {
                 Some(x) => x,
