@@ -222,7 +222,7 @@ fn cold_top(p: &Prepared, d: &Drive, detuning: f64, w_hi0: f64) -> f64 {
 /// serves the same bound. Otherwise no top: the descent goes on from the cold top as
 /// usual, and what was found from `w_cold` ([`Known`]) spares [`probe_crossing`] the
 /// search.
-// (not inlined: the descents of other stators keep their code as it is)
+// (not inlined: inlined, it enlarges the descent of every stator for the multi-branch ones)
 #[inline(never)]
 fn cold_crossing(trials: &mut Trials, w_cold: f64) -> (Option<Trial>, Known) {
     let (p, d) = (trials.p, trials.d);
@@ -697,10 +697,10 @@ fn fold_window(p: &Prepared, d: &Drive, spike: &Trial, eval: &mut dyn FnMut(f64)
 /// that finds a window halves that interval to 1e-7 or to the budget: the budget exit is
 /// the usual one then. An interval with r < 0 at its lower end that is narrower than
 /// `resolved` (relative) is taken as the answer at once: 1 − MULTI_BRANCH_STEP, the step
-/// the capped descent trusts, from a crossing with r < 0 (bounded splits there: the first
-/// bound step from the cold top lands within a few per cent of the root and the secant
-/// through the two below it, just below the root, 8.4 instead of 15.9 trials a point of
-/// `trum60a` as shipped); 0 after the descent (halved). (Returning
+/// the capped descent trusts, from a crossing with r < 0 (bounded splits there: at
+/// `trum60a` as shipped the top is 6-8 % above the root, and the regula falsi root between
+/// it and the crossing, 8-15 % below the root, closes such an interval at once); 0 after
+/// the descent (halved). (Returning
 /// at any width would miss a higher window inside that interval: generic60, softening
 /// 3e17, 409 N, 1.47 N·m.) A search that finds none costs nothing
 /// where the descent kept clear of the crossing.
@@ -778,8 +778,8 @@ pub(super) enum Split {
     Midpoint,
     /// Above the crossing, where the bound on G is known in closed form but for Im Z:
     /// alternately at the lowest amplitude the bound rules out from the interval's upper
-    /// probe ([`clear_from`]) and at the secant root through the two probes above
-    /// (`bounded_split`), never above the midpoint.
+    /// probe ([`clear_from`]) and at a secant root of r (`bounded_split`), never above the
+    /// midpoint.
     Bounded,
 }
 
@@ -794,9 +794,10 @@ fn above_crossing(ws: f64, z: &Trial) -> bool {
 /// is a secant step).
 ///
 /// A secant step, where `secant` allows it: the root of the secant of r through
-/// `probes[j]` and the probe above it, both r ≥ 0 and above the root, where it lies inside
-/// the interval. It lands a hair below the root (r < 0: the lower end of a narrow bracket)
-/// or above it where the bound rules out the rest of the interval (a lower top).
+/// `probes[j]` and the probe above it (both r ≥ 0, above the root), or without one the
+/// probe below where r < 0 there (regula falsi), where it lies inside the interval. It
+/// lands below the root (r < 0: the lower end of a narrow bracket) or above it where the
+/// bound rules out the rest of the interval (a lower top).
 /// Otherwise a bound step: the lowest amplitude from which the interval up to
 /// `probes[j]` is ruled out ([`clear_from`]), so that the probe there rules out all of the
 /// interval above it (r ≥ 0 there by the same bound); its rate is that of Im Z's fall
