@@ -902,7 +902,7 @@ fn arccos_near(u: f64, sin_ts: f64, dc: C64) -> C64 {
             C64::new(c.acos(), 0.0)
         };
     }
-    if dc.norm() > 0.5 {
+    if dc.norm_sqr() > 0.25 {
         return (dc + u).acos();
     }
     let root = csqrt(C64::new(sin_ts * sin_ts, 0.0) - dc * (2.0 * u));
@@ -910,21 +910,37 @@ fn arccos_near(u: f64, sin_ts: f64, dc: C64) -> C64 {
     // the quadratic's root is within about |δ|²/6 of δ relative, plenty for grading panels
     // up to |δ| = 0.1; beyond, Newton steps (two or three)
     for _ in 0..20 {
-        if d.norm() <= 0.1 {
+        // (squared moduli: no hypot call in the loop)
+        if d.norm_sqr() <= 0.01 {
             break;
         }
-        let (sd, cd) = (d.sin(), d.cos());
-        let half = (d * 0.5).sin();
+        let (half, half_cos) = sin_cos_complex(d * 0.5);
+        // sin δ and cos δ by the double-angle formulas: one real sin_cos and one expm1 a
+        // step instead of three complex sines and cosines
+        let sd = half * half_cos * 2.0;
+        let cd = C64::new(1.0, 0.0) - half * half * 2.0;
         let g = -half * half * (2.0 * u) - sd * sin_ts - dc;
         let dg = -(sd * u + cd * sin_ts);
         let step = g / dg;
         d -= step;
         // (a NaN step ends the steps too)
-        if step.norm().partial_cmp(&(1e-13 * d.norm())) != Some(std::cmp::Ordering::Greater) {
+        if step.norm_sqr().partial_cmp(&(1e-26 * d.norm_sqr())) != Some(std::cmp::Ordering::Greater) {
             break;
         }
     }
     d + u.clamp(-1.0, 1.0).acos()
+}
+
+/// (sin z, cos z) of a complex z = x + iy: sin x·cosh y + i·cos x·sinh y and
+/// cos x·cosh y − i·sin x·sinh y, with sinh y and cosh y from one e^y − 1 (no cancellation
+/// in sinh y for small y).
+fn sin_cos_complex(z: C64) -> (C64, C64) {
+    let (sx, cx) = z.re.sin_cos();
+    let em = z.im.exp_m1();
+    let e = em + 1.0;
+    let sinh = 0.5 * em * (em + 2.0) / e;
+    let cosh = 0.5 * (e + 1.0 / e);
+    (C64::new(sx * cosh, cx * sinh), C64::new(cx * cosh, -sx * sinh))
 }
 
 /// Panel ends of the graded rule on [0, φ0] about the singularity `z` = (Re θ*, |Im θ*|):

@@ -174,9 +174,8 @@ fn warm_top(trials: &mut Trials, top: &WarmTop, rtol: f64) -> (Trial, Option<Tri
     (top, Some(b))
 }
 
-/// The top of the descent, a trial with r(W) ≥ 0: the `warm` one, else the cold bound,
-/// raised by half while r < 0 (at most 60 times). `detuning` = k − m·ω² [N/m], `w_hi0` =
-/// Θ·V/(ω·c) [m].
+/// The top of the descent, a trial with r(W) ≥ 0: the `warm` one, else the cold bound
+/// `w_cold()` [m] ([`cold_top`]), raised by half while r < 0 (at most 60 times).
 ///
 /// Without preload stiffening or Hertz softening the modal stiffness does not depend on
 /// W, and the friction damping c_t·ω is ≥ 0 (the wave gives power to friction and rotor
@@ -185,16 +184,10 @@ fn warm_top(trials: &mut Trials, top: &WarmTop, rtol: f64) -> (Trial, Option<Tri
 /// stiffness only moves the mode away from the drive: stiffening (≥ 0) below the
 /// resonance, softening (≤ 0) above it. Softening could in principle exceed either bound;
 /// the bracket is then grown.
-fn descent_top(trials: &mut Trials, warm: Option<Trial>, detuning: f64, w_hi0: f64) -> Trial {
-    let (p, d) = (trials.p, trials.d);
-    let w_cold = if (p.stiffening == 0.0 || detuning >= 0.0) && (p.beta == 0.0 || detuning <= 0.0) {
-        p.theta * d.v / detuning.hypot(d.omega * d.c)
-    } else {
-        w_hi0
-    };
+fn descent_top(trials: &mut Trials, warm: Option<Trial>, w_cold: impl FnOnce() -> f64) -> Trial {
     let mut hi = match warm {
         Some(t) => t,
-        None => trials.eval(w_cold),
+        None => trials.eval(w_cold()),
     };
     let mut grow = 0;
     while hi.w < hi.w_next && grow < 60 {
@@ -203,6 +196,56 @@ fn descent_top(trials: &mut Trials, warm: Option<Trial>, detuning: f64, w_hi0: f
     }
     hi
 }
+
+/// The amplitude [m] a cold descent starts from ([`descent_top`]): Θ·V/|k − mω² + iωc| where
+/// the W-dependent stiffness cannot move the mode towards the drive, else `w_hi0` =
+/// Θ·V/(ω·c).
+fn cold_top(p: &Prepared, d: &Drive, detuning: f64, w_hi0: f64) -> f64 {
+    if (p.stiffening == 0.0 || detuning >= 0.0) && (p.beta == 0.0 || detuning <= 0.0) {
+        p.theta * d.v / detuning.hypot(d.omega * d.c)
+    } else {
+        w_hi0
+    }
+}
+
+/// The crossing probe of a cold multi-branch descent started without the trial at the cold
+/// top `w_cold` [m]: (a top to descend from, the trial at the stiffness crossing).
+///
+/// Friction damping is ≥ 0, so Im Z ≥ ω·c at every W, and with the elastic detuning
+/// ([`elastic_detuning`], exact) G(W) ≤ Θ·V/hypot(Re Z(W), ω·c) needs no interface
+/// integral. Where that bound puts r ≥ 0 at `w_cold` (the cold descent's top, which then
+/// needs no growing), the crossing is the one [`probe_crossing`] finds from it, and its
+/// trial is taken first. With r < 0 there, the top is the trial at the lowest amplitude
+/// the bound rules out above the crossing ([`clear_from`] with Im Z = ω·c; r ≥ 0 there),
+/// a few per cent above the largest root at `trum60a` as shipped, instead of the cold top
+/// 60-100× above it: one trial fewer than descending from `w_cold`, whose trial only
+/// serves the same bound. Otherwise no top: the descent goes on from the cold top as
+/// usual, and what was found from `w_cold` ([`Known`]) spares [`probe_crossing`] the
+/// search.
+// (not inlined: inlined, it enlarges the descent of every stator for the multi-branch ones)
+#[inline(never)]
+fn cold_crossing(trials: &mut Trials, w_cold: f64) -> (Option<Trial>, Known) {
+    let (p, d) = (trials.p, trials.d);
+    let Some(ws) = stiffness_crossing(p, d, w_cold) else {
+        return (None, Some((w_cold, None)));
+    };
+    let damping = d.omega * d.c;
+    // (false for a NaN too)
+    let ruled_out = w_cold * elastic_detuning(p, d, w_cold).hypot(damping) >= p.theta * d.v;
+    if !ruled_out {
+        return (None, None);
+    }
+    let t = trials.eval(ws);
+    if t.w < t.w_next {
+        let top = clear_from(p, d, ws, w_cold, damping).map(|w| trials.eval(w)).filter(|u| u.w >= u.w_next);
+        return (top, Some((w_cold, Some(t))));
+    }
+    (None, Some((w_cold, Some(t))))
+}
+
+/// The stiffness crossing as [`cold_crossing`] found it: (the top it searched below [m],
+/// the trial at the crossing, `None` where there is none), or `None` where it did not look.
+type Known = Option<(f64, Option<Trial>)>;
 
 /// The first amplitude below the top `hi` (before any step cap).
 ///
@@ -280,6 +323,9 @@ impl StepCap {
 
 /// The probe of the stiffness crossing below the top `hi` of a multi-branch descent:
 /// (the lower end of a bracket, the crossing's trial with r ≥ 0), at most one of them.
+/// The crossing is searched below `w_top` [m] (the cold top where `hi` is a top the bound
+/// found, [`cold_crossing`]); `known`: what [`cold_crossing`] found, used where it
+/// searched below the same top.
 ///
 /// G peaks in a spike where the W-dependent stiffness cancels the detuning k − mω²,
 /// narrower than any step cap (10 % wide in W at generic60, β = 3e17). Where the spike
@@ -299,20 +345,57 @@ impl StepCap {
 ///
 /// So the descent from the top goes on down to the crossing, and only there are the
 /// windows searched, the highest first ([`windows_at_crossing`]).
-fn probe_crossing(trials: &mut Trials, hi: &mut Trial) -> (Option<Trial>, Option<Trial>) {
+fn probe_crossing(trials: &mut Trials, hi: &mut Trial, w_top: f64, known: &Known) -> (Option<Trial>, Option<Trial>) {
     let (p, d) = (trials.p, trials.d);
-    let Some(ws) = stiffness_crossing(p, d, hi.w) else {
-        return (None, None);
+    // (found from the same top: no crossing, or its trial, whose amplitude is the crossing)
+    let (ws, known) = match known.filter(|k| k.0 == w_top) {
+        Some((_, Some(t))) => (t.w, Some(t)),
+        Some((_, None)) => return (None, None),
+        None => match stiffness_crossing(p, d, w_top) {
+            Some(ws) => (ws, None),
+            None => return (None, None),
+        },
     };
-    let t = trials.eval(ws);
+    let t = match known {
+        Some(t) => t,
+        None => trials.eval(ws),
+    };
     if t.w < t.w_next {
-        let found = highest_window(p, d, ws, vec![*hi, t], 40, 1.0 - MULTI_BRANCH_STEP, &mut |w| trials.eval(w));
+        let found =
+            highest_window(p, d, ws, vec![*hi, t], 40, 1.0 - MULTI_BRANCH_STEP, probe_split(), &mut |w| trials.eval(w));
         let (tl, top) = found.unwrap_or((t, *hi));
         *hi = top;
         (Some(tl), None)
     } else {
         (None, Some(t))
     }
+}
+
+/// Whether a multi-branch descent uses the bound on G that needs no interface integral
+/// ([`cold_crossing`], `Split::Bounded`, secant steps inside the bracket): always, but where
+/// a test asks for the descent without it, the reference it is compared with.
+fn bounded() -> bool {
+    #[cfg(test)]
+    if REFERENCE_DESCENT.with(std::cell::Cell::get) {
+        return false;
+    }
+    true
+}
+
+/// The split of the crossing probe's window search.
+fn probe_split() -> Split {
+    if bounded() {
+        Split::Bounded
+    } else {
+        Split::Midpoint
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Set by a test: multi-branch descents run without the bound ([`bounded`]): from the
+    /// cold top's trial, midpoint splits, regula falsi inside the bracket.
+    pub(super) static REFERENCE_DESCENT: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// The windows of r < 0 at the stiffness crossing `spike`, which the descent is about to
@@ -323,7 +406,7 @@ fn probe_crossing(trials: &mut Trials, hi: &mut Trial) -> (Option<Trial>, Option
 fn windows_at_crossing(trials: &mut Trials, spike: Trial, mut above: Vec<Trial>) -> Option<(Trial, Trial)> {
     let (p, d) = (trials.p, trials.d);
     above.push(spike);
-    highest_window(p, d, spike.w, above, 40, 0.0, &mut |w| trials.eval(w)).or_else(|| {
+    highest_window(p, d, spike.w, above, 40, 0.0, Split::Midpoint, &mut |w| trials.eval(w)).or_else(|| {
         // the fold window's trials, to rule out a window above the one it found
         let mut seen = vec![spike];
         let tm = fold_window(p, d, &spike, &mut |w| {
@@ -332,7 +415,7 @@ fn windows_at_crossing(trials: &mut Trials, spike: Trial, mut above: Vec<Trial>)
             t
         })?;
         seen.retain(|t| t.w >= tm.w);
-        highest_window(p, d, spike.w, seen, 40, 0.0, &mut |w| trials.eval(w))
+        highest_window(p, d, spike.w, seen, 40, 0.0, Split::Midpoint, &mut |w| trials.eval(w))
     })
 }
 
@@ -419,12 +502,32 @@ pub(super) fn solve_drive_below(
     let warm = warm_trial.filter(|t| t.w >= t.w_next);
     let below = below.filter(|_| warm.is_some());
     let detuning = d.ks - p.m * d.omega * d.omega;
-    let mut hi = descent_top(&mut trials, warm, detuning, w_hi0);
+    let multi_branch = p.stiffening != 0.0 || p.beta != 0.0;
+    // (a top found by the bound stands for the cold top `w_top`, where r ≥ 0 by the same
+    // bound)
+    let (mut hi, w_top, crossing) = match multi_branch && warm.is_none() && bounded() {
+        true => {
+            let w_cold = cold_top(p, d, detuning, w_hi0);
+            match cold_crossing(&mut trials, w_cold) {
+                (Some(top), known) => (top, w_cold, known),
+                (None, known) => {
+                    let hi = descent_top(&mut trials, warm, || w_cold);
+                    (hi, hi.w, known)
+                }
+            }
+        }
+        false => {
+            let hi = descent_top(&mut trials, warm, || cold_top(p, d, detuning, w_hi0));
+            (hi, hi.w, None)
+        }
+    };
     let mut lo: Option<Trial> = below;
     let start = first_step(warm, below, &hi);
-    let multi_branch = p.stiffening != 0.0 || p.beta != 0.0;
-    let cap = StepCap::new(p, detuning, hi.w);
-    let (cur, mut spike) = if multi_branch { probe_crossing(&mut trials, &mut hi) } else { (None, None) };
+    let cap = StepCap::new(p, detuning, w_top);
+    let (cur, mut spike) =
+        if multi_branch { probe_crossing(&mut trials, &mut hi, w_top, &crossing) } else { (None, None) };
+    // secant steps inside the bracket where the descent met a stiffness crossing
+    let secants = (cur.is_some() || spike.is_some()) && bounded();
     // the descent's trials above the crossing (r ≥ 0 at each); no allocation without one
     let mut above = Vec::new();
     if spike.is_some() {
@@ -472,7 +575,11 @@ pub(super) fn solve_drive_below(
         let next = match lo {
             // Newton with the trial's exact slope where its step stays inside [lo, hi],
             // else regula falsi (Illinois) there.
-            Some(l) => match cur.newton().filter(|&x| x > l.w && x < hi.w) {
+            Some(l) => match cur
+                .newton()
+                .or_else(|| secants.then(|| secant(&cur, prev)).flatten())
+                .filter(|&x| x > l.w && x < hi.w)
+            {
                 Some(x) => x,
                 None => bracket.regula_falsi().unwrap_or(0.5 * (l.w + hi.w)),
             },
@@ -501,6 +608,14 @@ pub(super) fn solve_drive_below(
     // Use the trial consistent with the converged amplitude for every output.
     let status = if cur.stalled { Status::Stall } else { Status::Ok };
     finish(p, d, op, &cur, status, evals)
+}
+
+/// The root of the secant of r = W − G(W) through the trials `cur` and `prev`, where `cur`
+/// has the smaller |r| (at most half of `prev`'s: the iterates close in on a root).
+fn secant(cur: &Trial, prev: Option<Trial>) -> Option<f64> {
+    let pv = prev?;
+    let (rc, rp) = (cur.w - cur.w_next, pv.w - pv.w_next);
+    (rc.abs() <= 0.5 * rp.abs() && rc != rp).then(|| cur.w - rc * (cur.w - pv.w) / (rc - rp)).filter(|x| x.is_finite())
 }
 
 /// A trial with r = W − G(W) < 0 just below the stiffness crossing `spike` (where r ≥ 0),
@@ -574,14 +689,18 @@ fn fold_window(p: &Prepared, d: &Drive, spike: &Trial, eval: &mut dyn FnMut(f64)
 /// - below the crossing (Re Z ≥ 0) |Z(W)| ≥ |Z(z2)|, G(W) ≤ G(z2): none where z1 ≥ G(z2);
 /// - above it (Re Z ≤ 0) |Z(W)| ≥ hypot(Re Z(z1), Im Z(z2)): none where z1 ≥ Θ·V over that.
 ///
-/// The highest interval not ruled out is halved, top down, until every interval above a
+/// The highest interval not ruled out is split (`split`: halved, or `Split::Bounded`),
+/// top down, until every interval above a
 /// probe with r < 0 is ruled out or narrower than 1e-7 relative (as `fold_window`), or
 /// `budget` new probes are spent (then the highest r < 0 found so far). The bound never
 /// rules out the interval just above a probe with r < 0 (there G(z2) > z1), so a search
 /// that finds a window halves that interval to 1e-7 or to the budget: the budget exit is
 /// the usual one then. An interval with r < 0 at its lower end that is narrower than
 /// `resolved` (relative) is taken as the answer at once: 1 − MULTI_BRANCH_STEP, the step
-/// the capped descent trusts, from a crossing with r < 0; 0 after the descent. (Returning
+/// the capped descent trusts, from a crossing with r < 0 (bounded splits there: at
+/// `trum60a` as shipped the top is 6-8 % above the root, and the regula falsi root between
+/// it and the crossing, 8-15 % below the root, closes such an interval at once); 0 after
+/// the descent (halved). (Returning
 /// at any width would miss a higher window inside that interval: generic60, softening
 /// 3e17, 409 N, 1.47 N·m.) A search that finds none costs nothing
 /// where the descent kept clear of the crossing.
@@ -593,6 +712,7 @@ fn fold_window(p: &Prepared, d: &Drive, spike: &Trial, eval: &mut dyn FnMut(f64)
 /// (generic60, stiffening 3.3 and compliance 1 in truth form: 7× over 0.2 % of W), so the
 /// bound above the crossing is not proven there; on dense grids of 18 configurations no
 /// interval it rules out holds r < 0.
+#[allow(clippy::too_many_arguments)]
 fn highest_window(
     p: &Prepared,
     d: &Drive,
@@ -600,6 +720,7 @@ fn highest_window(
     mut probes: Vec<Trial>,
     budget: usize,
     resolved: f64,
+    split: Split,
     eval: &mut dyn FnMut(f64) -> Trial,
 ) -> Option<(Trial, Trial)> {
     let theta_v = p.theta * d.v;
@@ -610,6 +731,9 @@ fn highest_window(
     };
     probes.sort_by(|a, b| a.w.total_cmp(&b.w));
     let mut spent = 0;
+    // `Split::Bounded`: whether the latest new probe was a secant step, and whether secant
+    // steps are still taken (until one lands above the root where it rules nothing out)
+    let (mut secant_step, mut secants) = (false, true);
     'refine: loop {
         // top down: a probe with r < 0 is the answer once every interval above it is clear
         for j in (0..probes.len()).rev() {
@@ -628,10 +752,106 @@ fn highest_window(
                 return Some((probes[k], probes[k + 1]));
             }
             spent += 1;
-            let t = eval(0.5 * (probes[j - 1].w + probes[j].w));
+            let mid = 0.5 * (probes[j - 1].w + probes[j].w);
+            let (x, secant) = match split {
+                Split::Bounded if above_crossing(ws, &probes[j - 1]) => {
+                    bounded_split(p, d, &probes, j, secants && !secant_step, mid)
+                }
+                _ => (mid, false),
+            };
+            let t = eval(x);
+            if secant && !below(&t) && !clear(&t, &probes[j]) {
+                secants = false;
+            }
+            secant_step = secant;
             probes.insert(j, t);
             continue 'refine;
         }
         return None;
     }
+}
+
+/// How [`highest_window`] splits an interval it cannot rule out.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) enum Split {
+    /// At its midpoint.
+    Midpoint,
+    /// Above the crossing, where the bound on G is known in closed form but for Im Z:
+    /// alternately at the lowest amplitude the bound rules out from the interval's upper
+    /// probe ([`clear_from`]) and at a secant root of r (`bounded_split`), never above the
+    /// midpoint.
+    Bounded,
+}
+
+/// True when the probe `z` lies at or above the stiffness crossing `ws`, where Re Z ≤ 0.
+fn above_crossing(ws: f64, z: &Trial) -> bool {
+    z.w >= ws
+}
+
+/// The next probe inside the interval (`probes[j − 1]`, `probes[j]`) that
+/// [`highest_window`] cannot rule out, every interval above `probes[j]` ruled out
+/// (r ≥ 0 at `probes[j]`), for the split `Split::Bounded`: (the amplitude [m], whether it
+/// is a secant step).
+///
+/// A secant step, where `secant` allows it: the root of the secant of r through
+/// `probes[j]` and the probe above it (both r ≥ 0, above the root), or without one the
+/// probe below where r < 0 there (regula falsi), where it lies inside the interval. It
+/// lands below the root (r < 0: the lower end of a narrow bracket) or above it where the
+/// bound rules out the rest of the interval (a lower top).
+/// Otherwise a bound step: the lowest amplitude from which the interval up to
+/// `probes[j]` is ruled out ([`clear_from`]), so that the probe there rules out all of the
+/// interval above it (r ≥ 0 there by the same bound); its rate is that of Im Z's fall
+/// between the probes, a seventh of the distance to the root a step at `trum60a` as
+/// shipped. Never above the midpoint `mid`: where the bound is weak (r a hair above zero
+/// over a long stretch) the halving of the midpoint rule is kept.
+fn bounded_split(p: &Prepared, d: &Drive, probes: &[Trial], j: usize, secant: bool, mid: f64) -> (f64, bool) {
+    let (z1, z2) = (&probes[j - 1], &probes[j]);
+    let inside = |x: f64| (x > z1.w && x < z2.w).then_some(x);
+    if secant {
+        // (the probe above, else the one below where r < 0 there: regula falsi)
+        if let Some(z3) = probes.get(j + 1).or(Some(z1).filter(|z| z.w < z.w_next)) {
+            let (r2, r3) = (z2.w - z2.w_next, z3.w - z3.w_next);
+            if r3 != r2 {
+                if let Some(x) = inside(z2.w - r2 * (z3.w - z2.w) / (r3 - r2)) {
+                    return (x, true);
+                }
+            }
+        }
+    }
+    (clear_from(p, d, z1.w, z2.w, z2.z.1).and_then(inside).map_or(mid, |x| x.min(mid)), false)
+}
+
+/// The lowest amplitude W in [`lo`, `hi`] [m] from which no root of r = W − G(W) lies up
+/// to `hi` by the bound of [`highest_window`] above the crossing, `im_z` [N/m] a lower
+/// bound of Im Z on [W, `hi`] (Im Z at a probe `hi`: friction damping falls with W):
+/// W·hypot(Re Z(W), `im_z`) ≥ Θ·V. Re Z falls with W above the crossing, so the left side
+/// rises with W and the interval above W is ruled out as a whole. Re Z is the elastic
+/// detuning ([`elastic_detuning`], a contact solve without the interface integrals).
+/// Illinois regula falsi to 1e-4 relative, returning the end where the bound holds;
+/// `None` where it holds at `lo` already or nowhere.
+fn clear_from(p: &Prepared, d: &Drive, lo: f64, hi: f64, im_z: f64) -> Option<f64> {
+    let theta_v = p.theta * d.v;
+    let f = |w: f64| w * elastic_detuning(p, d, w).hypot(im_z) - theta_v;
+    let (f_lo, f_hi) = (f(lo), f(hi));
+    if !(f_lo < 0.0 && f_hi >= 0.0) {
+        return None;
+    }
+    let mut b = SignBracket { neg: Some((lo, f_lo)), pos: Some((hi, f_hi.max(f64::MIN_POSITIVE))), last_side: 0 };
+    for _ in 0..60 {
+        let (a, c) = (b.neg?.0, b.pos?.0);
+        if c - a <= 1e-4 * c {
+            break;
+        }
+        let x = b.regula_falsi()?;
+        let fx = f(x);
+        if fx.is_nan() {
+            return None;
+        }
+        if fx >= 0.0 {
+            b.record(x, fx.max(f64::MIN_POSITIVE), true);
+        } else {
+            b.record(x, fx, true);
+        }
+    }
+    Some(b.pos?.0)
 }

@@ -857,3 +857,49 @@ fn truth_form_warm_ups_have_their_shapes() {
     let left = 1.0 - rise(&diffusive, loss, x * tau) / ss;
     assert!((left * (std::f64::consts::PI * x).sqrt() - 1.0).abs() < 1e-2, "{left}");
 }
+
+/// The multi-branch descent with the bound on G that needs no interface integral (the
+/// top it rules out from the cold bound, `descent::Split::Bounded`, secant steps inside
+/// the bracket) against the descent without it (the cold top's trial, midpoint splits,
+/// regula falsi; `descent::REFERENCE_DESCENT`) on `trum60a` as shipped (radial friction
+/// and preload stiffening, the mode below the drive) over preload × voltage × frequency ×
+/// torque: the same status and amplitude to 1e-9 relative at every point (both converge
+/// to 1e-10 on r, so they differ by the solve's tolerance alone), at many points where
+/// the amplitude map has several fixed points, in fewer trials.
+#[test]
+fn the_bounded_descent_finds_the_reference_descents_root() {
+    let m = crate::presets::preset("trum60a").expect("preset");
+    let set_reference = |on: bool| super::descent::REFERENCE_DESCENT.with(|c| c.set(on));
+    let (mut points, mut multi, mut evals_ref, mut evals_bounded) = (0, 0, 0u64, 0u64);
+    let mut differ = Vec::new();
+    for f_n in [120.0, 180.0, 240.0, 300.0, 360.0] {
+        for v in [120.0, 160.0, 200.0, 240.0, 280.0] {
+            for f in [41.0e3, 41.8e3, 42.5e3, 43.0e3, 43.7e3, 44.5e3] {
+                for t in [0.0, 0.3, 0.6, 0.9] {
+                    let op = OperatingPoint::new(f_n, t, v, f);
+                    set_reference(true);
+                    let a = solve(&m, &op);
+                    set_reference(false);
+                    let b = solve(&m, &op);
+                    points += 1;
+                    evals_ref += u64::from(a.iterations);
+                    evals_bounded += u64::from(b.iterations);
+                    multi += usize::from(amplitude_branches(&m, &op).len() > 1);
+                    let rel = (a.amplitude_m - b.amplitude_m).abs() / a.amplitude_m.abs().max(f64::MIN_POSITIVE);
+                    if a.status != b.status || !(rel <= 1e-9 || a.amplitude_m == b.amplitude_m) {
+                        differ.push(format!(
+                            "{op:?}: reference {:?} {:e} m, bounded {:?} {:e} m",
+                            a.status, a.amplitude_m, b.status, b.amplitude_m
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "{points} points, {multi} with several fixed points, trials {evals_ref} reference, {evals_bounded} bounded"
+    );
+    assert!(differ.is_empty(), "{} of {points} points differ:\n{}", differ.len(), differ.join("\n"));
+    assert!(multi >= 100, "only {multi} of {points} points have several fixed points");
+    assert!(evals_bounded < evals_ref, "{evals_bounded} trials bounded, {evals_ref} reference");
+}
