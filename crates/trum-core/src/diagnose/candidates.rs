@@ -487,9 +487,8 @@ impl<'a> Scorer<'a> {
 /// (the speed-std instrument's floor, the torque and temperature offsets). They are the
 /// bench's, not the motor's, and every fit estimates them anew; a fit started from the
 /// nominal motor would start them at zero, the floor on its bound, where its transformed
-/// gradient vanishes and a first step can throw it to the other bound: a
-/// `tangential_compliance` fit from the scan's valley ended with the floor at its upper
-/// bound, 50 % above every reading, which cost it nothing in χ² but most of its held-out
+/// gradient vanishes and a first step can throw it to the other bound: such a fit can end
+/// with the floor 50 % above every reading, nearly free in χ² but most of its held-out
 /// NRMSE (the speed std's readings spread little, so its scale is small).
 fn with_bench(motor: &Motor, calibrated: &Motor) -> Motor {
     let mut m = motor.clone();
