@@ -126,8 +126,8 @@ fn radial_friction_ratio_grows_with_preload_by_its_exponent() {
     assert!(solve(&steep, &hi).speed_rpm < solve(&flat, &hi).speed_rpm);
 }
 
-/// `hertz_softening`'s preload exponent: β·(1 + gF)² is the plain candidate with
-/// β' = β·(1 + gF) at that preload.
+/// `hertz_softening`'s preload exponent: 2β·((1 + gF)/2)² is the plain candidate with
+/// β' = β·(1 + gF)/2 at that preload.
 #[test]
 fn hertz_softening_exponent_is_a_power_of_the_preload_growth() {
     let hs = Effect::HertzSoftening;
@@ -135,12 +135,44 @@ fn hertz_softening_exponent_is_a_power_of_the_preload_growth() {
     let mut a = baseline();
     a.effects.set(hs, &[beta, g, 2.0]);
     let mut b = baseline();
-    b.effects.set(hs, &[beta * (1.0 + g * f), g, 1.0]);
+    b.effects.set(hs, &[beta * (1.0 + g * f) / 2.0, g, 1.0]);
     for t in [0.0, 0.3] {
         let (x, y) = (solve(&a, &op(f, t, 0.0)), solve(&b, &op(f, t, 0.0)));
         assert!((x.speed_rpm - y.speed_rpm).abs() <= 1e-9 * y.speed_rpm, "{} vs {}", x.speed_rpm, y.speed_rpm);
         assert!((x.modal_stiffness_n_per_m / y.modal_stiffness_n_per_m - 1.0).abs() < 1e-12);
     }
+}
+
+/// `hertz_softening`'s falling member: at n = −1 the cubic coefficient is 4β/(1 + gF), the
+/// plain candidate's with β' = 4β/(1 + gF)² at that preload, so it softens less the harder
+/// the contact is pressed (a Hertzian contact expanded about its preloaded compression).
+#[test]
+fn hertz_softening_falls_with_the_preload_at_a_negative_exponent() {
+    let hs = Effect::HertzSoftening;
+    let (beta, g) = (1e18, 0.004);
+    let mut falling = baseline();
+    falling.effects.set(hs, &[beta, g, -1.0]);
+    for f in [100.0, 250.0, 400.0] {
+        let mut plain = baseline();
+        plain.effects.set(hs, &[4.0 * beta / (1.0 + g * f).powi(2), g, 1.0]);
+        for t in [0.0, 0.3] {
+            let (x, y) = (solve(&falling, &op(f, t, 0.0)), solve(&plain, &op(f, t, 0.0)));
+            assert!(
+                (x.speed_rpm - y.speed_rpm).abs() <= 1e-9 * y.speed_rpm,
+                "{f} N: {} vs {}",
+                x.speed_rpm,
+                y.speed_rpm
+            );
+            assert!((x.modal_stiffness_n_per_m / y.modal_stiffness_n_per_m - 1.0).abs() < 1e-12);
+        }
+    }
+    // the same β softens the stator less at 400 N than at 100 N: the resonance's drop
+    // below the effect-free motor's shrinks as the contact is pressed
+    let shift = |f: f64| {
+        let (x, y) = (solve(&falling, &op(f, 0.0, 0.0)), solve(&baseline(), &op(f, 0.0, 0.0)));
+        (y.modal_stiffness_n_per_m - x.modal_stiffness_n_per_m) / y.modal_stiffness_n_per_m
+    };
+    assert!(shift(100.0) > 0.0 && shift(400.0) < shift(100.0), "{} {}", shift(100.0), shift(400.0));
 }
 
 /// `voltage_sag`'s current-limited driver: below its knee it holds the set voltage exactly

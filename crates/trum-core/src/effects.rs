@@ -165,7 +165,7 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
     EffectInfo {
         name: "hertz_softening",
         summary: "softening cubic restoring force at high amplitude: resonance shifts down with \
-                  amplitude, growing with preload",
+                  amplitude, changing with preload",
         source: "the Hertzian driving-circuit paper (2022) eq. 2-4 and 10-12",
         params: &[
             EffectParam {
@@ -190,15 +190,17 @@ pub const EFFECTS: [EffectInfo; N_EFFECTS] = [
             },
             EffectParam {
                 name: "preload_exponent",
-                doc: "exponent n of the preload growth of the cubic coefficient [-]: \
-                      beta·(1 + g·F_N)^n; 1 linear growth, 1.5 the growth of a Hertzian \
-                      contact's stiffness with its load",
+                doc: "exponent n of the preload dependence of the cubic coefficient [-]: \
+                      2·beta·((1 + g·F_N)/2)^n, which meets the candidate's beta·(1 + g·F_N) \
+                      where g·F_N = 1; 1 linear growth, 1.5 the growth of a Hertzian \
+                      contact's stiffness with its load, -1 the cubic term of a Hertzian \
+                      contact expanded about its preloaded compression (falls as 1/F_N)",
                 typical: 1.0,
-                min: 0.5,
+                min: -1.0,
                 max: 3.0,
                 shape: true,
                 held: true,
-                levels: &[0.5, 1.5, 2.0],
+                levels: &[-1.0, 0.5, 1.5, 2.0],
             },
         ],
         fit_start: 0.5,

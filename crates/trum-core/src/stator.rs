@@ -133,7 +133,8 @@ pub(crate) fn softening_per_w2(p: &Prepared, d: &Drive) -> f64 {
         // the first truth family: a Hertzian contact F = c·δ^(3/2) expanded about its
         // static compression δ0 has a cubic term ∝ δ0^(−3/2) ∝ 1/F_N (Johnson 1985,
         // Contact Mechanics, the Hertz solution): the contact's share of the softening
-        // falls as it is pressed, where every member of (1 + g·F_N)^n, g ≥ 0, grows
+        // falls as it is pressed towards the bulk's constant share, where the falling
+        // members of (1 + g·F_N)^n, n < 0, fall towards zero
         1.0 + p.beta_gain * TRUTH_SOFTENING_REFERENCE_N.powi(2) / d.f_n.max(20.0)
     } else if p.beta_exponent != 1.0 {
         hertz_preload_growth(p.beta_gain, p.beta_exponent, d.f_n)
@@ -147,13 +148,19 @@ pub(crate) fn softening_per_w2(p: &Prepared, d: &Drive) -> f64 {
 /// g·F (as in the candidate); it falls as 1/F_N about it (floored at 20 N).
 const TRUTH_SOFTENING_REFERENCE_N: f64 = 200.0;
 
-/// `hertz_softening`'s preload family: the cubic coefficient grows as (1 + g·F_N)^n [-]. The
-/// Hertzian driving-circuit paper (2022, eq. 2-4) takes the contact's cubic term in
-/// proportion to its load (n = 1); the stiffness of a Hertzian contact itself grows as
-/// F^(1/3) (point) to F^(1/2) and its nonlinear terms faster, so the paper's linear law is
-/// one member of a family whose exponent a bench may show anywhere in [0.5, 3].
+/// `hertz_softening`'s preload family: the cubic coefficient's growth with the preload,
+/// 2·((1 + g·F_N)/2)^n [-]: the candidate's 1 + g·F_N at n = 1, and every member meets it
+/// where g·F_N = 1, so that the exponent changes how the softening varies with the preload
+/// and not how strong it is there (a strength means the same in every form, and the
+/// diagnosis' scan tries each form at the same strengths). The Hertzian driving-circuit
+/// paper (2022, eq. 2-4) takes the contact's cubic term in proportion to its load (n = 1);
+/// the stiffness of a Hertzian contact itself grows as F^(1/3) (point) to F^(1/2) and its
+/// nonlinear terms faster (n up to 3). Expanded about its static compression δ0, a contact
+/// F = c·δ^(3/2) has a cubic term ∝ δ0^(−3/2) ∝ 1/F_N (Johnson 1985, Contact Mechanics,
+/// the Hertz solution): a softening that falls as the contact is pressed, n = −1 where
+/// g·F_N ≫ 1. A bench may show any n in [−1, 3].
 pub(crate) fn hertz_preload_growth(g: f64, n: f64, f_n: f64) -> f64 {
-    (1.0 + g * f_n).max(0.0).powf(n)
+    2.0 * (0.5 * (1.0 + g * f_n)).max(0.0).powf(n)
 }
 
 /// The modal stiffness at amplitude `w` [m] with contact `ct` and force scale `a` [N]: the

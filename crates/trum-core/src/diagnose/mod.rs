@@ -272,7 +272,7 @@ pub fn diagnose(
     let mut fits = Fits::default();
     let mut ranking = candidates::score_singles(&scorer, &mut fits);
 
-    let tests = GapTests { base_nrmse: base.nrmse, gap_noise: base.noise_best };
+    let tests = GapTests { base_nrmse: base.nrmse, gap_noise: base.noise_best, base_z2: base.z2, n_read: ctx.n_read };
     // The gap is real when the baseline misses held-out data beyond twice the noise
     // variance, or when some effect closes a material part of it (a small, consistent gap).
     let gap = base.z2 > 2.0 || ranking.iter().any(|r| tests.material(r));
@@ -287,13 +287,25 @@ pub fn diagnose(
     if gap {
         let best_single = ranking.iter().find(|r| GapTests::supported(r)).cloned();
         let single_closes = best_single.as_ref().is_some_and(|b| tests.closes(b));
-        // Pairs are tried when no single effect closes the gap, and also when one does: it
-        // may close the gap on average yet leave another effect's signature in one quantity
-        // or corner of the data, and that second effect need not be supported on its own
-        // (the first one's gap dominates its single fit). Which second effects are worth a
-        // pair fit is screened by their score test at the lead's fit (`pairs`).
+        // Pairs are tried when no single effect closes the gap, and also when one closes it
+        // by its NRMSE while leaving a gap in σ (held-out mean z² > 2): another effect's
+        // signature in one quantity or corner of the data, and that second effect need not
+        // be supported on its own (the first one's gap dominates its single fit). Which
+        // second effects are worth a pair fit is screened by their score test at the lead's
+        // fit (`pairs`). A single that leaves the held-out data at the noise needs no
+        // partner: the spec names two effects when both are needed to close the gap, and
+        // a second effect fitted there polishes the first one's form, which on a bench
+        // differs from every candidate's (with enough readings any form error is
+        // significant, so no test of the pair's gain can tell the two apart).
+        let single_at_noise = best_single.as_ref().filter(|b| single_closes && b.heldout_chi2_after <= 2.0);
+        if let Some(b) = single_at_noise {
+            notes.push(format!(
+                "no pair of effects tried: {} alone leaves the held-out data at the noise (mean squared normalised residual {:.2}), so a second effect is not needed",
+                b.effect, b.heldout_chi2_after
+            ));
+        }
         let mut best_pair = None;
-        if ctx.opts.try_pairs && ranking.len() >= 2 {
+        if ctx.opts.try_pairs && ranking.len() >= 2 && single_at_noise.is_none() {
             (best_pair, screened_note) =
                 pairs::fit_pairs(&scorer, &mut fits, &mut ranking, &best_single, single_closes);
         }

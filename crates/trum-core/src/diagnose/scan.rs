@@ -166,39 +166,64 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
             .flat_map(|(b, base)| points.iter().filter(|p| !p.2).map(move |(f, v, _)| (b, base, *f, v.clone())))
             .collect(),
     );
-    // then each held shape's levels at the strengths within one grid step of the plain
-    // forms' best from that base (a form changes how strong the effect must be by about
-    // a step; the whole grid for every level cost a null diagnosis a quarter more time)
+    // then each held shape's levels: at every other strength of the grid and at those
+    // within one grid step of the plain forms' best from that base, then at the neighbours
+    // of each level's own best. A form can change how strong the effect must be by about
+    // a step, or by decades where it changes how the effect scales with the operating
+    // point (a softening that falls with the preload needs its preload gain an order of
+    // magnitude above the growing form's); the whole grid for every level cost a null
+    // diagnosis a quarter more time.
     let grid_factors = factors(e);
-    let near: Vec<Vec<f64>> = (0..bases.len())
+    let index = |f: f64| grid_factors.iter().position(|&g| g == f).unwrap_or(0);
+    let near: Vec<Vec<usize>> = (0..bases.len())
         .map(|b| {
             let best = scored.iter().filter(|p| p.0 == b).min_by(|x, y| x.3.total_cmp(&y.3)).map(|p| p.1);
-            let k = best.and_then(|f| grid_factors.iter().position(|&g| g == f)).unwrap_or(0);
-            grid_factors[k.saturating_sub(1)..(k + 2).min(grid_factors.len())].to_vec()
+            let k = best.map_or(0, index);
+            (k.saturating_sub(1)..(k + 2).min(grid_factors.len())).collect()
         })
         .collect();
+    let first_pass = |b: usize, f: f64| index(f) % 2 == 0 || near[b].contains(&index(f));
     scored.extend(score(
         bases
             .iter()
             .enumerate()
             .flat_map(|(b, base)| {
-                let near = &near[b];
-                points.iter().filter(move |p| p.2 && near.contains(&p.0)).map(move |(f, v, _)| (b, base, *f, v.clone()))
+                points.iter().filter(move |p| p.2 && first_pass(b, p.0)).map(move |(f, v, _)| (b, base, *f, v.clone()))
             })
             .collect(),
     ));
+    let shape_of = |v: &[f64]| -> Vec<u64> {
+        e.info().params.iter().zip(v).filter(|(q, _)| q.shape).map(|(_, x)| x.to_bits()).collect()
+    };
+    let mut refine: Vec<(usize, &&Motor, f64, Vec<f64>)> = Vec::new();
+    for (b, base) in bases.iter().enumerate() {
+        for (f, v, _) in points.iter().filter(|p| p.2 && !first_pass(b, p.0)) {
+            // the level's best so far, from this base
+            let key = shape_of(v);
+            let best = scored
+                .iter()
+                .filter(|p| p.0 == b && shape_of(&p.2) == key)
+                .min_by(|x, y| x.3.total_cmp(&y.3))
+                .map(|p| index(p.1));
+            if best.is_some_and(|k| index(*f).abs_diff(k) == 1) {
+                refine.push((b, base, *f, v.clone()));
+            }
+        }
+    }
+    scored.extend(score(refine));
     let mut found: Vec<Valley> = Vec::new();
     for (b, base) in bases.iter().enumerate() {
         // one series per shape set: the values with the same shape parameters
         let mut series: Vec<Vec<&Scored>> = Vec::new();
         for p in scored.iter().filter(|p| p.0 == b) {
-            let shape_of = |v: &[f64]| -> Vec<u64> {
-                e.info().params.iter().zip(v).filter(|(q, _)| q.shape).map(|(_, x)| x.to_bits()).collect()
-            };
             match series.iter_mut().find(|s| shape_of(&s[0].2) == shape_of(&p.2)) {
                 Some(s) => s.push(p),
                 None => series.push(vec![p]),
             }
+        }
+        // each series by strength (a held level's refinement was scored after its first pass)
+        for s in &mut series {
+            s.sort_by(|x, y| x.1.total_cmp(&y.1));
         }
         // (within the fit's bounds: every form scanned from this base, as a held shape's
         // short series may have no strength of its own there)
@@ -314,7 +339,7 @@ mod tests {
     fn the_grid_tries_each_held_shape_at_its_levels() {
         let count = |e: Effect, knee: &[f64]| grid(e, knee).len() / factors(e).len();
         assert_eq!(count(Effect::RadialFriction, &[]), 3);
-        assert_eq!(count(Effect::HertzSoftening, &[]), 4);
+        assert_eq!(count(Effect::HertzSoftening, &[]), 5);
         assert_eq!(count(Effect::ThermalDrift, &[]), 3);
         assert_eq!(count(Effect::Eccentricity, &[]), 5);
         assert_eq!(count(Effect::TangentialCompliance, &[]), 3);

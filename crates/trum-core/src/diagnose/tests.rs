@@ -645,6 +645,29 @@ fn a_current_limited_driver_is_diagnosed_as_voltage_sag() {
     }
 }
 
+/// A single effect that leaves the held-out data at the noise needs no partner: with
+/// pairs allowed, the current-limited driver's data are `voltage_sag` alone, no pair is
+/// fitted, and a note says why (a second effect there would only polish the first one's
+/// form).
+#[test]
+fn a_single_at_the_noise_is_given_no_partner() {
+    let nominal = crate::calibrate::tests::reference_motor();
+    let mut truth = nominal.clone();
+    truth.effects.set(Effect::VoltageSag, &[300.0, 0.0]);
+    let (rows, groups) = data(&truth, 1.0, 13);
+    let opts = DiagnoseOptions {
+        candidates: vec![Effect::VoltageSag, Effect::RadialFriction, Effect::PreloadStiffening],
+        try_pairs: true,
+        ..quick(false)
+    };
+    let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+    let sag = d.ranking.iter().find(|r| r.effect == "voltage_sag").expect("ranked");
+    assert_eq!(d.verdict, "voltage_sag");
+    assert!(d.complete && sag.heldout_chi2_after <= 2.0, "{sag:?}");
+    assert!(d.ranking.iter().all(|r| !r.effect.contains('+')), "{:?}", d.ranking);
+    assert!(d.notes.iter().any(|n| n.starts_with("no pair of effects tried: voltage_sag alone")), "{:?}", d.notes);
+}
+
 /// A stator temperature sensor that reads 1.5 K high (a thermocouple within its class-1
 /// tolerance) is a bench nuisance, not a gap: a warm-up of the reference motor with nothing
 /// else added is diagnosed `none`, and the fitted offset comes back within 0.4 K. Without the

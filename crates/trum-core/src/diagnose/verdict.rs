@@ -4,7 +4,7 @@
 use super::candidates::bootstrap_shrink;
 use super::context::Context;
 use super::folds::errors;
-use super::pairs::{pair_gains, rounded, PAIR_GAIN};
+use super::pairs::{chi2_excess, pair_gains, rounded, PAIR_GAIN};
 use super::{same_set, signature, RankEntry};
 use crate::effects::Effect;
 use std::collections::BTreeMap;
@@ -23,6 +23,10 @@ pub(super) struct GapTests {
     /// level the same test let a 1.4 % shrink close (a review's `thermal_drift` on
     /// `voltage_sag` data, χ² 8.1 left), so no switch between the two levels will do.
     pub(super) gap_noise: f64,
+    /// The baseline's held-out mean z² (each reading's clipped at `OUTLIER_Z2`).
+    pub(super) base_z2: f64,
+    /// The readings the held-out figures are over.
+    pub(super) n_read: usize,
 }
 
 impl GapTests {
@@ -52,10 +56,26 @@ impl GapTests {
         }
     }
 
-    /// A material part of the gap: a fifth of the held-out NRMSE or a quarter of its part
-    /// beyond the noise (with the supported test's bootstrap bound above zero).
+    /// The fraction of the held-out mean z²'s excess over the noise an entry closes, on the
+    /// root scale of the NRMSE's (√(z² − 1), [`chi2_excess`]); 0 where the baseline's z² is
+    /// at most 2 (no gap beyond the noise in σ to close).
+    pub(super) fn z2_excess_shrink(&self, r: &RankEntry) -> f64 {
+        let before = chi2_excess(self.base_z2, self.n_read);
+        if self.base_z2 > 2.0 && before > 0.0 {
+            1.0 - chi2_excess(r.heldout_chi2_after, self.n_read) / before
+        } else {
+            0.0
+        }
+    }
+
+    /// A material part of the gap: a fifth of the held-out NRMSE, or a quarter of its part
+    /// beyond the noise, or a quarter of the held-out z²'s part beyond the noise where that
+    /// is a gap (z² > 2) (with the supported test's bootstrap bound above zero). The NRMSE
+    /// weighs each quantity by its spread, so a quantity that no model moves (a speed
+    /// spread at its instrument floor, a temperature that barely rises) can be most of it
+    /// and hide what an effect closes on the others; z² weighs every reading by its noise.
     pub(super) fn material(&self, r: &RankEntry) -> bool {
-        Self::supported(r) && (r.shrink >= 0.2 || self.excess_shrink(r) >= 0.25)
+        Self::supported(r) && (r.shrink >= 0.2 || self.excess_shrink(r) >= 0.25 || self.z2_excess_shrink(r) >= 0.25)
     }
 
     /// An entry closes the gap when it removes a material part of it and what it leaves is
@@ -256,7 +276,12 @@ mod tests {
         let motor = crate::calibrate::tests::reference_motor();
         let (rows, groups) = data(&motor, 1.0, 3);
         let ctx = Context::new(&motor, &rows, &groups, &quick(false)).unwrap();
-        let tests = GapTests { base_nrmse: 0.4, gap_noise: 0.05 };
+        let tests = GapTests {
+            base_nrmse: 0.4,
+            gap_noise: 0.05,
+            base_z2: 1.0,
+            n_read: rows.iter().map(|r| r.readings.len()).sum(),
+        };
         let none = BTreeMap::new();
         let decide_on = |ranking: &mut [RankEntry], closes: bool| {
             let best = ranking.iter().find(|r| GapTests::supported(r)).cloned();
@@ -320,5 +345,32 @@ mod tests {
         assert!(!GapTests::supported(&weak));
         let v = decide_on(&mut [weak], false);
         assert_eq!((v.verdict.as_str(), v.partial), ("unexplained", None));
+    }
+
+    /// An entry that takes most of the held-out z² beyond the noise closes a material part
+    /// of the gap however little of the NRMSE it moves (a quantity no model moves can be
+    /// most of the NRMSE); where the baseline's z² shows no gap (≤ 2), z² alone makes
+    /// nothing material.
+    #[test]
+    fn a_gap_closed_in_sigma_is_material_whatever_the_nrmse() {
+        let n_read = 600;
+        let tests = GapTests { base_nrmse: 0.168, gap_noise: 0.09, base_z2: 3.33, n_read };
+        // a tenth of the NRMSE, three quarters of the z² excess (2.33 → 0.59)
+        let drift = RankEntry { shrink_interval: (0.05, 0.2), ..ranked("thermal_drift", 1.59, 0.152) };
+        let drift = RankEntry { shrink: 0.096, evidence: 2176.0, ..drift };
+        assert!(drift.shrink < 0.2 && tests.excess_shrink(&drift) < 0.25);
+        assert!((tests.z2_excess_shrink(&drift) - (1.0 - (0.59f64 / 2.33).sqrt())).abs() < 1e-9);
+        assert!(tests.material(&drift) && tests.closes(&drift));
+        // a fifth of the z² excess is not enough
+        let sliver = RankEntry { heldout_chi2_after: 1.0 + 2.33 * 0.8 * 0.8, ..drift.clone() };
+        assert!(!tests.material(&sliver));
+        // no gap in σ to close: z² alone makes nothing material
+        let quiet = GapTests { base_z2: 1.8, ..tests };
+        let polish = RankEntry { heldout_chi2_after: 1.05, ..drift.clone() };
+        assert_eq!(quiet.z2_excess_shrink(&polish), 0.0);
+        assert!(!quiet.material(&polish));
+        // unsupported entries are never material
+        let unsupported = RankEntry { shrink_interval: (-0.01, 0.2), ..drift };
+        assert!(!tests.material(&unsupported));
     }
 }
