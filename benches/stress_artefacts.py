@@ -5,7 +5,7 @@ diagnosis makes of them (docs/DIAGNOSIS.md, "Bench-artefact stress set").
 Each case is a `trum synth` file of the frozen reference motor (tests/data/motors/ring60.toml,
 every parameter perturbed as in the blind benchmark) that this script then alters as a
 bench would: gains of the speed, torque, power or feedback readings, read-back noise of
-the preload or the frequency, a quantised torque, an offset of the temperature sensor,
+the preload or the frequency, a quantised torque, an offset or a lag of the temperature sensor,
 heavy-tailed speed noise, cells left empty, noise three times the nominal. Null cases
 must come out `none`; effect cases (each effect at about twice its typical strength in
 its first truth form, with two artefacts drawn at random and the development half's own)
@@ -81,6 +81,35 @@ ARTEFACTS = {
     "missing": missing,
 }
 
+def sensor_lag(tau_s):
+    """A first-order temperature sensor with time constant `tau_s` [s], run within each run
+    over the recorded temperatures in time order, each interval taken as a straight line
+    (the exact response to a first-order hold): the sensor starts at the first reading."""
+
+    def apply(rows, rng):
+        runs = {}
+        for row in rows:
+            if row.get("temperature_c", "") != "" and row.get("elapsed_s", "") != "":
+                runs.setdefault(row.get("run_id", ""), []).append(row)
+        for run in runs.values():
+            run.sort(key=lambda r: float(r["elapsed_s"]))
+            t0, x0 = float(run[0]["elapsed_s"]), float(run[0]["temperature_c"])
+            y = x0
+            for row in run[1:]:
+                t, x = float(row["elapsed_s"]), float(row["temperature_c"])
+                dt = t - t0
+                if dt > 0:
+                    m = (x - x0) / dt
+                    y = x - tau_s * m + (y - x0 + tau_s * m) * math.exp(-dt / tau_s)
+                t0, x0 = t, x
+                row["temperature_c"] = repr(y)
+
+    return apply
+
+
+# artefacts of the null cases only (the effect cases draw theirs from ARTEFACTS)
+NULL_ONLY = {"temp_lag": sensor_lag(30.0)}
+
 EFFECTS = {
     "radial_friction": "radial_friction=2",
     "preload_stiffening": "preload_stiffening=0.1",
@@ -105,6 +134,8 @@ def cases():
     out.append(("null_noise3_combined", "none", [], "combined", 7202, None, 3, []))
     out.append(("null_freq_sweep_gain", "none", ["feedback_gain", "freq_readback"], "frequency-sweep", 7203, None, 1, []))
     out.append(("null_warm_up_temp_offset", "none", ["temp_offset"], "warm-up", 7204, None, 1, []))
+    out.append(("null_warm_up_temp_lag", "none", ["temp_lag"], "warm-up", 7205, None, 1, []))
+    out.append(("null_combined_temp_lag", "none", ["temp_lag"], "combined", 7206, None, 1, []))
     rng = random.Random(11)
     seed = 8100
     for effect, arg in EFFECTS.items():
@@ -127,7 +158,7 @@ def run(case, work):
         rows = list(csv.DictReader(f))
     rng = random.Random(seed)
     for art in arts:
-        ARTEFACTS[art](rows, rng)
+        {**ARTEFACTS, **NULL_ONLY}[art](rows, rng)
     with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, list(rows[0].keys()))
         w.writeheader()

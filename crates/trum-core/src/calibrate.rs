@@ -38,6 +38,8 @@ pub enum InstrumentParam {
     TorqueOffsetNm,
     /// [`crate::effects::Instrument::temperature_offset_k`].
     TemperatureOffsetK,
+    /// [`crate::effects::Instrument::temperature_lag_s`].
+    TemperatureLagS,
 }
 
 impl ParamRef {
@@ -49,6 +51,7 @@ impl ParamRef {
             ParamRef::Instrument(InstrumentParam::SpeedStdFloorRpm) => "bench.speed_std_floor_rpm".into(),
             ParamRef::Instrument(InstrumentParam::TorqueOffsetNm) => "bench.torque_offset_nm".into(),
             ParamRef::Instrument(InstrumentParam::TemperatureOffsetK) => "bench.temperature_offset_k".into(),
+            ParamRef::Instrument(InstrumentParam::TemperatureLagS) => "bench.temperature_lag_s".into(),
         }
     }
 
@@ -59,6 +62,17 @@ impl ParamRef {
             ParamRef::Instrument(InstrumentParam::SpeedStdFloorRpm) => m.effects.instrument().speed_std_floor_rpm,
             ParamRef::Instrument(InstrumentParam::TorqueOffsetNm) => m.effects.instrument().torque_offset_nm,
             ParamRef::Instrument(InstrumentParam::TemperatureOffsetK) => m.effects.instrument().temperature_offset_k,
+            // a sensor without a stated lag starts the fit at the prior's centre (a lag
+            // of 1 s moves no reading taken seconds apart; at zero it would sit below the
+            // logarithmic range)
+            ParamRef::Instrument(InstrumentParam::TemperatureLagS) => {
+                let v = m.effects.instrument().temperature_lag_s;
+                if v > 0.0 {
+                    v
+                } else {
+                    TEMPERATURE_LAG_CENTRE_S
+                }
+            }
         }
     }
 
@@ -77,6 +91,7 @@ impl ParamRef {
             ParamRef::Instrument(InstrumentParam::TemperatureOffsetK) => {
                 m.effects.instrument_mut().temperature_offset_k = v
             }
+            ParamRef::Instrument(InstrumentParam::TemperatureLagS) => m.effects.instrument_mut().temperature_lag_s = v,
         }
     }
 }
@@ -223,6 +238,9 @@ pub fn baseline_params_with(
     if let Some(fp) = temperature_offset_param(rows, overrides) {
         out.push(fp);
     }
+    if let Some(fp) = temperature_lag_param(rows, overrides) {
+        out.push(fp);
+    }
     out.extend(own_effect_params(motor));
     out
 }
@@ -330,6 +348,49 @@ fn temperature_offset_param(
         hi: half,
         log: false,
         prior: sd.is_finite().then_some(Prior { centre: 0.0, sd }),
+    })
+}
+
+/// Centre of the temperature sensor's lag prior [s]: a sensor bonded to the stator through
+/// its sheath and the bond answers in about a second to tens of seconds.
+pub const TEMPERATURE_LAG_CENTRE_S: f64 = 1.0;
+
+/// Default prior standard deviation of the logarithm of the temperature sensor's lag: a
+/// factor of e² ≈ 7.4 at one σ, so 0.14-7.4 s within one σ and up to 55 s within two.
+pub const TEMPERATURE_LAG_LN_SD: f64 = 2.0;
+
+/// The temperature sensor's lag (a bench nuisance), where the stator temperature is read at
+/// least three times in a warm-up (rows with `elapsed_s` > 0): a log-normal prior centred
+/// on [`TEMPERATURE_LAG_CENTRE_S`] with [`TEMPERATURE_LAG_LN_SD`], bounded at 0.1-120 s (a
+/// lag longer than two minutes is a sensor not bonded to the stator, beyond this model). A
+/// tolerance in the motor file's `[tolerances]` under `bench.temperature_lag_s` replaces the
+/// prior's width (the standard deviation of its logarithm, as for the motor's parameters);
+/// 0 holds the lag at zero, `inf` fits it without a prior. The lag moves the readings only:
+/// effects that follow the temperature see the stator's.
+fn temperature_lag_param(
+    rows: &[ObservedRow],
+    overrides: &std::collections::BTreeMap<String, f64>,
+) -> Option<FitParam> {
+    let key = "bench.temperature_lag_s";
+    let n = rows
+        .iter()
+        .filter(|r| r.op.elapsed_s > 0.0)
+        .flat_map(|r| &r.readings)
+        .filter(|x| x.0 == Observable::TemperatureC)
+        .count();
+    if n < 3 {
+        return None;
+    }
+    let sd = overrides.get(key).copied().unwrap_or(TEMPERATURE_LAG_LN_SD);
+    if sd.is_nan() || sd <= 0.0 {
+        return None;
+    }
+    Some(FitParam {
+        param: ParamRef::Instrument(InstrumentParam::TemperatureLagS),
+        lo: 0.1,
+        hi: 120.0,
+        log: true,
+        prior: sd.is_finite().then_some(Prior { centre: TEMPERATURE_LAG_CENTRE_S.ln(), sd }),
     })
 }
 
@@ -529,7 +590,18 @@ pub fn residuals(motor: &Motor, rows: &[ObservedRow]) -> Vec<f64> {
 /// The expected reading of `o` in row `r` for the solution `s` of its point, through the
 /// bench's instruments `inst`.
 pub(crate) fn expected(o: Observable, r: &ObservedRow, s: &Solution, inst: &Instrument, sigma: f64) -> f64 {
-    o.expected_reading(r, inst.reading(o, o.predict(s, r.ambient_c)), sigma)
+    let model = if o == Observable::TemperatureC && inst.temperature_lag_s > 0.0 {
+        r.ambient_c
+            + crate::thermal::sensor_rise_k(
+                s.temperature_rise_k,
+                s.temperature_rise_at_elapsed_k,
+                r.op.elapsed_s,
+                inst.temperature_lag_s,
+            )
+    } else {
+        o.predict(s, r.ambient_c)
+    };
+    o.expected_reading(r, inst.reading(o, model), sigma)
 }
 
 /// The normalised residuals of one row's readings for the solution `s` of its point.

@@ -444,6 +444,9 @@ pub struct Instrument {
     /// tolerance, IEC 60584-1), which on a warm-up of a few kelvin is a gap far beyond a
     /// reading's noise.
     pub temperature_offset_k: f64,
+    /// Time constant of the stator temperature sensor [s]: a first-order sensor lags the
+    /// stator's warm-up ([`crate::thermal::sensor_rise_k`]). 0: it follows at once.
+    pub temperature_lag_s: f64,
 }
 
 impl Instrument {

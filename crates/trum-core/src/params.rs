@@ -287,7 +287,9 @@ pub fn plausible_from_toml_str(
 /// ([`crate::tolerances::TOLERANCES`], docs/DIAGNOSIS.md); the bench's speed-std floor is
 /// `bench.speed_std_floor_rpm` (0: the bench has none), the torque transducer's zero offset
 /// `bench.torque_offset_nm` (the prior's standard deviation in N·m; 0: no offset), the
-/// temperature reading's offset `bench.temperature_offset_k` (in K; 0: no offset). Empty
+/// temperature reading's offset `bench.temperature_offset_k` (in K; 0: no offset), the
+/// temperature sensor's lag `bench.temperature_lag_s` (the standard deviation of its
+/// logarithm; 0: no lag). Empty
 /// without a table; errors name
 /// the file, line and key.
 pub fn tolerances_from_toml_str(
@@ -335,12 +337,21 @@ pub fn tolerances_from_toml_str(
 
 /// The keys a `[tolerances]` table accepts: the parameters calibration fits
 /// ([`crate::tolerances::TOLERANCES`]) by dotted motor key, then the bench's
-/// `bench.speed_std_floor_rpm`, `bench.torque_offset_nm` and `bench.temperature_offset_k`.
+/// `bench.speed_std_floor_rpm`, `bench.torque_offset_nm`, `bench.temperature_offset_k` and
+/// `bench.temperature_lag_s`.
 pub fn tolerance_keys() -> Vec<String> {
     crate::tolerances::TOLERANCES
         .iter()
         .map(|t| t.key.to_string())
-        .chain(["bench.speed_std_floor_rpm", "bench.torque_offset_nm", "bench.temperature_offset_k"].map(String::from))
+        .chain(
+            [
+                "bench.speed_std_floor_rpm",
+                "bench.torque_offset_nm",
+                "bench.temperature_offset_k",
+                "bench.temperature_lag_s",
+            ]
+            .map(String::from),
+        )
         .collect()
 }
 

@@ -105,19 +105,23 @@ pub struct Artefacts {
     /// Offset of the stator temperature sensor [K]: it reads the stator's temperature
     /// plus this.
     pub temperature_offset_k: f64,
+    /// Time constant of the stator temperature sensor [s]: a first-order sensor lags the
+    /// warm-up ([`crate::thermal::sensor_rise_k`]).
+    pub temperature_lag_s: f64,
     /// Fraction of readings replaced by gross outliers (a reading off by 5-15 of its σ).
     pub outlier_fraction: f64,
 }
 
 impl Artefacts {
     /// Names of the artefacts as written in `name=value` lists.
-    pub const NAMES: [&'static str; 6] = [
+    pub const NAMES: [&'static str; 7] = [
         "readback_rel",
         "speed_std_floor_rpm",
         "torque_offset_nm",
         "speed_quantum_rpm",
         "outlier_fraction",
         "temperature_offset_k",
+        "temperature_lag_s",
     ];
 
     /// Parses `name=value,...` (e.g. `readback_rel=0.005,speed_std_floor_rpm=0.3`); the
@@ -142,6 +146,7 @@ impl Artefacts {
                 "speed_quantum_rpm" => &mut a.speed_quantum_rpm,
                 "outlier_fraction" => &mut a.outlier_fraction,
                 "temperature_offset_k" => &mut a.temperature_offset_k,
+                "temperature_lag_s" => &mut a.temperature_lag_s,
                 other => {
                     return Err(TrumError::input(format!(
                         "unknown bench artefact '{other}'; valid names are: {}",
@@ -160,6 +165,9 @@ impl Artefacts {
         }
         if !(0.0..0.5).contains(&a.outlier_fraction) {
             return bad("outlier_fraction", "must be in [0, 0.5)");
+        }
+        if a.temperature_lag_s < 0.0 {
+            return bad("temperature_lag_s", "must be >= 0");
         }
         Ok(a)
     }
@@ -376,6 +384,15 @@ pub fn synthesize(motor: &Motor, cfg: &SynthConfig) -> Result<Vec<SynthRow>, Tru
                         v = v.hypot(art.speed_std_floor_rpm);
                     }
                     if o == Observable::TemperatureC {
+                        if art.temperature_lag_s > 0.0 {
+                            v = ambient
+                                + crate::thermal::sensor_rise_k(
+                                    s.temperature_rise_k,
+                                    s.temperature_rise_at_elapsed_k,
+                                    op.elapsed_s,
+                                    art.temperature_lag_s,
+                                );
+                        }
                         v += art.temperature_offset_k;
                     }
                     let mut x = v + noise.gauss(reading_noise(o, v));

@@ -35,6 +35,32 @@ pub fn temperature_rise_piecewise_k(
         .collect()
 }
 
+/// The rise a first-order temperature sensor of time constant `lag_s` [s] shows at
+/// `elapsed_s` [s] of a warm-up whose stator rise is `rise_at_elapsed_k` there and tends to
+/// `rise_ss_k` [K]. The stator follows the lumped model of Chen et al. 2020 (eq. 11),
+/// rise_ss·(1 − e^(−t/τ)), whose τ the two rises give (τ = −t/ln(1 − rise_t/rise_ss)); the
+/// sensor obeys τ_s·dT_s/dt = T − T_s from the ambient, so it reads
+/// rise_ss·[1 − (τ·e^(−t/τ) − τ_s·e^(−t/τ_s))/(τ − τ_s)] (the limit (1 + t/τ)·e^(−t/τ) in
+/// the bracket's second term where τ_s = τ). A thermocouple or resistance thermometer
+/// bonded to a stator responds in seconds to tens of seconds through its sheath and the
+/// bond. Without a lag, at the start, at steady state or where the rise is not a warming
+/// (rise_t ≤ 0, rise_ss ≤ 0), the stator's rise itself. Valid for a run at one operating
+/// point from the ambient; where the model's rise is not one exponential (`thermal_drift`
+/// with a fast interface node) τ is the one that matches the rise at `elapsed_s`.
+pub fn sensor_rise_k(rise_ss_k: f64, rise_at_elapsed_k: f64, elapsed_s: f64, lag_s: f64) -> f64 {
+    let phi = rise_at_elapsed_k / rise_ss_k;
+    if !(lag_s > 0.0 && elapsed_s > 0.0 && rise_ss_k > 0.0 && phi > 0.0 && phi < 1.0) {
+        return rise_at_elapsed_k;
+    }
+    // a = t/τ, b = t/τ_s, r = τ_s/τ
+    let a = -(-phi).ln_1p();
+    let b = elapsed_s / lag_s;
+    let r = a / b;
+    let lagging =
+        if (1.0 - r).abs() < 1e-6 { (1.0 + a) * (-a).exp() } else { ((-a).exp() - r * (-b).exp()) / (1.0 - r) };
+    rise_ss_k * (1.0 - lagging)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -57,5 +83,38 @@ mod tests {
             t += dt * (p - a * t) / c;
         }
         assert!((t - pw[49]).abs() < 1e-3 * pw[49]);
+    }
+
+    /// The lagged sensor against its own ODE integrated through the lumped warm-up (RK4,
+    /// 1 ms steps), at lags below, at and above the stator's time constant; the limits
+    /// (no lag, the start, steady state) are the stator's rise itself.
+    #[test]
+    fn a_lagged_sensor_follows_its_ode() {
+        let (p, a, c) = (8.0, 0.2366, 60.0);
+        let tau = time_constant_s(a, c);
+        let rise = |t: f64| temperature_rise_k(p, a, c, t);
+        let ss = p / a;
+        for lag in [3.0, 30.0, tau, 400.0] {
+            let (mut y, h) = (0.0f64, 1e-3);
+            let f = |t: f64, y: f64| (rise(t) - y) / lag;
+            let mut t = 0.0;
+            for k in 1..=300_000 {
+                let k1 = f(t, y);
+                let k2 = f(t + 0.5 * h, y + 0.5 * h * k1);
+                let k3 = f(t + 0.5 * h, y + 0.5 * h * k2);
+                let k4 = f(t + h, y + h * k3);
+                y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+                t = k as f64 * h;
+                if k % 50_000 == 0 {
+                    let s = sensor_rise_k(ss, rise(t), t, lag);
+                    assert!((s - y).abs() < 1e-9 * ss, "lag {lag}, t {t}: {s} vs {y}");
+                    assert!(s < rise(t), "a lagging sensor reads low while warming");
+                }
+            }
+        }
+        assert_eq!(sensor_rise_k(ss, rise(50.0), 50.0, 0.0), rise(50.0));
+        assert_eq!(sensor_rise_k(ss, 0.0, 0.0, 30.0), 0.0);
+        assert_eq!(sensor_rise_k(ss, ss, 1e9, 30.0), ss);
+        assert_eq!(sensor_rise_k(0.0, 0.0, 50.0, 30.0), 0.0);
     }
 }
