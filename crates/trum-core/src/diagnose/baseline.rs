@@ -40,15 +40,49 @@ pub(super) fn bic(chi2: f64, kpar: usize, n_read: usize) -> f64 {
 
 /// Calibrates the baseline on all rows of `ctx` and predicts each fold's block held out.
 pub(super) fn fit(ctx: &Context) -> Result<Baseline, TrumError> {
-    let (motor, rows, opts, reduced, sc) = (ctx.motor, &ctx.rows[..], &ctx.opts, ctx.reduced, &ctx.sc);
-    let (folds, k, est) = (&ctx.folds[..], ctx.k, &ctx.est);
-    // full-data baseline fit (the start of every other fit; "where", BIC, reported parameters)
-    let (start0, bparams) = fit_params(motor, motor, rows, &[], reduced, &opts.tolerances);
+    let base_cal = calibrate(ctx, ctx.motor)?;
+    with_held_out(ctx, base_cal)
+}
+
+/// The baseline calibrated on all rows of `ctx` from the baseline parameters of `from` (the
+/// nominal motor, or a better start found by the candidates' fits, `better_start`).
+pub(super) fn calibrate(ctx: &Context, from: &Motor) -> Result<Calibration, TrumError> {
+    let (motor, rows, opts, reduced) = (ctx.motor, &ctx.rows[..], &ctx.opts, ctx.reduced);
+    let (start0, bparams) = fit_params(motor, from, rows, &[], reduced, &opts.tolerances);
     // A baseline that ends with a parameter on a bound is refitted from its own end
     // (`Calibrate::refit_bounds`). (1000-row benchmark, seeds 31-38: every single fit,
     // started from the baseline left on the damping bound, first refitted the baseline
     // whatever its effect.)
-    let base_cal = Calibration::builder(&start0, rows).params(&bparams).options(&opts.fit).refit_bounds(true).run()?;
+    Calibration::builder(&start0, rows).params(&bparams).options(&opts.fit).refit_bounds(true).run()
+}
+
+/// A start for the baseline that the candidates' fits found: the fit of the candidate with
+/// the most evidence, its effect taken out, when its data χ² is below the calibrated
+/// baseline's by more than 2 — the baseline is the model of every candidate at zero
+/// strength, so a lower χ² there means the baseline's own fit stopped in a valley of its
+/// parameters and every candidate's evidence measures that valley, not its effect (seen
+/// where half the readings are of a stalled rotor: every candidate gained ½ΔBIC ≈ 100
+/// with no held-out shrink). `None` when there is none.
+pub(super) fn better_start(ctx: &Context, base: &Baseline, fits: &BTreeMap<String, Calibration>) -> Option<Motor> {
+    let chi2 = |m: &Motor| crate::calibrate::residuals(m, &ctx.rows).iter().map(|z| z * z).sum::<f64>();
+    let base_chi2 = chi2(&base.cal.motor);
+    fits.iter()
+        .filter_map(|(name, c)| {
+            let e = crate::effects::Effect::from_name(name).ok()?;
+            let mut m = c.motor.clone();
+            m.effects.clear(e);
+            let x = chi2(&m);
+            (x.is_finite() && x < base_chi2 - 2.0).then_some((x, m))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, m)| m)
+}
+
+/// The baseline `base_cal` with its held-out predictions, errors, evidence and noise level.
+pub(super) fn with_held_out(ctx: &Context, base_cal: Calibration) -> Result<Baseline, TrumError> {
+    let (motor, rows, opts, reduced, sc) = (ctx.motor, &ctx.rows[..], &ctx.opts, ctx.reduced, &ctx.sc);
+    let (folds, k, est) = (&ctx.folds[..], ctx.k, &ctx.est);
+    let n_params = fit_params(motor, motor, rows, &[], reduced, &opts.tolerances).1.len();
     let start = base_cal.motor.clone();
     let base_cv = if opts.exact_cv {
         cross_validate(motor, &start, rows, folds, k, &[], opts, reduced)
@@ -72,7 +106,7 @@ pub(super) fn fit(ctx: &Context) -> Result<Baseline, TrumError> {
         noise_nrmse_best(rows, est, &best, &predict(&base_cal.motor, &refs), sc)
     };
     Ok(Baseline {
-        bic: bic(base_cal.chi2, bparams.len(), ctx.n_read),
+        bic: bic(base_cal.chi2, n_params, ctx.n_read),
         start,
         cv: base_cv,
         nrmse: base_nrmse,

@@ -168,10 +168,10 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
     );
     // then each held shape's levels: at every other strength of the grid and at those
     // within one grid step of the plain forms' best from that base, then at the neighbours
-    // of each level's own best. A form can change how strong the effect must be by about
-    // a step, or by decades where it changes how the effect scales with the operating
-    // point (a softening that falls with the preload needs its preload gain an order of
-    // magnitude above the growing form's); the whole grid for every level cost a null
+    // of each level's own best. A form can change how strong the effect must be by more
+    // than a step, most where it changes how the effect scales with the operating point
+    // (a softening that falls with the preload against one that grows), so its best need
+    // not lie next to the plain form's; the whole grid for every level cost a null
     // diagnosis a quarter more time.
     let grid_factors = factors(e);
     let index = |f: f64| grid_factors.iter().position(|&g| g == f).unwrap_or(0);

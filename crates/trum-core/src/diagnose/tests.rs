@@ -675,6 +675,35 @@ fn a_lagging_temperature_sensor_is_the_benchs_not_a_gap() {
     assert_ne!(d.verdict, "none");
 }
 
+/// A strong `radial_friction` stalls the rotor at half the preloads of a speed-stability
+/// run: the baseline's calibration from the nominal motor stops in a valley of its own
+/// parameters, and every candidate's fit (refitting those parameters from other starts)
+/// gains ½ΔBIC ≈ 100 over it with no held-out shrink, so that the one candidate with a
+/// little shrink, `eccentricity`, was named. The baseline is every candidate at zero
+/// strength: it is refitted from the best candidate fit with its effect taken out, the
+/// spurious evidence goes, and no wrong effect is named.
+#[test]
+fn a_baseline_stuck_in_its_own_valley_is_refitted_from_a_candidates_fit() {
+    let nominal = crate::calibrate::tests::reference_motor();
+    let mut truth = nominal.clone();
+    truth.effects.set_strength(Effect::RadialFriction, 2.0);
+    let cfg = SynthConfig {
+        campaign: Campaign::Stability,
+        noise: 1.0,
+        seed: 95,
+        artefacts: crate::synth::Artefacts { readback_rel: 0.004, speed_std_floor_rpm: 0.3, ..Default::default() },
+        ..SynthConfig::default()
+    };
+    let (rows, groups) = synthesized(&truth, &cfg);
+    let opts = DiagnoseOptions { bootstrap: 50, ..DiagnoseOptions::default() };
+    let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+    assert!(d.notes.iter().any(|n| n.starts_with("the baseline was refitted from a candidate's fit")), "{:?}", d.notes);
+    assert!(d.verdict == "radial_friction" || d.verdict == "unexplained", "{} {:?}", d.verdict, d.ranking);
+    assert_eq!(d.ranking[0].effect, "radial_friction", "{:?}", d.ranking);
+    // no candidate keeps the valley's evidence
+    assert!(d.ranking.iter().all(|r| r.evidence < 20.0), "{:?}", d.ranking);
+}
+
 /// A single effect that leaves the held-out data at the noise needs no partner: with
 /// pairs allowed, the current-limited driver's data are `voltage_sag` alone, no pair is
 /// fitted, and a note says why (a second effect there would only polish the first one's
