@@ -44,6 +44,7 @@ mod tests {
             heldout_chi2_after: 4.0,
             shrink: 0.35,
             shrink_interval: (0.2, 0.5),
+            z2_shrink_interval: (0.2, 0.5),
             params: vec![],
             signature_match: None,
             linear_chi2_drop: None,

@@ -25,6 +25,8 @@ pub(super) struct Baseline {
     pub(super) z2: f64,
     /// Per held-out reading: squared residual over the quantity's scale.
     pub(super) e2: Vec<f64>,
+    /// Per held-out reading: squared normalised residual, clipped at `OUTLIER_Z2`.
+    pub(super) z2s: Vec<f64>,
     /// Held-out NRMSE that noise alone gives, with the best noise levels
     /// ([`noise_nrmse_best`]; the reported `noise_nrmse`).
     pub(super) noise_best: f64,
@@ -89,7 +91,7 @@ pub(super) fn with_held_out(ctx: &Context, base_cal: Calibration) -> Result<Base
     } else {
         approx_cv(&base_cal, rows, folds, k, &opts.fit)
     };
-    let (base_nrmse, base_z2, base_e2, _) = errors(rows, &base_cv.preds, sc);
+    let (base_nrmse, base_z2, base_e2, base_z2s) = errors(rows, &base_cv.preds, sc);
     // The noise NRMSE reported (the spec's `noise_nrmse`) is the best estimate of what noise
     // alone gives; the tests beyond the noise below keep the weights' levels, upper bounds
     // consistent with the χ² the fits minimise (with the best levels in those tests the
@@ -112,9 +114,16 @@ pub(super) fn with_held_out(ctx: &Context, base_cal: Calibration) -> Result<Base
         nrmse: base_nrmse,
         z2: base_z2,
         e2: base_e2,
+        z2s: clipped(&base_z2s),
         noise_best,
         cal: base_cal,
     })
+}
+
+/// Each reading's squared normalised residual clipped at [`super::folds::OUTLIER_Z2`], as the
+/// held-out mean z² counts it.
+pub(super) fn clipped(z2: &[f64]) -> Vec<f64> {
+    z2.iter().map(|x| x.min(super::folds::OUTLIER_Z2)).collect()
 }
 
 /// Noise factors per quantity (`noise::estimate`), each the smaller of two estimates:

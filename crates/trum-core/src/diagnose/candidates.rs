@@ -166,6 +166,7 @@ impl<'a> Scorer<'a> {
                 heldout_chi2_after: base_z2,
                 shrink: 0.0,
                 shrink_interval: (0.0, 0.0),
+                z2_shrink_interval: (0.0, 0.0),
                 params: Vec::new(),
                 signature_match: None,
                 linear_chi2_drop: None,
@@ -463,9 +464,10 @@ impl<'a> Scorer<'a> {
                 }
             }
         }
-        let (after, chi2_after, e2, _) = errors(rows, &preds, sc);
+        let (after, chi2_after, e2, z2s) = errors(rows, &preds, sc);
         let shrink = 1.0 - after / base_nrmse.max(1e-300);
         let interval = bootstrap_shrink(base_e2, &e2, opts.bootstrap, opts.seed);
+        let z2_interval = bootstrap_shrink(&base.z2s, &super::baseline::clipped(&z2s), opts.bootstrap, opts.seed);
         let entry = RankEntry {
             effect: name,
             evidence,
@@ -473,6 +475,7 @@ impl<'a> Scorer<'a> {
             heldout_chi2_after: chi2_after,
             shrink,
             shrink_interval: interval,
+            z2_shrink_interval: z2_interval,
             params: fitted.into_iter().filter(|p| p.name.starts_with("effects.")).map(|p| (p.name, p.value)).collect(),
             signature_match: single_sig(effects).map(|s| s.matched),
             linear_chi2_drop: single_sig(effects).map(|s| s.linear_chi2_drop),

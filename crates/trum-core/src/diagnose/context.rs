@@ -230,6 +230,9 @@ pub(super) fn data_notes(rows: &[ObservedRow]) -> Vec<String> {
     notes
 }
 
+/// The floor of a quantity's NRMSE scale, × its mean noise level.
+const NOISE_SCALE_FLOOR: f64 = 2.0;
+
 /// Scale of each observable for the NRMSE: the spread (standard deviation) of its
 /// measured values, floored by its noise level.
 pub(super) fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
@@ -245,7 +248,7 @@ pub(super) fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
             let mean = vs.iter().map(|x| x.0).sum::<f64>() / n;
             let sd = (vs.iter().map(|x| (x.0 - mean).powi(2)).sum::<f64>() / n).sqrt();
             let noise = vs.iter().map(|x| x.1).sum::<f64>() / n;
-            (o, sd.max(noise).max(1e-12))
+            (o, sd.max(NOISE_SCALE_FLOOR * noise).max(1e-12))
         })
         .collect()
 }

@@ -65,6 +65,8 @@ pub fn guard_non_finite(mut d: Diagnosis) -> Diagnosis {
         gap(&mut r.heldout_chi2_after);
         score(&mut r.shrink_interval.0);
         score(&mut r.shrink_interval.1);
+        score(&mut r.z2_shrink_interval.0);
+        score(&mut r.z2_shrink_interval.1);
     }
     for g in &mut d.gap_where {
         gap(&mut g.mean_residual);
@@ -135,6 +137,7 @@ pub fn to_json(d: &Diagnosis, src: &Provenance<'_>) -> Value {
             "heldout_chi2_after": num(r.heldout_chi2_after),
             "shrink": num(r.shrink),
             "shrink_interval": [num(r.shrink_interval.0), num(r.shrink_interval.1)],
+            "z2_shrink_interval": [num(r.z2_shrink_interval.0), num(r.z2_shrink_interval.1)],
             "params": pairs(&r.params),
             "signature_match": r.signature_match.map(num),
             "linear_chi2_drop": r.linear_chi2_drop.map(num),

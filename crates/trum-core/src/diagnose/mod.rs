@@ -132,6 +132,11 @@ pub struct RankEntry {
     pub shrink: f64,
     /// Bootstrap 90 % interval of the shrink.
     pub shrink_interval: (f64, f64),
+    /// Bootstrap 90 % interval of the same shrink in σ: 1 − √(Σz²_after/Σz²_before) over
+    /// the held-out readings, each reading's z² clipped at [`OUTLIER_Z2`]. The NRMSE weighs
+    /// each quantity by its spread, so a few readings of a quantity with a small spread can
+    /// carry most of it and make its interval wide where the gain in σ is certain.
+    pub z2_shrink_interval: (f64, f64),
     /// Fitted effect parameters on the full data (name, value).
     pub params: Vec<(String, f64)>,
     /// Score test at the calibrated baseline (single effects): cos of the angle between
@@ -324,9 +329,9 @@ pub fn diagnose(
         // significant, so no test of the pair's gain can tell the two apart).
         // (At the noise in either held-out measure: a mean z² ≤ 2, or an NRMSE no larger
         // than noise alone gives.)
-        let single_at_noise = best_single.as_ref().filter(|b| {
-            single_closes && (b.heldout_chi2_after <= 2.0 || b.heldout_nrmse_after <= base.noise_best)
-        });
+        let single_at_noise = best_single
+            .as_ref()
+            .filter(|b| single_closes && (b.heldout_chi2_after <= 2.0 || b.heldout_nrmse_after <= base.noise_best));
         if let Some(b) = single_at_noise {
             notes.push(format!(
                 "no pair of effects tried: {} alone leaves the held-out data at the noise (mean squared normalised residual {:.2}, NRMSE {} against {} from noise alone), so a second effect is not needed",

@@ -343,22 +343,23 @@ fn diagnosed_single(
     diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis")
 }
 
-/// On a `combined` campaign the weights' noise levels put the whole held-out NRMSE of
+/// On a `combined` campaign the weights' noise levels put most of the held-out NRMSE of
 /// the baseline inside the noise, where noise alone gives a small fraction of it. The
 /// test "half of the NRMSE beyond the noise is gone" measured against the weights'
-/// level would then hold for every supported effect, and a `radial_friction` closing a
-/// fifth of a preload-stiffening gap would pass for the whole answer. Against the best
+/// level would then hold for almost any supported effect, and a `radial_friction` closing
+/// a fifth of a preload-stiffening gap would pass for the whole answer. Against the best
 /// noise estimate it closes only part: named, as the best partial explanation among the
 /// candidates (the truth is left out of them), with `complete: false`.
 #[test]
 fn a_gap_inside_the_weights_noise_is_not_closed_by_every_effect() {
     let d = diagnosed_single(Effect::PreloadStiffening, 0.05, Campaign::Combined, 0.5, 136, &[Effect::RadialFriction]);
-    // the premise: the weights' noise is above the baseline's gap, the best estimate far below
+    // the premise: the weights' noise is most of the baseline's gap, the best estimate far below
     assert!(
-        d.noise_nrmse_weights > d.baseline_heldout_nrmse,
-        "{} vs {}",
+        d.noise_nrmse_weights > 0.7 * d.baseline_heldout_nrmse && d.noise_nrmse_weights > 3.0 * d.noise_nrmse,
+        "{} vs {} and {}",
         d.noise_nrmse_weights,
-        d.baseline_heldout_nrmse
+        d.baseline_heldout_nrmse,
+        d.noise_nrmse
     );
     assert!(d.noise_nrmse < 0.5 * d.baseline_heldout_nrmse, "{} vs {}", d.noise_nrmse, d.baseline_heldout_nrmse);
     let rf = d.ranking.iter().find(|r| r.effect == "radial_friction").expect("ranked");
@@ -500,6 +501,7 @@ pub(super) fn ranked(effect: &str, chi2: f64, nrmse: f64) -> RankEntry {
         heldout_chi2_after: chi2,
         shrink: 0.5,
         shrink_interval: (0.4, 0.6),
+        z2_shrink_interval: (0.4, 0.6),
         params: Vec::new(),
         signature_match: None,
         linear_chi2_drop: None,

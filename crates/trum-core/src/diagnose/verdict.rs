@@ -31,14 +31,15 @@ pub(super) struct GapTests {
 
 impl GapTests {
     /// A candidate is supported when the full-data evidence is very strong (½ΔBIC > 5)
-    /// and its held-out improvement is real (the bootstrap 5 % bound of the shrink is
-    /// above zero). (It closes the gap, [`GapTests::closes`], when the held-out residual is
+    /// and its held-out improvement is real (the shrink positive, and the bootstrap 5 %
+    /// bound of the shrink above zero in NRMSE or in σ: [`RankEntry::z2_shrink_interval`]).
+    /// (It closes the gap, [`GapTests::closes`], when the held-out residual is
     /// back near the noise, or at least half of the held-out NRMSE is gone, or at least
     /// half of the part of it beyond the noise, √(NRMSE² − noise²): the truth may differ in
     /// form from the candidate and leave a remainder, and a gap only a little above the
     /// noise can never lose half of its total NRMSE.)
     pub(super) fn supported(r: &RankEntry) -> bool {
-        r.evidence > 5.0 && r.shrink > 0.0 && r.shrink_interval.0 > 0.0
+        r.evidence > 5.0 && r.shrink > 0.0 && (r.shrink_interval.0 > 0.0 || r.z2_shrink_interval.0 > 0.0)
     }
 
     /// x beyond the noise, √(x² − noise²) (0 below the noise).
@@ -370,7 +371,25 @@ mod tests {
         assert_eq!(quiet.z2_excess_shrink(&polish), 0.0);
         assert!(!quiet.material(&polish));
         // unsupported entries are never material
-        let unsupported = RankEntry { shrink_interval: (-0.01, 0.2), ..drift };
+        let unsupported = RankEntry { shrink_interval: (-0.01, 0.2), z2_shrink_interval: (-0.01, 0.2), ..drift };
         assert!(!tests.material(&unsupported));
+    }
+
+    /// A held-out gain that is certain in σ is real even where a few readings of a
+    /// quantity with a small spread make the NRMSE's interval straddle zero (a
+    /// `tangential_compliance` on a combined campaign: shrink 0.31, NRMSE interval
+    /// [−2 %, 48 %], its gain in σ certain); a gain certain in neither is not, nor is a
+    /// negative shrink.
+    #[test]
+    fn a_gain_certain_in_sigma_supports_an_effect() {
+        let base = RankEntry { evidence: 2762.0, shrink: 0.31, ..ranked("tangential_compliance", 1.1, 0.0935) };
+        let wide = RankEntry { shrink_interval: (-0.02, 0.48), z2_shrink_interval: (0.1, 0.3), ..base.clone() };
+        assert!(GapTests::supported(&wide));
+        let neither = RankEntry { z2_shrink_interval: (-0.01, 0.3), ..wide.clone() };
+        assert!(!GapTests::supported(&neither));
+        let worse = RankEntry { shrink: -0.05, ..wide.clone() };
+        assert!(!GapTests::supported(&worse));
+        let weak = RankEntry { evidence: 4.0, ..wide };
+        assert!(!GapTests::supported(&weak));
     }
 }
