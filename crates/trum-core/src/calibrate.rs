@@ -332,15 +332,7 @@ fn temperature_offset_param(
     rows: &[ObservedRow],
     overrides: &std::collections::BTreeMap<String, f64>,
 ) -> Option<FitParam> {
-    let key = "bench.temperature_offset_k";
-    let n = rows.iter().flat_map(|r| &r.readings).filter(|x| x.0 == Observable::TemperatureC).count();
-    if n < 3 {
-        return None;
-    }
-    let sd = overrides.get(key).copied().unwrap_or(TEMPERATURE_OFFSET_SD_K);
-    if sd.is_nan() || sd <= 0.0 {
-        return None;
-    }
+    let sd = temperature_prior_sd(rows, false, overrides, "bench.temperature_offset_k", TEMPERATURE_OFFSET_SD_K)?;
     let half = if sd.is_finite() { (5.0 * sd).max(5.0) } else { 20.0 };
     Some(FitParam {
         param: ParamRef::Instrument(InstrumentParam::TemperatureOffsetK),
@@ -349,6 +341,27 @@ fn temperature_offset_param(
         log: false,
         prior: sd.is_finite().then_some(Prior { centre: 0.0, sd }),
     })
+}
+
+/// The prior width of a temperature sensor's nuisance parameter: `default`, or the
+/// tolerance `overrides` gives under `key`; `None` (not fitted) where the stator temperature
+/// is read fewer than three times (in a time series, rows with `elapsed_s` > 0, where
+/// `time_series`) or the tolerance is 0.
+fn temperature_prior_sd(
+    rows: &[ObservedRow],
+    time_series: bool,
+    overrides: &std::collections::BTreeMap<String, f64>,
+    key: &str,
+    default: f64,
+) -> Option<f64> {
+    let n = rows
+        .iter()
+        .filter(|r| !time_series || r.op.elapsed_s > 0.0)
+        .flat_map(|r| &r.readings)
+        .filter(|x| x.0 == Observable::TemperatureC)
+        .count();
+    let sd = overrides.get(key).copied().unwrap_or(default);
+    (n >= 3 && !sd.is_nan() && sd > 0.0).then_some(sd)
 }
 
 /// Centre of the temperature sensor's lag prior [s]: a sensor bonded to the stator through
@@ -371,20 +384,7 @@ fn temperature_lag_param(
     rows: &[ObservedRow],
     overrides: &std::collections::BTreeMap<String, f64>,
 ) -> Option<FitParam> {
-    let key = "bench.temperature_lag_s";
-    let n = rows
-        .iter()
-        .filter(|r| r.op.elapsed_s > 0.0)
-        .flat_map(|r| &r.readings)
-        .filter(|x| x.0 == Observable::TemperatureC)
-        .count();
-    if n < 3 {
-        return None;
-    }
-    let sd = overrides.get(key).copied().unwrap_or(TEMPERATURE_LAG_LN_SD);
-    if sd.is_nan() || sd <= 0.0 {
-        return None;
-    }
+    let sd = temperature_prior_sd(rows, true, overrides, "bench.temperature_lag_s", TEMPERATURE_LAG_LN_SD)?;
     Some(FitParam {
         param: ParamRef::Instrument(InstrumentParam::TemperatureLagS),
         lo: 0.1,

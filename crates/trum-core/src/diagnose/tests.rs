@@ -655,26 +655,18 @@ fn a_current_limited_driver_is_diagnosed_as_voltage_sag() {
 /// offset cannot stand in for a lag that fades as the warm-up settles.
 #[test]
 fn a_lagging_temperature_sensor_is_the_benchs_not_a_gap() {
-    let nominal = crate::calibrate::tests::reference_motor();
-    let cfg = SynthConfig {
-        campaign: Campaign::WarmUp,
-        noise: 1.0,
-        seed: 1,
-        artefacts: crate::synth::Artefacts { temperature_lag_s: 40.0, ..Default::default() },
-        ..SynthConfig::default()
-    };
-    let (rows, groups) = synthesized(&nominal, &cfg);
-    let opts = DiagnoseOptions { bootstrap: 50, try_pairs: false, ..DiagnoseOptions::default() };
-    let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+    let artefacts = crate::synth::Artefacts { temperature_lag_s: 40.0, ..Default::default() };
+    let (d, held) = warm_up_through_a_sensor(artefacts, 1, "bench.temperature_lag_s");
     assert_eq!(d.verdict, "none", "{:?}", d.ranking);
     let (_, got) = d.baseline_params.iter().find(|(k, _)| k == "bench.temperature_lag_s").expect("the lag is fitted");
     assert!((got - 40.0).abs() < 5.0, "fitted lag {got} s against 40 s");
-    let held = BTreeMap::from([("bench.temperature_lag_s".to_string(), 0.0)]);
-    let opts = DiagnoseOptions { tolerances: held, ..opts };
-    let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
-    assert!(d.baseline_params.iter().all(|(k, _)| k != "bench.temperature_lag_s"));
-    assert!(d.baseline_heldout_chi2_per_reading > 2.0, "held-out mean z² {}", d.baseline_heldout_chi2_per_reading);
-    assert_ne!(d.verdict, "none");
+    assert!(held.baseline_params.iter().all(|(k, _)| k != "bench.temperature_lag_s"));
+    assert!(
+        held.baseline_heldout_chi2_per_reading > 2.0,
+        "held-out mean z² {}",
+        held.baseline_heldout_chi2_per_reading
+    );
+    assert_ne!(held.verdict, "none");
 }
 
 /// A strong `radial_friction` stalls the rotor at half the preloads of a speed-stability
@@ -736,27 +728,33 @@ fn a_single_at_the_noise_is_given_no_partner() {
 /// (a held-out mean z² above 2), which no candidate explains.
 #[test]
 fn a_temperature_sensor_offset_is_the_benchs_not_a_gap() {
-    let nominal = crate::calibrate::tests::reference_motor();
-    let cfg = SynthConfig {
-        campaign: Campaign::WarmUp,
-        noise: 1.0,
-        seed: 7204,
-        artefacts: crate::synth::Artefacts { temperature_offset_k: 1.5, ..Default::default() },
-        ..SynthConfig::default()
-    };
-    let (rows, groups) = synthesized(&nominal, &cfg);
-    let opts = DiagnoseOptions { bootstrap: 50, try_pairs: false, ..DiagnoseOptions::default() };
-    let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+    let artefacts = crate::synth::Artefacts { temperature_offset_k: 1.5, ..Default::default() };
+    let (d, held) = warm_up_through_a_sensor(artefacts, 7204, "bench.temperature_offset_k");
     assert_eq!(d.verdict, "none", "{:?}", d.ranking);
     let (_, got) =
         d.baseline_params.iter().find(|(k, _)| k == "bench.temperature_offset_k").expect("the offset is fitted");
     assert!((got - 1.5).abs() < 0.4, "fitted offset {got} K against 1.5 K");
-    let held = BTreeMap::from([("bench.temperature_offset_k".to_string(), 0.0)]);
-    let opts = DiagnoseOptions { tolerances: held, ..opts };
-    let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
-    assert!(d.baseline_params.iter().all(|(k, _)| k != "bench.temperature_offset_k"));
-    assert!(d.baseline_heldout_chi2_per_reading > 2.0, "held-out mean z² {}", d.baseline_heldout_chi2_per_reading);
-    assert_ne!(d.verdict, "none");
+    assert!(held.baseline_params.iter().all(|(k, _)| k != "bench.temperature_offset_k"));
+    assert!(
+        held.baseline_heldout_chi2_per_reading > 2.0,
+        "held-out mean z² {}",
+        held.baseline_heldout_chi2_per_reading
+    );
+    assert_ne!(held.verdict, "none");
+}
+
+/// A warm-up of the reference motor with nothing added, read through a temperature sensor
+/// with `artefacts` (noise seed `seed`), diagnosed with the sensor's nuisance parameter
+/// `key` fitted and with it held at zero (its tolerance 0).
+fn warm_up_through_a_sensor(artefacts: crate::synth::Artefacts, seed: u64, key: &str) -> (Diagnosis, Diagnosis) {
+    let nominal = crate::calibrate::tests::reference_motor();
+    let cfg = SynthConfig { campaign: Campaign::WarmUp, noise: 1.0, seed, artefacts, ..SynthConfig::default() };
+    let (rows, groups) = synthesized(&nominal, &cfg);
+    let opts = DiagnoseOptions { bootstrap: 50, try_pairs: false, ..DiagnoseOptions::default() };
+    let fitted = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+    let opts = DiagnoseOptions { tolerances: BTreeMap::from([(key.to_string(), 0.0)]), ..opts };
+    let held = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+    (fitted, held)
 }
 
 /// A `tangential_compliance` at twice its typical strength, in its first truth form, on a
