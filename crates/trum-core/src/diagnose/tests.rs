@@ -673,7 +673,7 @@ fn a_lagging_temperature_sensor_is_the_benchs_not_a_gap() {
 /// run: the baseline's calibration from the nominal motor stops in a valley of its own
 /// parameters, and every candidate's fit (refitting those parameters from other starts)
 /// gains ½ΔBIC ≈ 100 over it with no held-out shrink, so that the one candidate with a
-/// little shrink, `eccentricity`, was named. The baseline is every candidate at zero
+/// little shrink, `eccentricity`, would be named. The baseline is every candidate at zero
 /// strength: it is refitted from the best candidate fit with its effect taken out, the
 /// spurious evidence goes, and no wrong effect is named.
 #[test]
