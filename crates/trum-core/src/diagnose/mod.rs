@@ -304,8 +304,10 @@ pub fn diagnose(
 
     let tests = GapTests { base_nrmse: base.nrmse, gap_noise: base.noise_best, base_z2: base.z2, n_read: ctx.n_read };
     // The gap is real when the baseline misses held-out data beyond twice the noise
-    // variance, or when some effect closes a material part of it (a small, consistent gap).
-    let gap = base.z2 > 2.0 || ranking.iter().any(|r| tests.material(r));
+    // variance, with the noise levels at the upper end of their estimates (a level
+    // estimated low by chance raises every z²), or when some effect closes a material part
+    // of it (a small, consistent gap).
+    let gap = base.z2_upper_noise > 2.0 || ranking.iter().any(|r| tests.material(r));
     let mut decided = Verdict {
         verdict: String::from("none"),
         complete: true,
@@ -359,8 +361,8 @@ pub fn diagnose(
         notes.append(&mut decided.notes);
     } else {
         notes.push(format!(
-            "the calibrated baseline predicts the held-out regions at the noise level (mean squared normalised residual {:.2}) and no candidate effect is supported; no effect is needed",
-            base.z2
+            "the calibrated baseline predicts the held-out regions at the noise level (mean squared normalised residual {:.2}; {:.2} with each quantity's noise level at the upper end of its estimate's 90 % interval) and no candidate effect is supported; no effect is needed",
+            base.z2, base.z2_upper_noise
         ));
     }
     let Verdict { verdict, complete, confounded, partial, .. } = decided;
