@@ -19,6 +19,34 @@
 //! - the bar-type transient paper: *Transient analysis of bar-type ultrasonic motors*.
 //!
 //! SI units everywhere; every public quantity name carries its unit.
+//!
+//! ## Code map
+//!
+//! Entry points: `solve` (one operating point of a `Motor`, re-exported here), `sweep`
+//! (grids with warm starts), `criterion` (the preload criterion), `calibrate`, `diagnose`,
+//! `estimate`, `synth` and `dynamics`.
+//!
+//! - Motor and data: `params` (the `Motor` and its TOML file), `presets` (the built-in
+//!   motors, `crates/trum-core/presets/*.toml`), `effects` (the registry of unmodelled
+//!   effects), `limits`, `tolerances`, `measurements` (the measurement CSV),
+//!   `observable` and `observations` (bench data as observed rows).
+//! - Steady-state physics: `contact` (contact and stick zones, torque), `stator` (modal
+//!   dynamics and modal stiffness), `interface` (friction laws beyond 2-D Coulomb),
+//!   `losses`, `thermal`, `fluctuation`; `solve/` puts them together (its `mod.rs` maps
+//!   its files); `solution` and `quantities` hold what it reports.
+//! - Bench data and fits: `synth`, `noise`, `calibrate` (with `sensitivity`), and
+//!   `diagnose/`, one file per stage (`baseline`, `candidates`, `scan`, `signature`,
+//!   `pairs`, `verdict`, `where_`, `json`).
+//! - Dynamics: `dynamics::hertz` (the Hertzian-contact oscillator), `dynamics::transient`
+//!   (stick-slip start-up), `dynamics::bar_type`.
+//! - Checks of the papers: `papers` (closed forms as printed and corrected) and `quad`.
+//!
+//! The physics of an effect lives in the module of the part of the model it changes
+//! (`interface`, `stator`, `solve/trial.rs`, ...), read once per motor in
+//! `solve/prepared.rs`. Where a new effect, quantity, parameter or command goes, and how
+//! to run the tests (`bash scripts/test.sh`, `cargo test -p trum-core`) and the
+//! benchmarks (`cargo bench --bench solve`): `docs/CONTRIBUTING.md`. The equations are in
+//! `docs/MODEL.md`.
 #![warn(missing_docs)]
 
 pub mod axis;
