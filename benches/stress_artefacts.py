@@ -6,7 +6,8 @@ Each case is a `trum synth` file of the frozen reference motor (tests/data/motor
 every parameter perturbed as in the blind benchmark) that this script then alters as a
 bench would: gains of the speed, torque, power or feedback readings, read-back noise of
 the preload or the frequency, a quantised torque, an offset or a lag of the temperature sensor,
-heavy-tailed speed noise, cells left empty, noise three times the nominal. Null cases
+heavy-tailed speed noise, cells left empty, noise three times the nominal, noise that is
+all absolute or all relative. Null cases
 must come out `none`; effect cases (each effect at about twice its typical strength in
 its first truth form, with two artefacts drawn at random and the development half's own)
 should name the effect. The cases are a development set: the diagnosis was changed after
@@ -18,9 +19,11 @@ they were first run.
     TRUM=path/to/trum python3 benches/stress_artefacts.py
 
 Prints one line per case (verdict, complete, confounded set, the baseline's held-out NRMSE,
-the three strongest candidates) and the counts; the work files go to a temporary folder.
+the three strongest candidates) and the counts. The work files (each case's CSV and JSON)
+go to a temporary folder, or to the folder named by STRESS_KEEP, which is kept.
 """
 
+import contextlib
 import csv
 import json
 import math
@@ -107,8 +110,38 @@ def sensor_lag(tau_s):
     return apply
 
 
-# artefacts of the null cases only (the effect cases draw theirs from ARTEFACTS)
-NULL_ONLY = {"temp_lag": sensor_lag(30.0)}
+def noise_shape(levels):
+    """Gaussian noise of another shape than the simulator's (an absolute floor plus a
+    relative part): `levels` maps a column to its (absolute, relative) standard deviation.
+    Applied to readings synthesised without noise (`--noise 0`)."""
+
+    def apply(rows, rng):
+        for column, (a, r) in levels.items():
+            bounded = column not in ("temperature_c",)
+            top = 1.0 if column == "efficiency" else math.inf
+
+            def noisy(v):
+                x = v + rng.gauss(0.0, a + r * abs(v))
+                return min(top, max(0.0, x)) if bounded else x
+
+            alter(rows, column, noisy)
+
+    return apply
+
+
+# every reading's noise absolute (a bench whose instruments have a fixed resolution), or
+# relative (gains of the instruments' ranges), where the simulator and the diagnosis's
+# default levels have both parts
+ABSOLUTE = {"speed_rpm": (1.2, 0.0), "input_power_w": (0.08, 0.0), "current_a": (0.0015, 0.0),
+            "efficiency": (0.006, 0.0), "feedback_v": (0.4, 0.0), "temperature_c": (0.1, 0.0),
+            "speed_std_rpm": (0.1, 0.0)}
+RELATIVE = {"speed_rpm": (0.0, 0.012), "input_power_w": (0.0, 0.015), "current_a": (0.0, 0.012),
+            "efficiency": (0.0, 0.03), "feedback_v": (0.0, 0.008), "temperature_c": (0.1, 0.0),
+            "speed_std_rpm": (0.0, 0.1)}
+
+# artefacts of their own cases only (the effect cases of every effect draw theirs from
+# ARTEFACTS)
+NULL_ONLY = {"temp_lag": sensor_lag(30.0), "abs_noise": noise_shape(ABSOLUTE), "rel_noise": noise_shape(RELATIVE)}
 
 EFFECTS = {
     "radial_friction": "radial_friction=2",
@@ -136,6 +169,15 @@ def cases():
     out.append(("null_warm_up_temp_offset", "none", ["temp_offset"], "warm-up", 7204, None, 1, []))
     out.append(("null_warm_up_temp_lag", "none", ["temp_lag"], "warm-up", 7205, None, 1, []))
     out.append(("null_combined_temp_lag", "none", ["temp_lag"], "combined", 7206, None, 1, []))
+    # noise of other shapes, on readings synthesised without noise
+    seed = 7210
+    for shape in ("abs_noise", "rel_noise"):
+        for campaign in ("preload-torque", "combined"):
+            seed += 1
+            out.append((f"null_{shape}_{campaign}", "none", [shape], campaign, seed, None, 0, []))
+        seed += 1
+        out.append((f"tangential_compliance_{shape}", "tangential_compliance", [shape], "preload-torque", seed,
+                    EFFECTS["tangential_compliance"], 0, []))
     rng = random.Random(11)
     seed = 8100
     for effect, arg in EFFECTS.items():
@@ -177,7 +219,10 @@ def main():
     wanted = sys.argv[1:]
     todo = [c for c in cases() if not wanted or any(w in c[0] for w in wanted)]
     right = {"null": [0, 0], "effect": [0, 0]}
-    with tempfile.TemporaryDirectory() as work, ThreadPoolExecutor(2) as pool:
+    keep = os.environ.get("STRESS_KEEP")
+    if keep:
+        os.makedirs(keep, exist_ok=True)
+    with (contextlib.nullcontext(keep) if keep else tempfile.TemporaryDirectory()) as work, ThreadPoolExecutor(2) as pool:
         for name, truth, arts, d, seconds, err in pool.map(lambda c: run(c, work), todo):
             if d is None:
                 print(f"{name}: diagnosis failed: {err}")

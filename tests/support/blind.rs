@@ -521,7 +521,7 @@ pub fn half_slice_cases(half: Half) -> Vec<Case> {
 pub const FACTORS: [f64; 2] = [0.3, 1.0];
 
 /// The full benchmark's third strength, × typical: at 0.3 and 1 × alone the true motor's
-/// median shrink is 0.67-0.71 (docs/DIAGNOSIS.md), so the 0.7 would measure the
+/// median shrink is 0.67-0.71 (docs/DIAGNOSIS.md), so a target shrink of 0.7 would measure the
 /// design more than the diagnosis.
 pub const STRONG_FACTOR: f64 = 3.0;
 

@@ -727,7 +727,7 @@ fn map_statuses_agree_with_the_loaded_stall_torque_column() {
     assert_eq!(lines, 7);
     assert_eq!(empty, 1, "the 100 N line of generic60 clamps");
     assert!(crossings >= 5, "{crossings} lines reach their loaded stall torque");
-    // the point: its loaded stall torque is far below the rotor-at-rest torque
+    // the point of the column: its loaded stall torque is far below the rotor-at-rest torque
     let out = ok(&[
         "map",
         "--motor",

@@ -1,6 +1,6 @@
 //! Absurd data gets no confident answer: values outside a column's plausible range are
 //! refused with the line and column; with the range lifted, a diagnosis whose figures
-//! overflow says `unexplained` with every figure of the spec a finite number; calibrate
+//! overflow says `unexplained` with every required figure a finite number; calibrate
 //! refuses data the motor cannot solve at any row.
 
 use std::path::Path;
@@ -41,7 +41,7 @@ fn write(dir: &Path, name: &str, extra_col: Option<(&str, &[&str])>, extra_rows:
     std::fs::write(dir.join(name), t).expect("write data");
 }
 
-/// Every figure the spec requires is a finite JSON number.
+/// Every figure the diagnosis document requires is a finite JSON number.
 fn assert_spec_figures_finite(doc: &serde_json::Value) {
     let finite = |v: &serde_json::Value, what: &str| {
         assert!(v.as_f64().is_some_and(f64::is_finite), "{what} is not a finite number: {v}");

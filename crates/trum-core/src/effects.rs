@@ -1,5 +1,5 @@
 //! The library of named, switchable unmodelled effects (names fixed by
-//! `shared/spec/diagnose.md`). Like PyBaMM's model options: an explicit set of named
+//! the diagnosis document, docs/DIAGNOSIS_JSON.md). Like PyBaMM's model options: an explicit set of named
 //! effects, each with one to three strength parameters in physical units and shape
 //! parameters that choose among its forms, `none` by default, validated with errors that
 //! list the valid names.

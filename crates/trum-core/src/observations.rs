@@ -53,7 +53,7 @@ pub fn observations(m: &Measurements, motor: &Motor) -> BenchData {
     BenchData { rows, groups, lines: m.lines.clone(), observables: present }
 }
 
-/// Writes synthetic rows as measurements (the layout of shared/spec/measurements.md).
+/// Writes synthetic rows as measurements (the layout of docs/MEASUREMENTS.md).
 pub fn to_measurements(rows: &[SynthRow]) -> Result<Measurements, TrumError> {
     let mut b = Measurements::builder();
     for r in rows {

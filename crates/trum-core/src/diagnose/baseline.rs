@@ -95,7 +95,7 @@ pub(super) fn with_held_out(ctx: &Context, base_cal: Calibration) -> Result<Base
         approx_cv(&base_cal, rows, folds, k, &opts.fit)
     };
     let (base_nrmse, base_z2, base_e2, base_z2s) = errors(rows, &base_cv.preds, sc);
-    // The noise NRMSE reported (the spec's `noise_nrmse`) is the best estimate of what noise
+    // The noise NRMSE reported (the document's `noise_nrmse`) is the best estimate of what noise
     // alone gives; the tests beyond the noise below keep the weights' levels, upper bounds
     // consistent with the χ² the fits minimise (with the best levels in those tests the
     // blind benchmark lost 3 of its 45 correct verdicts: docs/DIAGNOSIS.md).

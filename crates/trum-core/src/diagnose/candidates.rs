@@ -308,19 +308,26 @@ impl<'a> Scorer<'a> {
                 _ => start.clone(),
             };
             let valleys = scan::valleys(&[start, motor], &fit_motor, rows, effects[0]);
+            // (the valleys' fits are independent: in parallel, then taken in the scan's order)
+            let from_valleys: Vec<_> = valleys
+                .par_iter()
+                .map(|v| {
+                    let mut wide = params.clone();
+                    scan::widen(&mut wide, effects[0], &v.values);
+                    let mut s2 = with_bench(&v.base, start);
+                    s2.effects.set(effects[0], &v.values);
+                    let c2 = Calibration::builder(&s2, rows)
+                        .params(&wide)
+                        .options(&opts.fit)
+                        .adding(added)
+                        .start(Start::Restart)
+                        .run();
+                    (v, c2)
+                })
+                .collect();
             let mut disagree = Vec::new();
-            for v in valleys {
-                let mut wide = params.clone();
-                scan::widen(&mut wide, effects[0], &v.values);
-                let mut s2 = with_bench(&v.base, start);
-                s2.effects.set(effects[0], &v.values);
-                if let Ok(c2) = Calibration::builder(&s2, rows)
-                    .params(&wide)
-                    .options(&opts.fit)
-                    .adding(added)
-                    .start(Start::Restart)
-                    .run()
-                {
+            for (v, c2) in from_valleys {
+                if let Ok(c2) = c2 {
                     let current = match &cal {
                         Ok(c) if !c.abandoned => c.chi2,
                         _ => f64::INFINITY,

@@ -241,7 +241,7 @@ pub const OUTLIER_Z2: f64 = 16.0;
 
 /// Normalised held-out errors: (NRMSE with the quantity scales, mean squared residual in σ
 /// with each reading's clipped at [`OUTLIER_Z2`], per-reading squared scaled residuals,
-/// per-reading squared residuals in σ). The NRMSE is not clipped: the spec's shrink is
+/// per-reading squared residuals in σ). The NRMSE is not clipped: the reported shrink is
 /// measured on it, and a baseline's large misses are the gap itself.
 pub(super) fn errors(
     rows: &[ObservedRow],

@@ -1,4 +1,4 @@
-//! The diagnosis as the JSON document of `shared/spec/diagnose.md` (the spec's fields
+//! The diagnosis as the JSON document of docs/DIAGNOSIS_JSON.md (its required fields
 //! plus extras). Built here so that `trum diagnose --json` and Python's `trum.diagnose`
 //! give the same document; writing it anywhere is the caller's business.
 
@@ -28,11 +28,11 @@ pub const NON_FINITE_NOTE: &str = "some of the diagnosis' figures are not finite
      overflowed are given as 1.7976931348623157e308, a not-a-number as 0 (evidence, shrink) or as that \
      value (a gap); check the data's plausible ranges (docs/MEASUREMENTS.md)";
 
-/// A diagnosis with a non-finite figure of the spec (the held-out and noise gaps, a
+/// A diagnosis with a non-finite required figure (the held-out and noise gaps, a
 /// candidate's evidence, gap after or shrink) is no diagnosis: the figures
 /// rest on sums that overflowed, and the ranking built on them means nothing. Such a
 /// diagnosis gets the verdict `unexplained`, incomplete, nothing confounded, a note, and
-/// finite figures in their place, so that every number the spec requires is a number
+/// finite figures in their place, so that every number the document requires is a number
 /// (JSON has no NaN or infinity, and `null` is not a number): an infinity becomes
 /// [`OVERFLOWED`] with its sign; a not-a-number becomes 0 for evidence and shrink (no
 /// support, nothing closed) and [`OVERFLOWED`] for a gap (unbounded). A diagnosis with
@@ -52,7 +52,7 @@ pub fn guard_non_finite(mut d: Diagnosis) -> Diagnosis {
         }
         bad
     };
-    // the spec's figures decide; the rest are made finite without deciding anything
+    // the required figures decide; the rest are made finite without deciding anything
     let mut bad = false;
     bad |= gap(&mut d.baseline_heldout_nrmse);
     bad |= gap(&mut d.noise_nrmse);

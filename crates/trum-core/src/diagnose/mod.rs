@@ -1,4 +1,4 @@
-//! The sim-to-real gap diagnosis (`shared/spec/diagnose.md`): where the calibrated
+//! The sim-to-real gap diagnosis (docs/DIAGNOSIS.md): where the calibrated
 //! baseline misses, which unmodelled effect causes it, and how far the gap shrinks on
 //! held-out operating regions once that effect is added.
 //!
@@ -325,7 +325,7 @@ pub fn diagnose(
         // be supported on its own (the first one's gap dominates its single fit). Which
         // second effects are worth a pair fit is screened by their score test at the lead's
         // fit (`pairs`). A single that leaves the held-out data at the noise needs no
-        // partner: the spec names two effects when both are needed to close the gap, and
+        // partner: a verdict names two effects when both are needed to close the gap, and
         // a second effect fitted there polishes the first one's form, which on a bench
         // differs from every candidate's (with enough readings any form error is
         // significant, so no test of the pair's gain can tell the two apart).

@@ -18,8 +18,11 @@ use crate::params::Motor;
 /// Most rows the scan evaluates (evenly spaced through the data).
 const SCAN_ROWS: usize = 120;
 
-/// Most valleys handed back (each costs a fit).
-const MAX_VALLEYS: usize = 2;
+/// Most valleys handed back (each costs a fit; they are fitted in parallel): the lowest by
+/// χ², then the best of each other form of the effect. One more than the most forms any
+/// effect's grid has (five), so that every form is fitted from its best valley (test
+/// `every_form_of_every_effect_fits_under_the_cap`).
+const MAX_VALLEYS: usize = 6;
 
 /// Largest strength of the grid, × typical: two decades above the typical strength, the
 /// top of the documented range where that is lower. (`voltage_sag`'s documented range
@@ -135,7 +138,8 @@ type Scored = (usize, f64, Vec<f64>, f64);
 /// Valleys of the objective along the effect's strength, from each motor of `bases`, that
 /// the fit ending at `fitted` has not reached: lower than the fit on the scan's rows, or
 /// beyond eight times the typical strength (the fit's bounds) and lower than every
-/// strength within them. At most [`MAX_VALLEYS`], best first.
+/// strength within them, or a valley of the effect's own; the lowest, and the best of each
+/// other form (`pick`).
 pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e: Effect) -> Vec<Valley> {
     use rayon::prelude::*;
     let step = rows.len().div_ceil(SCAN_ROWS).max(1);
@@ -211,7 +215,7 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
         }
     }
     scored.extend(score(refine));
-    let mut found: Vec<Valley> = Vec::new();
+    let mut found: Vec<Found> = Vec::new();
     for (b, base) in bases.iter().enumerate() {
         // one series per shape set: the values with the same shape parameters
         let mut series: Vec<Vec<&Scored>> = Vec::new();
@@ -241,22 +245,49 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
                 // removes most of what the base misses at its weakest strength
                 let own = i > 0 && p.3 < OWN_VALLEY_LEFT * s[0].3;
                 if lower || fenced || own {
-                    found.push(Valley { base: (*base).clone(), values: p.2.clone(), chi2: p.3 });
+                    let valley = Valley { base: (*base).clone(), values: p.2.clone(), chi2: p.3 };
+                    found.push(Found { valley, left: p.3 / s[0].3, form: shape_of(&p.2) });
                 }
             }
         }
     }
-    found.sort_by(|a, b| a.chi2.total_cmp(&b.chi2));
-    // distinct valleys only: not the same strength twice
-    let mut out: Vec<Valley> = Vec::new();
-    for v in found {
-        if !out.iter().any(|o| o.values == v.values) {
-            out.push(v);
-        }
-        if out.len() == MAX_VALLEYS {
+    pick(found)
+}
+
+/// A valley with what ranks it among the others.
+struct Found {
+    valley: Valley,
+    /// Its χ² over its series' χ² at the weakest strength: the part of what the base misses
+    /// that the effect leaves there.
+    left: f64,
+    /// The effect's shape parameters there (bit patterns): its form.
+    form: Vec<u64>,
+}
+
+/// The valleys handed back, best first, at most [`MAX_VALLEYS`]: the lowest χ², then the
+/// best of each other form by the part of its base's miss it leaves. The held shape
+/// levels are forms no fit moves between, and χ² from different bases do not compare (the
+/// nominal motor's is of a motor nothing was fitted to): a softening that falls with the
+/// preload, scanned from the nominal motor, left an eighth of that motor's miss, where
+/// two rising forms from the calibrated baseline were a little lower in χ² but fitted to
+/// nothing, and only its own fit reached the noise.
+fn pick(mut found: Vec<Found>) -> Vec<Valley> {
+    found.sort_by(|a, b| a.valley.chi2.total_cmp(&b.valley.chi2));
+    let mut chosen: Vec<Found> = Vec::new();
+    let mut rest = found.into_iter();
+    chosen.extend(rest.next());
+    let mut rest: Vec<Found> = rest.collect();
+    rest.sort_by(|a, b| a.left.total_cmp(&b.left));
+    for f in rest {
+        if chosen.len() == MAX_VALLEYS {
             break;
         }
+        if !chosen.iter().any(|c| c.form == f.form) {
+            chosen.push(f);
+        }
     }
+    let mut out: Vec<Valley> = chosen.into_iter().map(|f| f.valley).collect();
+    out.sort_by(|a, b| a.chi2.total_cmp(&b.chi2));
     out
 }
 
@@ -352,6 +383,52 @@ mod tests {
         }
         let knees: Vec<f64> = grid(Effect::VoltageSag, &[0.1, 0.2, 0.3]).iter().map(|(_, v, _)| v[1]).collect();
         assert!(knees.contains(&0.0) && knees.contains(&0.2));
+    }
+
+    /// Every form of every effect's grid (its shape parameters' combinations) gets its best
+    /// valley fitted: the forms, besides the lowest valley, fit under the cap.
+    #[test]
+    fn every_form_of_every_effect_fits_under_the_cap() {
+        for e in ALL {
+            let mut forms: Vec<Vec<u64>> = grid(e, &[0.1, 0.2, 0.3])
+                .iter()
+                .map(|(_, v, _)| e.info().params.iter().zip(v).filter(|(q, _)| q.shape).map(|(_, x)| x.to_bits()).collect())
+                .collect();
+            forms.sort();
+            forms.dedup();
+            assert!(forms.len() < MAX_VALLEYS, "{e}: {} forms", forms.len());
+        }
+    }
+
+    /// The lowest valley first, then the best of each other form by the part of its base's
+    /// miss it leaves, one per form, at most `MAX_VALLEYS`.
+    #[test]
+    fn the_valleys_handed_back_are_the_lowest_and_each_forms_best() {
+        let base = crate::presets::preset("generic60").expect("preset");
+        let f = |chi2: f64, left: f64, form: u64, strength: f64| Found {
+            valley: Valley { base: base.clone(), values: vec![strength, form as f64], chi2 },
+            left,
+            form: vec![form],
+        };
+        let found = vec![
+            // near the calibrated baseline: lowest in χ², little of its miss removed
+            f(2169.0, 0.99, 2, 0.1),
+            f(2178.0, 0.99, 3, 0.1),
+            // from the nominal motor: far above in χ², most of its miss removed
+            f(18865.0, 0.06, 1, 3.0),
+            f(19500.0, 0.07, 1, 10.0),
+            f(33260.0, 0.12, 0, 100.0),
+            f(48024.0, 0.15, 4, 3.0),
+        ];
+        let out = pick(found);
+        let got: Vec<(f64, f64)> = out.iter().map(|v| (v.chi2, v.values[1])).collect();
+        // the lowest; then by what they leave: form 1's best (not its second valley), form
+        // 0, form 4 (0.15 left), form 3 (0.99); returned by χ²
+        assert_eq!(got, vec![(2169.0, 2.0), (2178.0, 3.0), (18865.0, 1.0), (33260.0, 0.0), (48024.0, 4.0)]);
+        // fewer than the cap: every distinct form
+        let two = pick(vec![f(5.0, 0.9, 1, 1.0), f(7.0, 0.2, 1, 3.0), f(9.0, 0.5, 2, 1.0)]);
+        assert_eq!(two.iter().map(|v| v.chi2).collect::<Vec<_>>(), vec![5.0, 9.0]);
+        assert!(pick(Vec::new()).is_empty());
     }
 
     #[test]

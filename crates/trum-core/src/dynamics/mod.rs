@@ -5,7 +5,7 @@
 //!   frequency response with jumps (multiple scales, eq. 10-12, and one-term harmonic
 //!   balance), harmonic-balance identification of β from the isolated-electrode
 //!   (feedback) voltage (eq. 5-9) and a fixed-step RK4 time simulation with constant
-//!   frequency and slow linear sweeps. The spec names this effect `hertz_softening`.
+//!   frequency and slow linear sweeps. The steady model's counterpart is the `hertz_softening` effect.
 //!
 //! * [`transient`]: the step response with a discretised stick-slip contact (ring motor).
 //! * [`bar_type`]: the bar-type motor (rigid-disc stator driven by a moment) on the same

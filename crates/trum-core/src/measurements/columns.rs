@@ -4,7 +4,7 @@
 use super::{Measurements, Row};
 use std::fmt;
 
-/// Where a column's values must lie (the spec's "unit / range" column).
+/// Where a column's values must lie (the layout's "unit / range" column, docs/MEASUREMENTS.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Range {
     /// Strictly positive: `> 0`.
@@ -45,7 +45,7 @@ pub struct ColumnSpec {
     /// typo, a unit slip or a bench fault far more often than a measurement;
     /// [`super::PlausibleRanges`] overrides it.
     pub plausible: (f64, f64),
-    /// Meaning, as in the spec.
+    /// Meaning, as in docs/MEASUREMENTS.md.
     pub meaning: &'static str,
     /// Other spellings of the quantity (without unit), recognised in headers to suggest
     /// the right column name instead of ignoring the column as unknown.
@@ -54,7 +54,7 @@ pub struct ColumnSpec {
     pub(crate) access: Access,
 }
 
-/// Every column of the layout, in the order of the spec (and of written files).
+/// Every column of the layout, in the order of docs/MEASUREMENTS.md (and of written files).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Column {
     /// `preload_n`: axial preload pressing rotor on stator, N, > 0 (required).
@@ -131,7 +131,7 @@ impl fmt::Debug for Access {
     }
 }
 
-/// Accesses compare by kind: the spec's `column` tells columns apart.
+/// Accesses compare by kind: the layout's `column` tells columns apart.
 impl PartialEq for Access {
     fn eq(&self, other: &Access) -> bool {
         self.kind() == other.kind()
@@ -340,7 +340,7 @@ pub const COLUMNS: [ColumnSpec; 14] = [
 ];
 
 impl Column {
-    /// All columns, in the order of the spec and of written files.
+    /// All columns, in the order of docs/MEASUREMENTS.md and of written files.
     pub const ALL: [Column; 14] = [
         Column::PreloadN,
         Column::VoltageV,

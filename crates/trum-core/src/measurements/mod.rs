@@ -1,4 +1,4 @@
-//! Measurement files: the CSV layout of `shared/spec/measurements.md`, read and written.
+//! Measurement files: the CSV layout of docs/MEASUREMENTS.md, read and written.
 //!
 //! The layout is a public interface. [`parse_measurements`] reads it to the letter and
 //! rejects anything that does not fit with a [`MeasurementError`] naming the source, the

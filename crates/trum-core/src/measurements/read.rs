@@ -298,10 +298,10 @@ fn unit_suffix(spec: &ColumnSpec) -> &'static str {
     spec.name.rsplit('_').next().unwrap_or("")
 }
 
-/// Reads a measurement file in the layout of the spec.
+/// Reads a measurement file in the layout of docs/MEASUREMENTS.md.
 ///
 /// `bytes` is the file's content; `source` names it in messages (usually the file name).
-/// Follows the spec to the letter: UTF-8 (a leading BOM is skipped), comma-separated,
+/// Follows the layout to the letter: UTF-8 (a leading BOM is skipped), comma-separated,
 /// one header row, column order free, blank lines skipped, `\n`, `\r\n` or `\r` line
 /// ends, cells trimmed of surrounding whitespace (inside quotes, kept), unknown columns
 /// kept in [`Measurements::extra_columns`] with one warning naming them. Errors for:

@@ -479,7 +479,7 @@ fn implausible_values_are_refused_with_line_and_column() {
         let e = PlausibleRanges::default().parse_assignment(bad).err().unwrap_or_else(|| panic!("{bad} accepted"));
         assert!(e.contains(why), "{bad}: {e}");
     }
-    // every default range holds the spec's own example values and lies inside the layout's range
+    // every default range holds docs/MEASUREMENTS.md's own example values and lies inside the layout's range
     for c in COLUMNS.iter().filter(|c| c.column.is_numeric()) {
         let (lo, hi) = c.plausible;
         assert!(lo < hi && lo.is_finite() && hi.is_finite(), "{}", c.name);

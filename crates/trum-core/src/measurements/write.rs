@@ -1,10 +1,10 @@
-//! The writer: [`Measurements`] in the layout of the spec, read back identically by
+//! The writer: [`Measurements`] in the layout of docs/MEASUREMENTS.md, read back identically by
 //! [`super::parse_measurements`].
 
 use super::{Column, Measurements};
 
 impl Measurements {
-    /// The data in the layout of the spec: a header of the present columns in layout
+    /// The data in that layout: a header of the present columns in layout
     /// order, one line per row, `\n` line ends. Numbers are written in their shortest
     /// form that reads back to the same `f64`; empty optional cells stay empty; `run_id`
     /// is quoted when it holds a comma, a quote or surrounding whitespace. Extra columns
