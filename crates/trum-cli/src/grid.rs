@@ -54,6 +54,27 @@ impl GridArgs {
     }
 }
 
+/// Margin of a default load-torque axis above the largest loaded stall torque: a few
+/// points past the torque where the loaded motor stops show that it stops there.
+pub const DEFAULT_TORQUE_MARGIN: f64 = 0.05;
+
+/// The top [N·m] of a default load-torque axis: [`DEFAULT_TORQUE_MARGIN`] above the
+/// largest loaded stall torque ([`trum_core::criterion::loaded_stall_torque_nm`], the load
+/// at which the loaded rotor stops) over the preloads of `preload` [N], at `voltage_v` [V]
+/// and `frequency_hz` [Hz]. The rotor-at-rest `stall_torque_nm` at no load can lie far
+/// above it (the amplitude falls under load), and an axis up to it would be mostly
+/// stalled or clamped rows. `None` when the rotor runs at none of the preloads.
+pub fn running_torque_top(motor: &trum_core::Motor, preload: &Axis, voltage_v: f64, frequency_hz: f64) -> Option<f64> {
+    use rayon::prelude::*;
+    let prep = trum_core::solve::Prepared::new(motor);
+    let largest = (0..preload.n)
+        .into_par_iter()
+        .map(|i| trum_core::criterion::loaded_stall_torque_nm(&prep, motor, preload.at(i), voltage_v, frequency_hz))
+        .filter(|t| t.is_finite() && *t > 0.0)
+        .reduce(|| 0.0, f64::max);
+    (largest > 0.0).then_some((1.0 + DEFAULT_TORQUE_MARGIN) * largest)
+}
+
 /// The fixed default grid (one point: 250 N, 0 N·m, 200 V, 43 kHz).
 pub fn default_grid() -> Grid {
     Grid {

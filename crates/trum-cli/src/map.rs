@@ -17,7 +17,7 @@ use clap::Args;
 use rayon::prelude::*;
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
-use trum_core::quantities::{self, Quantity, QUANTITIES};
+use trum_core::quantities::{Quantity, QUANTITIES};
 use trum_core::solve::Prepared;
 use trum_core::sweep::{
     axis_values, chunk_count, chunk_range, solve_range, Axis, Grid, LineStall, AXES, CHUNK_POINTS, LOADED_STALL_COLUMN,
@@ -61,28 +61,22 @@ pub struct MapArgs {
 }
 
 /// The map of a motor when nothing sets the axes: preload 100-500 N in 9 steps, load
-/// torque from 0 to the stall torque at the highest preload in 25 steps (rounded up to
-/// two significant digits), at the motor's drive (its `[drive]`, else 200 V, 43 kHz).
+/// torque from 0 to 5 % above the largest loaded stall torque over those preloads
+/// ([`crate::grid::running_torque_top`], rounded up to two significant digits) in 25
+/// steps, at the motor's drive (its `[drive]`, else 200 V, 43 kHz).
 fn motor_default_grid(motor: &Motor, drive: Option<trum_core::params::Drive>) -> Result<Grid> {
     let (v, f) = drive
         .map_or((crate::grid::DEFAULT_VOLTAGE_V, crate::grid::DEFAULT_FREQUENCY_HZ), |d| (d.voltage_v, d.frequency_hz));
     let preload = Axis::linspace(100.0, 500.0, 9);
-    let op = trum_core::OperatingPoint {
-        preload_n: preload.stop,
-        torque_nm: 0.0,
-        voltage_v: v,
-        frequency_hz: f,
-        elapsed_s: 0.0,
-    };
-    let stall = trum_core::solve(motor, &op).stall_torque_nm;
-    if !(stall.is_finite() && stall > 0.0) {
+    let Some(stall) = crate::grid::running_torque_top(motor, &preload, v, f) else {
         bail!(
-            "the motor does not run at {} N, {} V, {} Hz, so it has no default map: give the axes (e.g. --preload-n 100:500:9 --torque-nm 0:1:25)",
+            "the motor does not run at {}-{} N, {} V, {} Hz, so it has no default map: give the axes (e.g. --preload-n 100:500:9 --torque-nm 0:1:25)",
+            preload.start,
             preload.stop,
             v,
             f
         );
-    }
+    };
     let step = 10f64.powf(stall.log10().floor() - 1.0);
     let top = (stall / step).ceil() * step;
     Ok(Grid {
@@ -127,9 +121,11 @@ pub fn default_columns() -> Vec<MapColumn> {
     QUANTITIES.iter().map(MapColumn::Quantity).chain([MapColumn::LoadedStall]).collect()
 }
 
-/// Parses `--columns`: known quantity names (and `loaded_stall_torque_nm`), no duplicates.
+/// Parses `--columns`: names of [`default_columns`], no duplicates. The accepted names and
+/// the list an unknown name's error prints are both that list, so they always agree.
 pub fn parse_columns(spec: Option<&str>) -> Result<Vec<MapColumn>> {
     let Some(spec) = spec else { return Ok(default_columns()) };
+    let known = default_columns();
     let mut cols: Vec<MapColumn> = Vec::new();
     for name in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         if INPUT_COLUMNS.contains(&name) || name == "status" || name == "warnings" {
@@ -137,15 +133,11 @@ pub fn parse_columns(spec: Option<&str>) -> Result<Vec<MapColumn>> {
                 "--columns: '{name}' is always written (inputs, status and warnings come first); list only quantities"
             );
         }
-        let c = if name == LOADED_STALL_COLUMN.0 {
-            MapColumn::LoadedStall
-        } else {
-            MapColumn::Quantity(quantities::find(name).map_err(|m| {
-                let known = quantities::QUANTITIES.iter().map(|q| q.name).chain([LOADED_STALL_COLUMN.0]);
-                let hint = crate::suggest::hint(name, crate::suggest::names(known));
-                anyhow!("--columns: {m}{hint}")
-            })?)
-        };
+        let c = *known.iter().find(|k| k.name() == name).ok_or_else(|| {
+            let names: Vec<&str> = known.iter().map(MapColumn::name).collect();
+            let hint = crate::suggest::hint(name, crate::suggest::names(names.iter().copied()));
+            anyhow!("--columns: unknown quantity '{name}'; valid quantities are: {}{hint}", names.join(", "))
+        })?;
         if cols.iter().any(|k| k.name() == c.name()) {
             bail!("--columns: '{name}' is listed twice");
         }
@@ -511,6 +503,26 @@ mod tests {
         f.push(&mut out, f64::NAN);
         f.push(&mut out, f64::INFINITY);
         assert!(out.is_empty());
+    }
+
+    /// The list an unknown `--columns` name prints is exactly the set of names
+    /// `--columns` accepts: every listed name parses on its own, and every accepted
+    /// column (the defaults, `loaded_stall_torque_nm` among them) is listed.
+    #[test]
+    fn unknown_column_error_lists_exactly_the_accepted_columns() {
+        let msg = format!("{:#}", parse_columns(Some("speed_rmp")).expect_err("an unknown name is an error"));
+        let list = msg.split("valid quantities are: ").nth(1).expect("the message lists the names");
+        let list = list.split("; did you mean").next().unwrap_or(list);
+        let listed: Vec<&str> = list.split(", ").collect();
+        let accepted: Vec<&str> = default_columns().iter().map(MapColumn::name).collect();
+        assert_eq!(listed, accepted, "{msg}");
+        assert!(listed.contains(&LOADED_STALL_COLUMN.0), "{msg}");
+        for name in listed {
+            let cols = parse_columns(Some(name)).unwrap_or_else(|e| panic!("listed '{name}' is refused: {e}"));
+            assert_eq!(cols.iter().map(MapColumn::name).collect::<Vec<_>>(), [name]);
+        }
+        // the hint still points at the near miss
+        assert!(msg.ends_with("; did you mean 'speed_rpm'?"), "{msg}");
     }
 
     #[test]

@@ -17,7 +17,7 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use trum_core::quantities::QUANTITIES;
-use trum_core::solve::{solve_prepared, Prepared};
+use trum_core::solve::Prepared;
 use trum_core::sweep::{axis_values, chunk_count, chunk_range, solve_range, Axis, Grid, AXES};
 use trum_core::{Motor, OperatingPoint, Solution};
 
@@ -57,7 +57,7 @@ impl Kind {
         }
     }
 
-    /// Default grid for `--motor` (torque `None`: from zero to just above the stall torque).
+    /// Default grid for `--motor` (torque `None`: from zero to just above the largest loaded stall torque).
     fn default_axes(self) -> (Axis, Option<Axis>, Axis, Axis) {
         let (f, v) = (Axis::fixed(43_000.0), Axis::fixed(200.0));
         match self {
@@ -412,7 +412,8 @@ fn fonts_available() -> bool {
 }
 
 /// The grid for `--motor`: command line, then `[sweep]`, then the kind's defaults. An unset
-/// torque axis runs from zero to 5 % above the largest no-load stall torque.
+/// torque axis runs from zero to 5 % above the largest loaded stall torque over the
+/// preload axis, as `trum map`'s default grid ([`crate::grid::running_torque_top`]).
 fn plot_grid(motor: &Motor, a: &PlotArgs, sweep: &trum_core::params::SweepTable, x: &str) -> Result<Grid> {
     let (p, t, mut v, mut f) = match a.kind {
         Some(k) => k.default_axes(),
@@ -437,16 +438,9 @@ fn plot_grid(motor: &Motor, a: &PlotArgs, sweep: &trum_core::params::SweepTable,
         if let Some(t) = t {
             grid.torque_nm = t;
         } else {
-            let prep = Prepared::new(motor);
-            let stall = (0..grid.preload_n.n)
-                .map(|i| {
-                    let op =
-                        OperatingPoint::new(grid.preload_n.at(i), 0.0, grid.voltage_v.start, grid.frequency_hz.start);
-                    solve_prepared(&prep, motor, &op, None).stall_torque_nm
-                })
-                .filter(|s| s.is_finite())
-                .fold(0.0, f64::max);
-            let top = if stall > 0.0 { 1.05 * stall } else { 1.0 };
+            let top =
+                crate::grid::running_torque_top(motor, &grid.preload_n, grid.voltage_v.start, grid.frequency_hz.start)
+                    .unwrap_or(1.0);
             grid.torque_nm = Axis::linspace(0.0, top, 61);
         }
     }
@@ -1163,4 +1157,41 @@ fn efficiency_plane<DB: DrawingBackend>(
         }
     }
     colour_bar(&bar, z_name, zr, fz, look)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        plot: PlotArgs,
+    }
+
+    /// An unset torque axis ends 5 % above the largest loaded stall torque over the
+    /// preloads (where the loaded motor stops), not at the rotor-at-rest stall torque,
+    /// which for trum60a lies far beyond where it runs.
+    #[test]
+    fn default_torque_axis_ends_just_above_the_largest_loaded_stall_torque() {
+        let cli = Cli::try_parse_from(["plot", "--motor", "trum60a", "--kind", "speed-torque", "-o", "p.svg"])
+            .expect("arguments");
+        let (motor, sweep) = crate::motor::load_motor("trum60a").expect("preset");
+        let grid = plot_grid(&motor, &cli.plot, &sweep, "torque_nm").expect("grid");
+        let (v, f) = (grid.voltage_v.start, grid.frequency_hz.start);
+        assert_eq!((v, f), (200.0, 42_000.0), "the preset's [drive]");
+        let prep = Prepared::new(&motor);
+        let (mut loaded, mut at_rest) = (0.0f64, 0.0f64);
+        for i in 0..grid.preload_n.n {
+            let p = grid.preload_n.at(i);
+            loaded = loaded.max(trum_core::criterion::loaded_stall_torque_nm(&prep, &motor, p, v, f));
+            at_rest = at_rest.max(trum_core::solve(&motor, &OperatingPoint::new(p, 0.0, v, f)).stall_torque_nm);
+        }
+        let top = grid.torque_nm.stop;
+        assert!((top / (1.05 * loaded) - 1.0).abs() < 1e-12, "axis ends at {top} N·m, largest loaded stall {loaded}");
+        // the rotor-at-rest torque is well above it here, so the old axis was mostly stopped rows
+        assert!(at_rest > 1.3 * loaded, "at rest {at_rest}, loaded {loaded}");
+        assert_eq!((grid.torque_nm.start, grid.torque_nm.n), (0.0, 61));
+    }
 }

@@ -21,7 +21,7 @@ use std::io::Write;
 use std::path::PathBuf;
 use trum_core::dynamics::bar_type::{bar_step_response, BarMotor, BarStepConfig};
 use trum_core::dynamics::transient::{
-    steady_comparison, step_response, SteadyComparison, StepResponse, TransientConfig, TransientError,
+    steady_comparison, step_response, SteadyComparison, SteadyGap, StepResponse, TransientConfig, TransientError,
 };
 use trum_core::sweep::Axis;
 use trum_core::Motor;
@@ -97,8 +97,9 @@ struct Run {
     frequency_hz: f64,
     phase_deg: f64,
     result: Result<StepResponse, TransientError>,
-    /// The steady solver at the same point (ring motors only).
-    steady: Option<SteadyComparison>,
+    /// The steady solver at the same point, signed as the wave turns the rotor, or why it
+    /// does not describe the point (ring motors only: `None` for a bar-type motor).
+    steady: Option<Result<SteadyComparison, SteadyGap>>,
 }
 
 /// The motor of a run: a ring motor (driven by a voltage, with a steady solver) or a
@@ -147,7 +148,8 @@ fn quantities(r: &Run) -> Vec<(&'static str, f64, &'static str, &'static str)> {
     };
     let opt = |v: Option<f64>| v.unwrap_or(nan);
     let rel = |x: f64, y: f64| (x - y) / y;
-    let st = |f: fn(&SteadyComparison) -> f64| r.steady.as_ref().map_or(nan, f);
+    // empty where the steady model does not describe the point (no solver, or a SteadyGap)
+    let st = |f: fn(&SteadyComparison) -> f64| r.steady.and_then(Result::ok).as_ref().map_or(nan, f);
     let speed = a.map_or(nan, |a| a.speed_rpm);
     let torque = a.map_or(nan, |a| a.contact_torque_nm);
     let amp = a.map_or(nan, |a| a.amplitude_m);
@@ -329,6 +331,9 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
             }
         }
     }
+    if !single {
+        gap_notes(&runs, err)?;
+    }
     if let Some(path) = &a.table {
         write_atomic(path, ".csv", &table_csv(&runs, drive_name), out)?;
     }
@@ -375,11 +380,15 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
                 run.insert("preload_n".into(), crate::data::num(preload));
                 run.insert("torque_nm".into(), crate::data::num(a.torque_nm));
                 run.insert("status".into(), status(&r.result).into());
-                // (no steady solver for a bar-type motor)
-                run.insert(
-                    "steady_status".into(),
-                    r.steady.as_ref().map_or(serde_json::Value::Null, |s| s.status.to_string().into()),
-                );
+                // (no steady solver for a bar-type motor; a point outside the steady model
+                // is `not_comparable`, with the reason)
+                let (steady_status, steady_note) = match &r.steady {
+                    None => (serde_json::Value::Null, serde_json::Value::Null),
+                    Some(Ok(s)) => (s.status.to_string().into(), serde_json::Value::Null),
+                    Some(Err(g)) => (NOT_COMPARABLE.into(), g.to_string().into()),
+                };
+                run.insert("steady_status".into(), steady_status);
+                run.insert("steady_note".into(), steady_note);
                 run.insert("quantities".into(), q.into());
                 serde_json::Value::Object(run)
             })
@@ -400,6 +409,34 @@ pub fn run(a: &StepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32
         print_sweep(&runs, drive_name, summary)?;
     }
     Ok(0)
+}
+
+/// The steady status of a point the steady model does not describe ([`SteadyGap`]).
+const NOT_COMPARABLE: &str = "not_comparable";
+
+/// One note on `err` per kind of [`SteadyGap`] in a sweep, with the phases it applies to:
+/// the steady columns of those points are empty.
+fn gap_notes(runs: &[Run], err: &mut dyn Write) -> Result<()> {
+    let gaps: Vec<(f64, SteadyGap)> =
+        runs.iter().filter_map(|r| r.steady.and_then(Result::err).map(|g| (r.phase_deg, g))).collect();
+    let mut kinds: Vec<SteadyGap> = Vec::new();
+    for (_, g) in &gaps {
+        if !kinds.iter().any(|k| k.as_str() == g.as_str()) {
+            kinds.push(*g);
+        }
+    }
+    for first in kinds {
+        let mut phases: Vec<f64> = gaps.iter().filter(|(_, g)| g.as_str() == first.as_str()).map(|(p, _)| *p).collect();
+        phases.sort_by(f64::total_cmp);
+        phases.dedup();
+        let list: Vec<String> = phases.iter().map(|p| fmt_sig(*p, 6)).collect();
+        writeln!(
+            err,
+            "note: no steady comparison (steady_* empty) at phase difference {} deg: {first}",
+            list.join(", ")
+        )?;
+    }
+    Ok(())
 }
 
 /// The resolved defaults shown in the summary.
@@ -467,13 +504,17 @@ fn print_single(r: &Run, motor: &StepMotor, a: &StepArgs, shown: &Shown, out: &m
         (1.0 / (r.frequency_hz * resp.time_step_s)).round(),
     )?;
     match &r.steady {
-        Some(st) => writeln!(out, "status   {} (steady solver: {})", status(&r.result), st.status)?,
+        Some(Ok(st)) => writeln!(out, "status   {} (steady solver: {})", status(&r.result), st.status)?,
+        Some(Err(_)) => writeln!(out, "status   {} (steady solver: {NOT_COMPARABLE})", status(&r.result))?,
         None => writeln!(out, "status   {} (bar-type motor: no steady solver)", status(&r.result))?,
     }
     writeln!(out)?;
     let rows: Vec<Vec<String>> =
         quantities(r).into_iter().map(|(n, v, u, m)| vec![n.into(), fmt_sig(v, 6), u.into(), m.into()]).collect();
     write_table(out, &["quantity", "value", "unit", "meaning"], &[Align::Left, Align::Right, Align::Left], &rows)?;
+    if let Some(Err(gap)) = &r.steady {
+        writeln!(out, "note     no steady comparison (steady_* empty): {gap}")?;
+    }
     for s in &resp.snapshots {
         let (nc, st, sl) = s.counts();
         writeln!(
@@ -591,7 +632,7 @@ fn speed_plot(resp: &StepResponse, r: &Run, name: &str, drive_unit: &str, preloa
         line(&t.speed_rpm, RGBColor(170, 170, 170), "rotor speed", Stroke::Solid),
         line(&t.speed_period_mean_rpm, series_color(0, 3), "mean over a drive period", Stroke::Solid),
     ];
-    if let Some(v) = r.steady.map(|s| s.speed_rpm).filter(|v| v.is_finite()) {
+    if let Some(v) = r.steady.and_then(Result::ok).map(|s| s.speed_rpm).filter(|v| v.is_finite()) {
         let (t0, t1) = (t.time_s.first().copied().unwrap_or(0.0), t.time_s.last().copied().unwrap_or(0.0));
         lines.push(Line {
             label: Some("steady-state solver".into()),

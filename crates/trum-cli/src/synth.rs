@@ -55,12 +55,13 @@ pub struct SynthArgs {
     /// (what calibration must absorb).
     #[arg(long, default_value_t = 0.03, value_name = "REL")]
     perturbation: f64,
-    /// Drive voltage amplitude of the fixed-drive runs, zero-to-peak per phase [V].
-    #[arg(long, default_value_t = 200.0)]
-    voltage_v: f64,
-    /// Drive frequency of the fixed-drive runs [Hz].
-    #[arg(long, default_value_t = 43_000.0)]
-    frequency_hz: f64,
+    /// Drive voltage amplitude of the fixed-drive runs, zero-to-peak per phase [V]
+    /// (default: the motor's [drive], else 200).
+    #[arg(long, allow_hyphen_values = true)]
+    voltage_v: Option<f64>,
+    /// Drive frequency of the fixed-drive runs [Hz] (default: the motor's [drive], else 43000).
+    #[arg(long, allow_hyphen_values = true)]
+    frequency_hz: Option<f64>,
     /// Simulate the effects in their candidate forms (the forms the diagnosis fits). By
     /// default effects use their truth forms, which differ in form from the candidates, as
     /// a real motor would.
@@ -104,13 +105,27 @@ pub fn parse_omit(spec: Option<&str>) -> Result<Vec<Observable>> {
     Ok(v)
 }
 
+/// The fixed drive of the campaign, voltage [V] and frequency [Hz]: each given option,
+/// else the motor's `[drive]` (as `trum point`, `trum map` and `trum step` take it), else
+/// the core's [`SynthConfig`] default (200 V, 43 kHz), so that a motor without a `[drive]`
+/// gives the same file as the core's own synthesis.
+fn drive(a: &SynthArgs) -> Result<(f64, f64)> {
+    let own = crate::optimize::motor_drive(&a.motor.motor)?;
+    let core = SynthConfig::default();
+    Ok((
+        a.voltage_v.or(own.map(|d| d.voltage_v)).unwrap_or(core.voltage_v),
+        a.frequency_hz.or(own.map(|d| d.frequency_hz)).unwrap_or(core.frequency_hz),
+    ))
+}
+
 pub fn run(a: &SynthArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i32> {
     let (motor, _) = a.motor.load()?;
     // The motor file's (or preset's) own effects are part of the nominal model a diagnosis
     // of these data starts from: they keep their candidate forms; only what --effect adds
     // or changes takes a truth form.
     let own = crate::motor::load_motor(&a.motor.motor)?.0.effects;
-    for (flag, v) in [("--voltage-v", a.voltage_v), ("--frequency-hz", a.frequency_hz)] {
+    let (voltage_v, frequency_hz) = drive(a)?;
+    for (flag, v) in [("--voltage-v", voltage_v), ("--frequency-hz", frequency_hz)] {
         if !(v.is_finite() && v > 0.0) {
             bail!("{flag} {v} must be a finite number > 0");
         }
@@ -121,8 +136,8 @@ pub fn run(a: &SynthArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
         seed: a.seed,
         motor_seed: a.motor_seed,
         perturbation: a.perturbation,
-        voltage_v: a.voltage_v,
-        frequency_hz: a.frequency_hz,
+        voltage_v,
+        frequency_hz,
         truth_forms: !a.candidate_forms,
         truth_form_b: a.truth_forms_b,
         nominal_effects: own,
@@ -157,10 +172,12 @@ pub fn run(a: &SynthArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
         };
         writeln!(
             err,
-            "wrote {} rows to '{}': campaign {}, noise {}, seed {}{}, effects {}{forms}",
+            "wrote {} rows to '{}': campaign {} at {} V, {} Hz, noise {}, seed {}{}, effects {}{forms}",
             rows.len(),
             a.output.display(),
             a.campaign.to_possible_value().map(|v| v.get_name().to_string()).unwrap_or_default(),
+            crate::format::fmt_sig(voltage_v, 6),
+            crate::format::fmt_sig(frequency_hz, 6),
             a.noise,
             a.seed,
             a.motor_seed.filter(|&m| m != a.seed).map(|m| format!(" (motor seed {m})")).unwrap_or_default(),

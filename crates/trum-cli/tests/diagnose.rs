@@ -43,6 +43,59 @@ fn synth(dir: &Path, name: &str, extra: &[&str]) -> String {
     p
 }
 
+/// `trum synth` drives its fixed-drive runs at the motor's `[drive]` unless told, as every
+/// other command does (trum60-qut: 150 V, 42 kHz); `--voltage-v` and `--frequency-hz`
+/// override it; a motor without a `[drive]` (the frozen reference motor of the blind
+/// benchmark) runs at the core's `SynthConfig` default, 200 V and 43 kHz, and the file is
+/// byte for byte the core's own synthesis of it.
+#[test]
+fn synth_drives_at_the_motors_drive_unless_told() {
+    let base = ["--campaign", "stability", "--noise", "0", "--seed", "1", "-o", "-"];
+    // every row's (voltage_v, frequency_hz)
+    let drives = |csv: &str| -> Vec<(f64, f64)> {
+        let mut lines = csv.lines();
+        let h: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+        let (iv, ifr) = (
+            h.iter().position(|c| *c == "voltage_v").expect("voltage_v column"),
+            h.iter().position(|c| *c == "frequency_hz").expect("frequency_hz column"),
+        );
+        let num = |s: &str| s.parse::<f64>().unwrap_or_else(|_| panic!("'{s}' is not a number"));
+        lines
+            .map(|l| {
+                let c: Vec<&str> = l.split(',').collect();
+                (num(c[iv]), num(c[ifr]))
+            })
+            .collect()
+    };
+    let close = |got: &[(f64, f64)], want: (f64, f64)| {
+        assert_eq!(got.len(), 8, "{got:?}");
+        for &(v, f) in got {
+            assert!((v - want.0).abs() < 1e-9 * want.0 && (f - want.1).abs() < 1e-9 * want.1, "{got:?} vs {want:?}");
+        }
+    };
+    close(&drives(&ok(&[&["synth", "--motor", "trum60-qut"][..], &base[..]].concat())), (150.0, 42_000.0));
+    let told = ["--voltage-v", "180", "--frequency-hz", "43500"];
+    close(&drives(&ok(&[&["synth", "--motor", "trum60-qut"][..], &told[..], &base[..]].concat())), (180.0, 43_500.0));
+    let only_v = ["--voltage-v", "120"];
+    close(&drives(&ok(&[&["synth", "--motor", "trum60-qut"][..], &only_v[..], &base[..]].concat())), (120.0, 42_000.0));
+    let file = ok(&[&["synth", "--motor", MOTOR][..], &base[..]].concat());
+    close(&drives(&file), (200.0, 43_000.0));
+    let motor = trum_core::Motor::from_toml_str(&std::fs::read_to_string(MOTOR).expect("motor file"), MOTOR)
+        .expect("reference motor");
+    let cfg = trum_core::synth::SynthConfig {
+        campaign: trum_core::synth::Campaign::Stability,
+        noise: 0.0,
+        seed: 1,
+        nominal_effects: motor.effects.clone(),
+        ..trum_core::synth::SynthConfig::default()
+    };
+    let rows = trum_core::synth::synthesize(&motor, &cfg).expect("synth");
+    let core = trum_core::bench::to_measurements(&rows).expect("measurements").to_csv_string();
+    assert_eq!(file, core, "the CLI's file of a motor without [drive] is the core's default synthesis");
+    let e = fails(&[&["synth", "--motor", "trum60-qut", "--voltage-v", "-5"][..], &base[..]].concat(), 1);
+    assert!(e.contains("--voltage-v -5 must be a finite number > 0"), "{e}");
+}
+
 #[test]
 fn synth_writes_a_valid_reproducible_file() {
     let dir = tempfile::tempdir().expect("tempdir");

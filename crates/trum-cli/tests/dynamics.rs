@@ -373,6 +373,62 @@ fn step_sweep_over_phase_table() {
     assert!((delay(0) - delay(2)).abs() < 1e-6 * delay(2), "{} vs {}", delay(0), delay(2));
 }
 
+/// The steady comparison takes the wave's direction: at -90 deg it is the +90 deg steady
+/// solution mirrored (negative speed and contact torque), so the relative differences are
+/// those of +90 deg (to 1e-6), not about -2; at a phase with a standing part (-45, 0,
+/// 45 deg), or under a load with the reversed wave, the steady model says nothing: the
+/// steady cells are empty, and a note says why.
+#[test]
+fn step_steady_comparison_follows_the_wave_and_is_empty_where_it_does_not_apply() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let table = dir.path().join("t.csv");
+    let args = [
+        &["step", "--motor", FROZEN_TRUM60A, "--phase-difference-deg", "-90:90:5", "--table", p(&table), "-q"][..],
+        &FAST[..],
+    ]
+    .concat();
+    let o = trum(&args);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let (h, rows) = csv_rows(&std::fs::read_to_string(&table).expect("table"));
+    let col = |name: &str| h.iter().position(|c| c == name).unwrap_or_else(|| panic!("no column {name}"));
+    let at = |i: usize, name: &str| num(&rows[i][col(name)]);
+    assert_eq!(rows.iter().map(|r| num(&r[2])).collect::<Vec<_>>(), [-90.0, -45.0, 0.0, 45.0, 90.0]);
+    assert!(at(4, "steady_speed_rpm") > 50.0 && at(4, "steady_contact_torque_nm") > 0.0);
+    assert_eq!(at(0, "steady_speed_rpm"), -at(4, "steady_speed_rpm"));
+    assert_eq!(at(0, "steady_contact_torque_nm"), -at(4, "steady_contact_torque_nm"));
+    assert_eq!(at(0, "steady_amplitude_m"), at(4, "steady_amplitude_m"));
+    for q in ["speed_difference", "torque_difference"] {
+        let (back, fwd) = (at(0, q), at(4, q));
+        assert!(fwd.abs() < 0.15 && (back - fwd).abs() < 1e-6, "{q}: {back} at -90 deg, {fwd} at +90 deg");
+    }
+    let steady_cols =
+        ["steady_speed_rpm", "speed_difference", "steady_contact_torque_nm", "torque_difference", "steady_amplitude_m"];
+    for (i, r) in rows.iter().enumerate().take(4).skip(1) {
+        for q in steady_cols {
+            assert_eq!(r[col(q)], "", "row {i} ({} deg), {q}: no number where the steady model does not apply", r[2]);
+        }
+        assert_ne!(r[col("final_speed_rpm")], "", "the transient itself is still reported");
+    }
+    assert!(err.contains("note: no steady comparison (steady_* empty) at phase difference -45, 0, 45 deg"), "{err}");
+    assert!(err.contains("partly a standing wave"), "{err}");
+
+    // one point: the table says so beside the empty values; --json gives the reason
+    let out = ok(&[&["step", "--motor", FROZEN_TRUM60A, "--phase-difference-deg", "45"][..], &FAST[..]].concat());
+    assert!(out.contains("(steady solver: not_comparable)") && out.contains("partly a standing wave"), "{out}");
+    let j: serde_json::Value = serde_json::from_str(&ok(&[
+        &["step", "--motor", FROZEN_TRUM60A, "--phase-difference-deg", "-90", "--torque-nm", "0.1", "--json", "-q"][..],
+        &FAST[..],
+    ]
+    .concat()))
+    .expect("JSON");
+    let run = &j["runs"][0];
+    assert_eq!(run["steady_status"], "not_comparable");
+    assert!(run["steady_note"].as_str().is_some_and(|n| n.contains("drives the rotor")), "{run}");
+    assert!(run["quantities"]["steady_speed_rpm"].is_null() && run["quantities"]["speed_difference"].is_null());
+    assert!(run["quantities"]["final_speed_rpm"].as_f64().is_some_and(|v| v < 0.0), "{run}");
+}
+
 #[test]
 fn step_bad_input_and_failed_runs_leave_no_file() {
     let dir = tempfile::tempdir().expect("tempdir");

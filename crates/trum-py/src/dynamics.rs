@@ -12,7 +12,7 @@ use trum_core::dynamics::hertz::{
     identify_beta, BetaIdentificationInput, HertzError, HertzOscillator, OperatingPoint, ResponseMethod,
 };
 use trum_core::dynamics::transient::{
-    steady_comparison, step_response, SteadyComparison, StepResponse, TransientConfig, TransientError,
+    steady_comparison, step_response, SteadyComparison, SteadyGap, StepResponse, TransientConfig, TransientError,
 };
 use trum_core::layout::{
     response_rows, response_status, response_summary, ResponseCell, ResponseRow, RESPONSE_COLUMNS,
@@ -394,7 +394,7 @@ pub fn bar_step<'py>(
 fn response_dict<'py>(
     py: Python<'py>,
     r: StepResponse,
-    steady: Option<SteadyComparison>,
+    steady: Option<Result<SteadyComparison, SteadyGap>>,
     mu: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let series = PyDict::new(py);
@@ -437,17 +437,18 @@ fn response_dict<'py>(
             ("stick_fraction", a.stick_fraction),
         ],
     )?;
+    // A point the steady model does not describe (a SteadyGap) keeps the dict's keys, with
+    // NaN numbers, the status `not_comparable` and the reason in `note`.
     let st = match steady {
         Some(steady) => {
-            let st = float_dict(
-                py,
-                &[
-                    ("speed_rpm", steady.speed_rpm),
-                    ("contact_torque_nm", steady.contact_torque_nm),
-                    ("amplitude_m", steady.amplitude_m),
-                ],
-            )?;
-            st.set_item("status", steady.status.as_str())?;
+            let (nums, status, note) = match steady {
+                Ok(s) => ([s.speed_rpm, s.contact_torque_nm, s.amplitude_m], s.status.as_str(), None),
+                Err(g) => ([f64::NAN; 3], "not_comparable", Some(g.to_string())),
+            };
+            let st =
+                float_dict(py, &[("speed_rpm", nums[0]), ("contact_torque_nm", nums[1]), ("amplitude_m", nums[2])])?;
+            st.set_item("status", status)?;
+            st.set_item("note", note)?;
             Some(st)
         }
         None => None,

@@ -148,9 +148,18 @@ def test_step_settles_near_the_steady_solver_and_reverses():
     # -90 deg is motion the other way: ok, negative speed, the same delay
     assert back.status == "ok" and back.metrics["final_speed_rpm"] < 0
     assert back.metrics["delay_s"] == pytest.approx(r.metrics["delay_s"], rel=1e-6)
-    standing = trum.step(BASE, phase_difference_deg=0.0, **FAST)
+    # ... compared with the mirrored steady solution: the forward run's difference, not about -2
+    assert back.steady["status"] == "ok" and back.steady["note"] is None and r.steady["note"] is None
+    assert back.steady["speed_rpm"] == -r.steady["speed_rpm"]
+    assert back.steady["contact_torque_nm"] == -r.steady["contact_torque_nm"]
+    assert back.speed_difference() == pytest.approx(r.speed_difference(), abs=1e-6)
+    # a standing part (0 deg) is outside the steady model: NaN, with the reason, and a warning
+    with pytest.warns(UserWarning, match="partly a standing wave"):
+        standing = trum.step(BASE, phase_difference_deg=0.0, **FAST)
     assert standing.status == "not_moving" and standing.metrics["delay_s"] is None
     assert abs(standing.averages["speed_rpm"]) < 1e-3 * r.averages["speed_rpm"]
+    assert standing.steady["status"] == "not_comparable" and "standing wave" in standing.steady["note"]
+    assert math.isnan(standing.steady["speed_rpm"]) and math.isnan(standing.speed_difference())
 
 
 def test_step_runs_the_bar_type_motor_at_the_papers_conditions():

@@ -72,7 +72,15 @@ def test_step_optimum_diagnosis_plots_and_compact_reprs():
         s = trum.step("trum60a", duration_s=2e-3, nodes_per_wavelength=64)
     ax = s.plot()
     assert ax.get_xlabel() == "Time [ms]" and "preload 260 N" in ax.get_title()
+    assert "steady-state solver" in ax.get_legend_handles_labels()[1]
     assert len(repr(s)) < 600 and "StepResult" in repr(s)
+    # no steady line where there is no steady comparison: a standing part, a bar-type motor
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        partly = trum.step("trum60a", phase_difference_deg=45.0, duration_s=2e-3, nodes_per_wavelength=64)
+    bar = trum.step("bar36", duration_s=2e-3, nodes_per_wavelength=64)
+    for r in (partly, bar):
+        assert "steady-state solver" not in r.plot().get_legend_handles_labels()[1]
     r = trum.resonance(voltage_v=[100, 200, 300], preload_n=400.0)
     assert len(repr(r)) < 400 and all(len(repr(c)) < 200 for c in r.curves)
     o = trum.optimize("trum60a", preload_n=trum.linspace(150, 500, 8), torque_samples=8)

@@ -416,29 +416,92 @@ pub(crate) fn response(out: sim::RunOutput, plant: &sim::Plant) -> StepResponse 
 }
 
 /// The steady-state solver's answer at the operating point of a run, in the terms of
-/// [`SteadyAverages`], to compare a settled transient with.
+/// [`SteadyAverages`], signed as the run's rotation, to compare a settled transient with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SteadyComparison {
     /// Status of the steady solution; the numbers are NaN unless it is valid.
     pub status: Status,
-    /// Steady rotor speed [rpm].
+    /// Steady rotor speed [rpm], negative for a reversed wave (Δφ = −90°).
     pub speed_rpm: f64,
-    /// Contact torque at steady state: the load plus the rotor's viscous torque d_r·Ω [N·m].
+    /// Contact torque at steady state: the load plus the rotor's viscous torque d_r·Ω [N·m]
+    /// (negative with the speed for a reversed wave).
     pub contact_torque_nm: f64,
     /// Steady wave amplitude [m].
     pub amplitude_m: f64,
 }
 
+/// Largest |cos Δφ| at which a run's drive counts as a pure travelling wave (Δφ = ±90°
+/// within about 6·10⁻⁸ degrees): the only drive the steady model describes. Degrees
+/// converted to radians leave |cos| ≈ 10⁻¹⁶ at ±90°.
+pub const TRAVELLING_WAVE_COS_TOLERANCE: f64 = 1e-9;
+
+/// Why a run has no steady comparison ([`steady_comparison`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SteadyGap {
+    /// The phase difference is not ±90°: the drive is a travelling wave plus a standing
+    /// part, which the steady model (a pure travelling wave) does not describe.
+    StandingPart {
+        /// Phase of phase B behind phase A [deg].
+        phase_difference_deg: f64,
+    },
+    /// A reversed wave (−90°) under a load torque: the load acts against positive rotation
+    /// whatever the wave (`T_load` in the rotor equation), so it drives the reversed rotor
+    /// along, while the steady model's load always opposes the rotation.
+    LoadAlongReversedRotation {
+        /// Load torque [N·m].
+        load_torque_nm: f64,
+    },
+}
+
+impl SteadyGap {
+    /// A one-word name for status columns.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            SteadyGap::StandingPart { .. } => "standing_wave_part",
+            SteadyGap::LoadAlongReversedRotation { .. } => "load_along_rotation",
+        }
+    }
+}
+
+impl std::fmt::Display for SteadyGap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            // (the phase is left out: a sweep's note lists the phases of one reason)
+            SteadyGap::StandingPart { .. } => f.write_str(
+                "a phase difference other than +90 or -90 deg makes the drive partly a standing wave; \
+                 the steady model describes a pure travelling wave only",
+            ),
+            SteadyGap::LoadAlongReversedRotation { load_torque_nm } => write!(
+                f,
+                "the load torque {load_torque_nm} N·m acts against positive rotation, so it drives the rotor \
+                 of a reversed wave (-90 deg) along; the steady model's load always opposes the rotation"
+            ),
+        }
+    }
+}
+
 /// Solves the steady model ([`crate::solve`]) at the preload, load, voltage and frequency
-/// of `cfg` (the steady model has no phase difference: it assumes the travelling wave).
-pub fn steady_comparison(motor: &Motor, cfg: &TransientConfig) -> SteadyComparison {
+/// of `cfg`, for the direction of its travelling wave: at Δφ = +90° as it is; at −90° with
+/// no load mirrored (the rotor equation and the contact are symmetric under x → −x), so
+/// speed and contact torque take the reversed wave's negative sign. Any other phase
+/// difference, or a load under a reversed wave, is outside the steady model: the
+/// [`SteadyGap`] says why, and no number is given.
+pub fn steady_comparison(motor: &Motor, cfg: &TransientConfig) -> Result<SteadyComparison, SteadyGap> {
+    let (sin, cos) = cfg.phase_difference_rad.sin_cos();
+    if cos.is_nan() || cos.abs() > TRAVELLING_WAVE_COS_TOLERANCE {
+        return Err(SteadyGap::StandingPart { phase_difference_deg: cfg.phase_difference_rad.to_degrees() });
+    }
+    let direction = sin.signum();
+    if direction < 0.0 && cfg.load_torque_nm != 0.0 {
+        return Err(SteadyGap::LoadAlongReversedRotation { load_torque_nm: cfg.load_torque_nm });
+    }
     let s = solve(motor, &OperatingPoint::new(cfg.preload_n, cfg.load_torque_nm, cfg.voltage_v, cfg.frequency_hz));
     let valid = s.status.is_valid();
     let v = |x: f64| if valid { x } else { f64::NAN };
-    SteadyComparison {
+    Ok(SteadyComparison {
         status: s.status,
-        speed_rpm: v(s.speed_rpm),
-        contact_torque_nm: v(cfg.load_torque_nm + motor.rotor.viscous_damping_nms * s.speed_rad_s),
+        speed_rpm: v(direction * s.speed_rpm),
+        contact_torque_nm: v(cfg.load_torque_nm + motor.rotor.viscous_damping_nms * direction * s.speed_rad_s),
         amplitude_m: v(s.amplitude_m),
-    }
+    })
 }

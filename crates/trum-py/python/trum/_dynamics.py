@@ -289,7 +289,10 @@ class Snapshot:
 
 @dataclass(frozen=True)
 class StepResult:
-    """Result of :func:`step`. ``steady`` is ``None`` for a bar-type motor (no steady solver)."""
+    """Result of :func:`step`. ``steady`` is ``None`` for a bar-type motor (no steady solver);
+    at a phase difference other than ±90° (partly a standing wave), or under a load with the
+    reversed wave (−90°), its numbers are NaN, its ``status`` is ``'not_comparable'`` and its
+    ``note`` says why (``note`` is ``None`` otherwise)."""
 
     series: Dict[str, np.ndarray]
     metrics: Dict[str, Optional[float]]
@@ -305,7 +308,7 @@ class StepResult:
 
     def speed_difference(self) -> float:
         """(settled transient speed − steady-solver speed) / steady-solver speed (NaN
-        without a steady solver)."""
+        without a steady solver or where it does not describe the point)."""
         if self.steady is None:
             return float("nan")
         return (self.averages["speed_rpm"] - self.steady["speed_rpm"]) / self.steady["speed_rpm"]
@@ -324,7 +327,8 @@ class StepResult:
         ax.plot(t * ft, self.series[y], lw=0.6, color="0.6", label="rotor speed")
         if y == "speed_rpm" and "speed_period_mean_rpm" in self.series:
             ax.plot(t * ft, self.series["speed_period_mean_rpm"], lw=1.4, color="C0", label="mean over a drive period")
-        if y == "speed_rpm" and self.steady.get("speed_rpm") is not None:
+        steady_speed = None if self.steady is None else self.steady.get("speed_rpm")
+        if y == "speed_rpm" and steady_speed is not None and np.isfinite(steady_speed):
             ax.axhline(self.steady["speed_rpm"], color="C3", ls="--", lw=1, label="steady-state solver")
         for key, words in (("delay_s", "delay"), ("settling_time_s", "settled")):
             v = self.metrics.get(key)
@@ -371,7 +375,9 @@ def step(
     """Step response of the rotor speed with the stick-slip contact ([BarTransient]): the drive
     switches on at t = 0. Returns the time series, the metrics (delay, rise times,
     peak time, overshoot, settling time; ``None`` where undefined, e.g. a standing wave at
-    0°), the settled averages, the steady-state solver at the same point and the contact
+    0°), the settled averages, the steady-state solver at the same point (mirrored for a
+    reversed wave at −90°: negative speed and torque; NaN with a ``UserWarning`` where it
+    does not describe the point, see :class:`StepResult`) and the contact
     snapshots at ``snapshot_at_s``. A negative final speed (e.g. at −90°) is rotation the
     other way, status ``ok``. The GIL is released while it runs.
 
@@ -441,5 +447,7 @@ def step(
         s["state"] = np.array(s["state"], dtype=object)
         snaps.append(Snapshot(**s))
     steady = None if d["steady"] is None else dict(d["steady"])
+    if steady is not None and steady.get("note"):
+        warnings.warn(f"no steady comparison (steady numbers NaN): {steady['note']}", stacklevel=2)
     return StepResult(dict(d["series"]), dict(d["metrics"]), d["status"], dict(d["averages"]), steady,
                       snaps, d["time_step_s"], d["steps"], cond, name)

@@ -89,6 +89,54 @@ fn standing_wave_does_not_turn_the_rotor_and_minus_90_reverses() {
     assert!((d_back - d_fwd).abs() < 1e-3 * d_fwd, "{d_back} vs {d_fwd}");
 }
 
+/// The steady comparison takes the wave's direction: at −90° (no load) it is the +90°
+/// solution mirrored, negative speed and contact torque, and the reversed transient lies
+/// as close to it as the forward one to its own; a phase with a standing part, or a load
+/// under the reversed wave, has no steady number at all.
+#[test]
+fn steady_comparison_follows_the_wave_and_leaves_out_what_it_does_not_describe() {
+    use std::f64::consts::FRAC_PI_2;
+    let m = motor();
+    let c = TransientConfig { duration_s: 3e-3, ..cfg(300.0, 64) };
+    let fwd = steady_comparison(&m, &c).expect("+90 deg is a travelling wave");
+    let at = |deg: f64, load: f64| {
+        steady_comparison(
+            &m,
+            &TransientConfig { phase_difference_rad: deg.to_radians(), load_torque_nm: load, ..c.clone() },
+        )
+    };
+    let back = at(-90.0, 0.0).expect("-90 deg is a travelling wave");
+    assert_eq!(fwd.status, Status::Ok);
+    assert!(fwd.speed_rpm > 50.0 && fwd.contact_torque_nm > 0.0, "{fwd:?}");
+    // the mirror image, exactly
+    assert_eq!(back.status, fwd.status);
+    assert_eq!(back.speed_rpm, -fwd.speed_rpm);
+    assert_eq!(back.contact_torque_nm, -fwd.contact_torque_nm);
+    assert_eq!(back.amplitude_m, fwd.amplitude_m);
+    // -90 deg given in radians directly, and as +270 deg, is the same reversed wave
+    let direct = steady_comparison(&m, &TransientConfig { phase_difference_rad: -FRAC_PI_2, ..c.clone() });
+    assert_eq!(direct, Ok(back));
+    assert_eq!(at(270.0, 0.0), Ok(back));
+    // the transient runs settle on the same side of it: final/steady - 1 equal to 1e-6
+    let (tf, tb) = (run(&c), run(&TransientConfig { phase_difference_rad: -FRAC_PI_2, ..c.clone() }));
+    let (df, db) = (tf.averages.speed_rpm / fwd.speed_rpm - 1.0, tb.averages.speed_rpm / back.speed_rpm - 1.0);
+    assert!(df > 0.0 && df < 0.15, "{df}");
+    assert!((db - df).abs() < 1e-6, "reversed {db} vs forward {df}");
+    let (qf, qb) =
+        (tf.averages.contact_torque_nm / fwd.contact_torque_nm, tb.averages.contact_torque_nm / back.contact_torque_nm);
+    assert!((qb - qf).abs() < 1e-6 && (qf - 1.0).abs() < 0.15, "{qb} vs {qf}");
+    // a standing part (anything but +-90 deg) is outside the steady model
+    for deg in [0.0, 45.0, -45.0, 89.0, 180.0] {
+        match at(deg, 0.0) {
+            Err(SteadyGap::StandingPart { phase_difference_deg: d }) => assert!((d - deg).abs() < 1e-9, "{d} vs {deg}"),
+            other => panic!("{deg} deg: {other:?}"),
+        }
+    }
+    // so is a load under the reversed wave (it turns with the rotor); +90 deg takes it
+    assert_eq!(at(-90.0, 0.1), Err(SteadyGap::LoadAlongReversedRotation { load_torque_nm: 0.1 }));
+    assert_eq!(at(90.0, 0.1).map(|s| s.status), Ok(Status::Ok));
+}
+
 /// Trends of the bar-type transient paper Fig. 3-5: speed grows with voltage and near resonance; the
 /// response is a lightly damped second-order-like step with overshoot, settling in a few ms.
 #[test]
