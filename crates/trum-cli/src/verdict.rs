@@ -68,6 +68,7 @@ mod tests {
             n_readings: 30,
             folds: 4,
             baseline_params: vec![],
+            baseline_held_near_prior: vec![],
             heldout: vec![],
         };
         let w = verdict_words(&d);

@@ -150,6 +150,7 @@ pub fn to_json(d: &Diagnosis, src: &Provenance<'_>) -> Value {
         "n_readings": d.n_readings,
         "folds": d.folds,
         "baseline_params": pairs(&d.baseline_params),
+        "baseline_held_near_prior": d.baseline_held_near_prior,
         "motor": { "name": src.motor_name, "source": src.motor_source },
         "data": src.data,
         "heldout": d.heldout.iter().map(|h| json!({

@@ -195,6 +195,10 @@ pub struct Diagnosis {
     pub folds: usize,
     /// Baseline parameters calibrated on all data (name, value).
     pub baseline_params: Vec<(String, f64)>,
+    /// The baseline parameters with a prior that the data did not identify (their
+    /// posterior standard error not well inside the prior's width): held near their
+    /// priors, so their values are the priors' more than the data's.
+    pub baseline_held_near_prior: Vec<String>,
     /// Per held-out reading: (row index, observable, measured, baseline prediction,
     /// prediction with the verdict's effects) — for plots.
     pub heldout: Vec<HeldOut>,
@@ -399,6 +403,13 @@ pub fn diagnose(
         n_readings: ctx.n_read,
         folds: ctx.k,
         baseline_params: base.cal.params.iter().map(|p| (p.name.clone(), p.value)).collect(),
+        baseline_held_near_prior: base
+            .cal
+            .params
+            .iter()
+            .filter(|p| p.prior_rel_sd.is_some() && !p.identifiable)
+            .map(|p| p.name.clone())
+            .collect(),
         heldout,
     }))
 }

@@ -790,3 +790,28 @@ fn a_strong_compliance_is_reached_from_its_own_valley() {
     let (_, s) = tc.params.iter().find(|(k, _)| k.ends_with("shear_compliance_ratio")).expect("strength");
     assert!((1.5..3.0).contains(s), "fitted strength {s}");
 }
+
+/// The diagnosis names the baseline parameters its data leave at their priors, as
+/// calibration does: every one of them a calibrated parameter with a prior; fewer of them
+/// on a whole campaign than on a handful of its rows (more readings narrow more
+/// parameters), and on the whole campaign not the resonance frequency, which every reading
+/// of a drive near resonance pins down.
+#[test]
+fn the_parameters_the_data_leave_at_their_priors_are_named() {
+    let nominal = crate::calibrate::tests::reference_motor();
+    let (rows, groups) = data(&nominal, 1.0, 21);
+    let opts = DiagnoseOptions { candidates: vec![Effect::VoltageSag], ..quick(false) };
+    let full = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+    let few: Vec<usize> = (0..rows.len()).step_by(rows.len() / 8).collect();
+    let (rows8, groups8): (Vec<ObservedRow>, Vec<String>) =
+        few.iter().map(|&i| (rows[i].clone(), groups[i].clone())).unzip();
+    let small = diagnose(&nominal, &rows8, &groups8, &opts).expect("diagnosis");
+    for d in [&full, &small] {
+        for n in &d.baseline_held_near_prior {
+            assert!(d.baseline_params.iter().any(|(k, _)| k == n), "{n} is not a calibrated parameter");
+            assert!(!n.starts_with("effects."), "{n}");
+        }
+    }
+    assert!(full.baseline_held_near_prior.len() < small.baseline_held_near_prior.len());
+    assert!(!full.baseline_held_near_prior.iter().any(|n| n == "stator.resonance_frequency_hz"));
+}
