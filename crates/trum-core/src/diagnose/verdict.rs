@@ -9,6 +9,13 @@ use super::{same_set, signature, RankEntry};
 use crate::effects::Effect;
 use std::collections::BTreeMap;
 
+/// The bootstrap 5 % bound of an entry's z² shrink (1 − √(Σz²_after/Σz²_before)) above
+/// which its held-out gain is material wherever the baseline stands: a fifth of the
+/// held-out z² gone at least. On every null case of the blind benchmark's halves, their
+/// fresh draws and the stress set the bound stayed below 0.045, and below 0.03 on the
+/// weak effects whose baseline is at the noise.
+pub(super) const CERTAIN_Z2_GAIN: f64 = 0.1;
+
 /// The tests of a ranking entry against the held-out gap of the baseline.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct GapTests {
@@ -75,8 +82,18 @@ impl GapTests {
     /// weighs each quantity by its spread, so a quantity that no model moves (a speed
     /// spread at its instrument floor, a temperature that barely rises) can be most of it
     /// and hide what an effect closes on the others; z² weighs every reading by its noise.
+    /// Or a gain certain in both measures and large in σ, whatever the baseline's z²: the
+    /// bootstrap 5 % bound of the NRMSE's shrink above zero and that of the z² shrink at
+    /// least [`CERTAIN_Z2_GAIN`]. A baseline whose held-out z² is near one by the noise
+    /// levels estimated from the data can still miss a structure the effect predicts on
+    /// held-out data (a weak warm-up drift on a combined campaign: z² 1.09 → 0.76, evidence
+    /// 104, was `none`).
     pub(super) fn material(&self, r: &RankEntry) -> bool {
-        Self::supported(r) && (r.shrink >= 0.2 || self.excess_shrink(r) >= 0.25 || self.z2_excess_shrink(r) >= 0.25)
+        Self::supported(r)
+            && (r.shrink >= 0.2
+                || self.excess_shrink(r) >= 0.25
+                || self.z2_excess_shrink(r) >= 0.25
+                || (r.shrink_interval.0 > 0.0 && r.z2_shrink_interval.0 >= CERTAIN_Z2_GAIN))
     }
 
     /// An entry closes the gap when it removes a material part of it and what it leaves is
@@ -262,7 +279,15 @@ mod tests {
     /// An entry with `shrink` of the held-out NRMSE 0.4 gone (to `nrmse`), χ² `chi2` per
     /// reading left, evidence `evidence`.
     fn entry(effect: &str, evidence: f64, shrink: f64, chi2: f64) -> RankEntry {
-        RankEntry { evidence, shrink, ..ranked(effect, chi2, 0.4 * (1.0 - shrink)) }
+        // (bootstrap intervals about the shrink, in both measures)
+        let interval = (0.5 * shrink, 1.5 * shrink);
+        RankEntry {
+            evidence,
+            shrink,
+            shrink_interval: interval,
+            z2_shrink_interval: interval,
+            ..ranked(effect, chi2, 0.4 * (1.0 - shrink))
+        }
     }
 
     fn none_preds() -> BTreeMap<String, Vec<Vec<f64>>> {
@@ -363,16 +388,45 @@ mod tests {
         assert!((tests.z2_excess_shrink(&drift) - (1.0 - (0.59f64 / 2.33).sqrt())).abs() < 1e-9);
         assert!(tests.material(&drift) && tests.closes(&drift));
         // a fifth of the z² excess is not enough
-        let sliver = RankEntry { heldout_chi2_after: 1.0 + 2.33 * 0.8 * 0.8, ..drift.clone() };
+        // (its z² from 3.33 to 2.49: 1 − √(2.49/3.33) = 0.135 of it gone in σ, the bootstrap
+        // bound below a tenth)
+        let sliver =
+            RankEntry { heldout_chi2_after: 1.0 + 2.33 * 0.8 * 0.8, z2_shrink_interval: (0.08, 0.19), ..drift.clone() };
         assert!(!tests.material(&sliver));
         // no gap in σ to close: z² alone makes nothing material
         let quiet = GapTests { base_z2: 1.8, ..tests };
-        let polish = RankEntry { heldout_chi2_after: 1.05, ..drift.clone() };
+        let polish = RankEntry { heldout_chi2_after: 1.05, z2_shrink_interval: (0.01, 0.05), ..drift.clone() };
         assert_eq!(quiet.z2_excess_shrink(&polish), 0.0);
         assert!(!quiet.material(&polish));
         // unsupported entries are never material
         let unsupported = RankEntry { shrink_interval: (-0.01, 0.2), z2_shrink_interval: (-0.01, 0.2), ..drift };
         assert!(!tests.material(&unsupported));
+    }
+
+    /// Where the baseline's held-out z² is near one, an entry whose held-out gain is certain
+    /// in both measures and takes a fifth of the z² at the bootstrap bound is material (a
+    /// weak warm-up drift on a combined campaign: z² 1.09 → 0.76, interval [0.124, 0.195],
+    /// NRMSE shrink 0.055 in [0.037, 0.081]) and closes the gap; one whose z² bound is
+    /// lower (a weak runout seen only in the mean speed: [0.028, 0.10]), or whose NRMSE
+    /// gain is not certain, is not.
+    #[test]
+    fn a_gain_certain_and_large_in_sigma_is_material_at_the_noise() {
+        let tests = GapTests { base_nrmse: 0.064, gap_noise: 0.065, base_z2: 1.09, n_read: 640 };
+        let drift = RankEntry {
+            evidence: 104.0,
+            shrink: 0.055,
+            shrink_interval: (0.037, 0.081),
+            z2_shrink_interval: (0.124, 0.195),
+            ..ranked("thermal_drift", 0.76, 0.0605)
+        };
+        assert!(drift.shrink < 0.2 && tests.excess_shrink(&drift) < 0.25 && tests.z2_excess_shrink(&drift) == 0.0);
+        assert!(tests.material(&drift) && tests.closes(&drift));
+        let runout = RankEntry { z2_shrink_interval: (0.028, 0.10), ..drift.clone() };
+        assert!(!tests.material(&runout));
+        let uncertain = RankEntry { shrink_interval: (-0.01, 0.081), ..drift.clone() };
+        assert!(!tests.material(&uncertain));
+        let at_bound = RankEntry { z2_shrink_interval: (CERTAIN_Z2_GAIN, 0.2), ..drift };
+        assert!(tests.material(&at_bound));
     }
 
     /// A held-out gain that is certain in σ is real even where a few readings of a
