@@ -65,6 +65,10 @@ pub struct Factors {
     pub power_du: f64,
     /// See `power_du`.
     pub radial_du: f64,
+    /// ∂²torque/∂u² at fixed contact, for the speed solve's third-order (Halley) steps and
+    /// its estimate of a Newton step's error; NaN where the route does not sum it (the
+    /// general saturating laws), which leaves the speed solve to plain Newton steps.
+    pub torque_uu: f64,
 }
 
 impl Factors {
@@ -77,6 +81,7 @@ impl Factors {
         self.torque_du += o.torque_du;
         self.power_du += o.power_du;
         self.radial_du += o.radial_du;
+        self.torque_uu += o.torque_uu;
     }
 
     /// The factors at u + `du` to first order (the integrand's derivatives at fixed nodes,
@@ -343,7 +348,8 @@ fn accumulate(f: &mut Factors, s: f64, co: f64, w: f64, c: f64, u: f64, rho: f64
 
 /// The node sums of the Coulomb law with radial slip (g = 1/D), in local accumulators.
 /// With D² = dt² + dr² and dt = cos θ − u the integrands simplify: power = u·torque +
-/// ∫q·D, ∂torque/∂u = −∫q·dr²/D³, ∂power/∂u = u·∂torque/∂u, ∂radial/∂u = ∫q·dr²·dt/D³.
+/// ∫q·D, ∂torque/∂u = −∫q·dr²/D³, ∂power/∂u = u·∂torque/∂u, ∂radial/∂u = ∫q·dr²·dt/D³,
+/// ∂²torque/∂u² = −3∫q·dr²·dt/D⁵ (∂D/∂u = −dt/D).
 /// One square root and one division a node (the general route: the same plus six more
 /// products and two more accumulators through memory; callgrind: 60 % more instructions).
 /// Node k adds to partial sum k mod 4 and the node terms have no branch, so the compiler
@@ -357,6 +363,7 @@ fn accumulate(f: &mut Factors, s: f64, co: f64, w: f64, c: f64, u: f64, rho: f64
 fn coulomb_sums(nodes: &Nodes, c: f64, u: f64, rho: f64, weight: f64) -> Factors {
     const L: usize = 4;
     let (mut t, mut slip, mut t_u, mut rad, mut rad_u) = ([0.0; L], [0.0; L], [0.0; L], [0.0; L], [0.0; L]);
+    let mut t_uu = [0.0; L];
     // (panels add NODES = 12 nodes at a time)
     debug_assert_eq!(nodes.len % L, 0);
     for k0 in (0..nodes.len).step_by(L) {
@@ -371,12 +378,15 @@ fn coulomb_sums(nodes: &Nodes, c: f64, u: f64, rho: f64, weight: f64) -> Factors
             let id = 1.0 / d2.max(f64::MIN_POSITIVE).sqrt();
             let a = wq * id;
             let dr2 = dr * dr;
-            let b = a * dr2 * (id * id);
+            let id2 = id * id;
+            let b = a * dr2 * id2;
+            let bdt = b * dt;
             t[l] += a * dt;
             slip[l] += wq * (d2 * id);
             t_u[l] -= b;
             rad[l] += a * dr2;
-            rad_u[l] += b * dt;
+            rad_u[l] += bdt;
+            t_uu[l] += bdt * id2;
         }
     }
     let sum = |x: [f64; L]| (x[0] + x[1]) + (x[2] + x[3]);
@@ -388,17 +398,19 @@ fn coulomb_sums(nodes: &Nodes, c: f64, u: f64, rho: f64, weight: f64) -> Factors
         torque_du: weight * t_u,
         power_du: weight * u * t_u,
         radial_du: weight * rad_u,
+        torque_uu: -3.0 * weight * sum(t_uu),
     }
 }
 
 /// The node sums of the candidate saturating law without radial slip (ρ = 0, S = tanh):
 /// the traction per unit μp is g_t = tanh(dt/σ) (odd in the slip, so its sign needs no
-/// branch) and ∂g_t/∂u = −(1 − g_t²)/σ, with power = ∫q·g_t·cos θ: one exp and one
-/// division a node (the general route, [`accumulate`], takes D = |dt|, g = S(D/σ)/D and
-/// dg/dD: a square root and two more divisions). The two agree to rounding (test below).
+/// branch), ∂g_t/∂u = −(1 − g_t²)/σ and ∂²g_t/∂u² = −2·g_t·(1 − g_t²)/σ² =
+/// 2·g_t·(∂g_t/∂u)/σ, with power = ∫q·g_t·cos θ: one exp and one division a node (the
+/// general route, [`accumulate`], takes D = |dt|, g = S(D/σ)/D and dg/dD: a square root
+/// and two more divisions). The two agree to rounding (test below).
 fn compliance_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64, weight: f64) -> Factors {
     let inv_s = 1.0 / slip_scale;
-    let (mut t, mut t_u, mut p, mut p_u) = (0.0, 0.0, 0.0, 0.0);
+    let (mut t, mut t_u, mut p, mut p_u, mut t_uu) = (0.0, 0.0, 0.0, 0.0, 0.0);
     for k in 0..nodes.len {
         let (co, w) = (nodes.cos[k], nodes.weight[k]);
         let wq = w * (co - c).max(0.0);
@@ -409,6 +421,7 @@ fn compliance_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64, weight: f64) 
         t_u += wq * dg;
         p += wq * g * co;
         p_u += wq * dg * co;
+        t_uu += wq * g * dg;
     }
     Factors {
         torque: weight * t,
@@ -417,6 +430,7 @@ fn compliance_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64, weight: f64) 
         torque_du: weight * t_u,
         power_du: weight * p_u,
         radial_du: 0.0,
+        torque_uu: 2.0 * inv_s * weight * t_uu,
     }
 }
 
@@ -610,11 +624,13 @@ fn compliance_factors(ct: &Contact, uc: f64, u: f64, law: &Law, z: Option<(f64, 
 }
 
 /// The node sums of [`compliance_factors`]: q·(tanh x − sign x) and q·∂tanh(x)/∂u with
-/// x = (cos θ − u)/σ, and the same times cos θ. A node with x = +0 (cos θ rounded onto u)
-/// counts as beyond θs, where the Coulomb part takes the sign −1.
+/// x = (cos θ − u)/σ, and the same times cos θ; and q·∂²tanh(x)/∂u² =
+/// −q·2·tanh x·(1 − tanh² x)/σ², the whole torque's second derivative (the Coulomb part's
+/// step at θs moves with u, but the difference's step cancels it). A node with x = +0
+/// (cos θ rounded onto u) counts as beyond θs, where the Coulomb part takes the sign −1.
 fn compliance_window_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64) -> Factors {
     let inv_s = 1.0 / slip_scale;
-    let (mut t, mut t_u, mut p, mut p_u) = (0.0, 0.0, 0.0, 0.0);
+    let (mut t, mut t_u, mut p, mut p_u, mut t_uu) = (0.0, 0.0, 0.0, 0.0, 0.0);
     for k in 0..nodes.len {
         let (co, w) = (nodes.cos[k], nodes.weight[k]);
         let wq = w * (co - c).max(0.0);
@@ -631,14 +647,24 @@ fn compliance_window_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64) -> Fac
         } else {
             (0.0, 0.0)
         };
-        let d = if x > 0.0 { -a } else { a };
+        // tanh x − sign x, and tanh x = sign x·(1 − a)
+        let (d, g) = if x > 0.0 { (-a, 1.0 - a) } else { (a, a - 1.0) };
         let dg = -sech2 * inv_s;
         t += wq * d;
         t_u += wq * dg;
         p += wq * d * co;
         p_u += wq * dg * co;
+        t_uu += wq * g * dg;
     }
-    Factors { torque: t, power: p, radial: 0.0, torque_du: t_u, power_du: p_u, radial_du: 0.0 }
+    Factors {
+        torque: t,
+        power: p,
+        radial: 0.0,
+        torque_du: t_u,
+        power_du: p_u,
+        radial_du: 0.0,
+        torque_uu: 2.0 * inv_s * t_uu,
+    }
 }
 
 /// [`factors`] on the graded panels between `ends`, two panels at a time (one node array
@@ -673,7 +699,8 @@ fn node_sums(nodes: &Nodes, c: f64, u: f64, law: &Law) -> Factors {
         let part = if law.slip_scale > 0.0 && rho == 0.0 && !law.truth && law.sharpness == 1.0 {
             compliance_sums(nodes, c, u, law.slip_scale, weight)
         } else if law.slip_scale > 0.0 {
-            let mut g = Factors::default();
+            // (no second derivative on this route)
+            let mut g = Factors { torque_uu: f64::NAN, ..Factors::default() };
             for k in 0..nodes.len {
                 accumulate(&mut g, nodes.sin[k], nodes.cos[k], weight * nodes.weight[k], c, u, rho, law);
             }
@@ -885,10 +912,12 @@ fn csqrt(z: C64) -> C64 {
 /// arccos(u + Δc) for u = cos θs ∈ [−1, 1], `sin_ts` = sin θs, accurate in its imaginary
 /// part where u + Δc is near 1 (the crest). A real offset: arccos of c = u + Δc in [−1, 1],
 /// else i·arcosh c (c > 1) or π + i·arcosh(−c), with c ∓ 1 = (u ∓ 1) + Δc (exact
-/// differences, no cancellation). A complex one: small, as θs + δ by Newton steps on
-/// −2u·sin²(δ/2) − sin θs·sin δ = Δc (the identity for cos(θs + δ) − u, free of the
-/// cancellation in cos θ − u), from the root of its quadratic expansion nearest zero;
-/// large, by the library's arccos.
+/// differences, no cancellation). A complex one: small (|δ| ≤ 0.1), as θs + δ with δ the
+/// root nearest zero of the quadratic expansion of −2u·sin²(δ/2) − sin θs·sin δ = Δc (the
+/// identity for cos(θs + δ) − u, free of the cancellation in cos θ − u), within about
+/// |δ|²/6 of δ relative, plenty for grading panels; larger, by [`acos_complex`], on the
+/// branch ±arccos nearer that estimate (the one a continuation from θs reaches), and where
+/// |Δc| > 1/2 the principal one.
 fn arccos_near(u: f64, sin_ts: f64, dc: C64) -> C64 {
     if dc.im == 0.0 {
         let c = u + dc.re;
@@ -903,37 +932,54 @@ fn arccos_near(u: f64, sin_ts: f64, dc: C64) -> C64 {
         };
     }
     if dc.norm_sqr() > 0.25 {
-        return (dc + u).acos();
+        return acos_complex(u + dc.re, dc.im);
     }
     let root = csqrt(C64::new(sin_ts * sin_ts, 0.0) - dc * (2.0 * u));
-    let mut d = -dc * 2.0 / (root + sin_ts);
-    // the quadratic's root is within about |δ|²/6 of δ relative, plenty for grading panels
-    // up to |δ| = 0.1; beyond, Newton steps (two or three)
-    for _ in 0..20 {
-        // (squared moduli: no hypot call in the loop)
-        if d.norm_sqr() <= 0.01 {
-            break;
-        }
-        let (half, half_cos) = sin_cos_complex(d * 0.5);
-        // sin δ and cos δ by the double-angle formulas: one real sin_cos and one expm1 a
-        // step instead of three complex sines and cosines
-        let sd = half * half_cos * 2.0;
-        let cd = C64::new(1.0, 0.0) - half * half * 2.0;
-        let g = -half * half * (2.0 * u) - sd * sin_ts - dc;
-        let dg = -(sd * u + cd * sin_ts);
-        let step = g / dg;
-        d -= step;
-        // (a NaN step ends the steps too)
-        if step.norm_sqr().partial_cmp(&(1e-26 * d.norm_sqr())) != Some(std::cmp::Ordering::Greater) {
-            break;
-        }
+    let d = -dc * 2.0 / (root + sin_ts);
+    let ts = u.clamp(-1.0, 1.0).acos();
+    if d.norm_sqr() <= 0.01 {
+        return d + ts;
     }
-    d + u.clamp(-1.0, 1.0).acos()
+    let estimate = d + ts;
+    let p = acos_complex(u + dc.re, dc.im);
+    if (p - estimate).norm_sqr() <= (p + estimate).norm_sqr() {
+        p
+    } else {
+        -p
+    }
+}
+
+/// The principal arccos of the complex number x + iy, y ≠ 0 (Re in [0, π], Im of the sign
+/// of −y), from A = (|z + 1| + |z − 1|)/2 ≥ 1: Im = −sign(y)·arcosh A and
+/// Re = atan(√((A − x)(A + x))/x) (cos Re = x/A), each difference formed without
+/// cancellation (Hull, Fairgrieve and Tang 1997, ACM TOMS 23(3), 299-335, §3; x ≥ 0 here,
+/// arccos(−z) = π − arccos z). A few ulp in both parts: no series, no iteration, one
+/// `atan` and one `ln_1p` (Newton steps on the cosine identity need two or three complex
+/// sines and cosines to the same accuracy).
+fn acos_complex(x: f64, y: f64) -> C64 {
+    let xa = x.abs();
+    let y2 = y * y;
+    // |z + 1| and |z − 1| for z = |x| + iy (both O(1) or larger: no overflow before 1e150)
+    let r = ((xa + 1.0) * (xa + 1.0) + y2).sqrt();
+    let s = ((xa - 1.0) * (xa - 1.0) + y2).sqrt();
+    let a = 0.5 * (r + s);
+    // r − (|x| + 1) = y²/(r + |x| + 1) exactly; s − (1 − |x|) or s − (|x| − 1) likewise
+    let r_m = y2 / (r + xa + 1.0);
+    let (a_m1, a_mx) = if xa <= 1.0 {
+        (0.5 * (r_m + y2 / (s + 1.0 - xa)), 0.5 * (r_m + s + 1.0 - xa))
+    } else {
+        (0.5 * (r_m + s + xa - 1.0), 0.5 * (r_m + y2 / (s + xa - 1.0)))
+    };
+    let im = (a_m1 + (a_m1 * (a + 1.0)).sqrt()).ln_1p();
+    let re = if xa == 0.0 { std::f64::consts::FRAC_PI_2 } else { ((a_mx * (a + xa)).sqrt() / xa).atan() };
+    let re = if x < 0.0 { std::f64::consts::PI - re } else { re };
+    C64::new(re, -im.copysign(y))
 }
 
 /// (sin z, cos z) of a complex z = x + iy: sin x·cosh y + i·cos x·sinh y and
 /// cos x·cosh y − i·sin x·sinh y, with sinh y and cosh y from one e^y − 1 (no cancellation
-/// in sinh y for small y).
+/// in sinh y for small y). The Newton reference of [`acos_complex`] in the tests.
+#[cfg(test)]
 fn sin_cos_complex(z: C64) -> (C64, C64) {
     let (sx, cx) = z.re.sin_cos();
     let em = z.im.exp_m1();
@@ -1146,6 +1192,13 @@ pub(crate) fn coulomb_interface(
 /// where the drive still exceeds the load (f(guess) ≥ 0, so f(0) ≥ 0 too) it is not needed
 /// for the root: it is left NaN and computed once for the converged trial (`finish`),
 /// which saves one of the ~4 integrals per trial.
+///
+/// `rest_first`: take the rotor-at-rest integral before the guess (the previous trial of
+/// the descent stalled, so this one likely does too). torque(u) falls with u, so the rotor
+/// stalls exactly where f(0) < 0 whatever the start: a stalled trial then costs that one
+/// integral instead of the guess's and it, and a running one the same steps from the
+/// same guess, with f(0) known (the same root, the same factors).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn general_interface(
     p: &Prepared,
     d: &Drive,
@@ -1154,10 +1207,15 @@ pub(crate) fn general_interface(
     v0: f64,
     law: &Law,
     ts_guess: Option<f64>,
+    rest_first: bool,
 ) -> (f64, f64, bool, Factors, f64) {
     let visc = p.dr * v0 / p.r0;
+    let plain = plain_speed_solve();
+    let rest_first = rest_first && !plain;
     let rule = std::cell::RefCell::new(SpeedFreeRule::new());
     let f = |u: f64| {
+        #[cfg(test)]
+        SPEED_SOLVE_INTEGRALS.with(|n| n.set(n.get() + 1));
         let fac = factors_reusing(ct, u, law, &mut rule.borrow_mut());
         (tscale * fac.torque - d.t_load - visc * u, fac)
     };
@@ -1172,17 +1230,26 @@ pub(crate) fn general_interface(
         (f0, fac0)
     };
     let stall = |fac0, tf0| (contact::stall_stick_half_angle_rad(ct), 0.0, true, fac0, tf0);
+    if rest_first {
+        let (f0, fac0) = at_rest(&mut tf0);
+        if f0 < 0.0 {
+            return stall(fac0, tf0);
+        }
+        flo = f0;
+    }
     let (mut u, mut fu, mut fac) = match ts_guess.map(f64::cos).filter(|g| *g > 0.0 && *g < 1.0) {
         Some(g) => {
             let (fg, fac) = f(g);
             (g, fg, fac)
         }
         None => {
-            let (f0, fac0) = at_rest(&mut tf0);
-            if f0 < 0.0 {
-                return stall(fac0, tf0);
+            if flo.is_nan() {
+                let (f0, fac0) = at_rest(&mut tf0);
+                if f0 < 0.0 {
+                    return stall(fac0, tf0);
+                }
+                flo = f0;
             }
-            flo = f0;
             let (f1, fac1) = f(1.0);
             if f1 >= 0.0 {
                 return (0.0, v0, false, fac1, tf0);
@@ -1215,16 +1282,32 @@ pub(crate) fn general_interface(
             break;
         }
         let slope = tscale * fac.torque_du - visc;
-        let newton = u - fu / slope;
+        // f'' where the route sums ∂²torque/∂u² (NaN elsewhere)
+        let curv = if plain { f64::NAN } else { tscale * fac.torque_uu };
+        // Halley's step where f'' is known and the correction moderate: Newton's step
+        // −f/f' divided by 1 − L/2, L = f·f''/f'² (|L| ≤ 1: the divisor within [1/2, 3/2]).
+        // Its error is third order in the step, Newton's second: from the ~1e-2 to 1e-3
+        // of a cold start one integral fewer to the 1e-16 below which the step is carried.
+        let l = fu * curv / (slope * slope);
+        let newton = if l.abs() <= 1.0 { u - fu / slope / (1.0 - 0.5 * l) } else { u - fu / slope };
+        let step = newton - u;
         let is_newton = slope < 0.0 && newton > lo && newton < hi;
         if is_newton {
-            // After steps δ₁ then δ₂ the next would be about δ₂²/δ₁ (linear convergence at
-            // the observed ratio; quadratic gives less). Below 1e-16 in u the step is taken
-            // without another integral, the factors carried over it to first order: 1-2 of
-            // the 3-4 integrals of a solve (the second step from a warm start, the first after
-            // it in a Jacobian's changed motor) were only confirming a root already found.
-            let step = newton - u;
-            if last_newton.is_some_and(|d| step * step <= 1e-16 * d && step.abs() <= 1e-8) {
+            // Below 1e-16 in u a step is taken without another integral, the factors
+            // carried over it to first order (steps ≤ 1e-8). With f'' known, the error left
+            // after it is at most Newton's, |f''/(2f')|·δ², to leading order. Without it,
+            // after steps δ₁ then δ₂ the next would be about δ₂²/δ₁ (linear convergence at
+            // the observed ratio; quadratic gives less). Most such integrals would only
+            // confirm a root already found (the first step of a trial started from the
+            // previous trials' extrapolated stick angle, the second from a cold start).
+            let small = |d: Option<f64>| {
+                if curv.is_finite() {
+                    (0.5 * curv / slope).abs() * step * step <= 1e-16
+                } else {
+                    d.is_some_and(|d| step * step <= 1e-16 * d)
+                }
+            };
+            if step.abs() <= 1e-8 && small(last_newton) {
                 fac = fac.carried(step);
                 u = newton;
                 break;
@@ -1267,6 +1350,25 @@ pub(crate) fn general_interface(
     }
     let ts = u.clamp(-1.0, 1.0).acos().min(ct.half_angle_rad);
     (ts, u * v0, false, fac, tf0)
+}
+
+/// True when a test asks for the speed solve by plain Newton steps from the guess (no
+/// rest-first start, no Halley steps, no carry judged by f''): the reference the faster
+/// route is compared with.
+fn plain_speed_solve() -> bool {
+    #[cfg(test)]
+    if REFERENCE_SPEED_SOLVE.with(std::cell::Cell::get) {
+        return true;
+    }
+    false
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Set by a test: [`general_interface`] runs its reference route ([`plain_speed_solve`]).
+    pub(crate) static REFERENCE_SPEED_SOLVE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Interface integrals taken by [`general_interface`]'s speed solves on this thread.
+    pub(crate) static SPEED_SOLVE_INTEGRALS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
 }
 
 /// The friction law of the generalised interface at contact `ct` (the compliance's slip
@@ -1329,6 +1431,95 @@ mod tests {
         cuts.retain(|&x| (0.0..=phi0).contains(&x));
         cuts.sort_by(f64::total_cmp);
         cuts
+    }
+
+    /// The complex arccos by Newton steps from the quadratic estimate (the reference of
+    /// [`acos_complex`] in [`arccos_near`]): steps on −2u·sin²(δ/2) − sin θs·sin δ = Δc
+    /// until one is below 1e-13 of δ; above |Δc| = 1/2 the library's arccos.
+    fn arccos_near_by_newton(u: f64, sin_ts: f64, dc: C64) -> C64 {
+        if dc.norm_sqr() > 0.25 {
+            return (dc + u).acos();
+        }
+        let root = csqrt(C64::new(sin_ts * sin_ts, 0.0) - dc * (2.0 * u));
+        let mut d = -dc * 2.0 / (root + sin_ts);
+        for _ in 0..40 {
+            let (half, half_cos) = sin_cos_complex(d * 0.5);
+            let sd = half * half_cos * 2.0;
+            let cd = C64::new(1.0, 0.0) - half * half * 2.0;
+            let g = -half * half * (2.0 * u) - sd * sin_ts - dc;
+            let dg = -(sd * u + cd * sin_ts);
+            let step = g / dg;
+            d -= step;
+            if step.norm_sqr() <= 1e-26 * d.norm_sqr() {
+                break;
+            }
+        }
+        d + u.clamp(-1.0, 1.0).acos()
+    }
+
+    /// The arccos of a complex offset in closed form against Newton's root of the same
+    /// identity and the library's arccos: 200 000 random u ∈ [−1, 1] and Δc (|Δc| up to
+    /// 0.7, Im Δc down to 1e-12, at both ends of u), the same branch and each part within
+    /// 1e-12 (absolute, or relative where larger); every result's cosine is u + Δc.
+    #[test]
+    fn closed_form_complex_arccos_matches_newtons_root_and_the_library() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(91);
+        use rand::{RngExt, SeedableRng};
+        let (mut worst, mut closed, mut newton_failed) = (0.0f64, 0, 0);
+        for i in 0..200_000 {
+            let u: f64 = match i % 4 {
+                0 => 1.0 - 10f64.powf(rng.random_range(-12.0..0.0)),
+                1 => -1.0 + 10f64.powf(rng.random_range(-12.0..0.0)),
+                _ => rng.random_range(-1.0..1.0),
+            };
+            let sin_ts = ((1.0 - u) * (1.0 + u)).max(0.0).sqrt();
+            let m = rng.random_range(0.0..0.7);
+            let arg = rng.random_range(-std::f64::consts::PI..std::f64::consts::PI);
+            let mut dc = C64::from_polar(m, arg);
+            if i % 3 == 0 {
+                dc.im = 10f64.powf(rng.random_range(-12.0..-1.0)).copysign(dc.im);
+            }
+            if dc.im == 0.0 {
+                continue;
+            }
+            let root = csqrt(C64::new(sin_ts * sin_ts, 0.0) - dc * (2.0 * u));
+            let d0 = -dc * 2.0 / (root + sin_ts);
+            if dc.norm_sqr() <= 0.25 && d0.norm_sqr() <= 0.01 {
+                continue;
+            }
+            closed += 1;
+            let (a, b) = (arccos_near(u, sin_ts, dc), arccos_near_by_newton(u, sin_ts, dc));
+            // the same point of {±θ* + 2πk}, where Newton's steps may have crossed to another
+            // (compared as the representative with Re in [0, π])
+            let canonical = |z: C64| {
+                let re = z.re - 2.0 * PI * (z.re / (2.0 * PI)).round();
+                if re < 0.0 {
+                    C64::new(-re, -z.im)
+                } else {
+                    C64::new(re, z.im)
+                }
+            };
+            let root_of = |z: C64| (z.cos() - (dc + u)).norm() <= 1e-12 * (1.0 + z.norm()).powi(2);
+            assert!(root_of(a), "u {u}, dc {dc}: cos {a} is {}", a.cos());
+            // (Newton's steps stall short of the root in a few cases beyond c = ±1)
+            if !root_of(b) {
+                newton_failed += 1;
+                continue;
+            }
+            let (a, b) = (canonical(a), canonical(b));
+            for (x, y) in [(a.re, b.re), (a.im, b.im)] {
+                let err = (x - y).abs() / y.abs().max(1.0);
+                worst = worst.max(err);
+                assert!(err <= 1e-12, "u {u}, dc {dc}: closed form {a}, Newton {b}");
+            }
+        }
+        assert!(
+            closed > 50_000 && newton_failed * 100 < closed,
+            "{closed} closed forms, {newton_failed} Newton failures"
+        );
+        eprintln!(
+            "{closed} offsets by the closed form ({newton_failed} where Newton fails), worst difference {worst:.1e}"
+        );
     }
 
     #[test]
@@ -1461,10 +1652,13 @@ mod tests {
     /// radial slip or compliance (ρ = 0.0035, σ = 0.003) ∂torque/∂u is a narrow peak at θs
     /// that the plain rule's nodes straddle (20-30 % too small without graded panels),
     /// and the rotor-speed solve's Newton steps and their carried last step
-    /// (`general_interface`) rest on it.
+    /// (`general_interface`) rest on it. ∂²torque/∂u², which its Halley steps and its
+    /// judgement of a carried step rest on, against the same differences of ∂torque/∂u where
+    /// the route sums it (the Coulomb law with radial slip, the tanh saturation without it),
+    /// and NaN on the routes that do not (the truth forms), which keeps those to Newton.
     #[test]
     fn torque_derivative_matches_central_differences() {
-        let mut worst: f64 = 0.0;
+        let (mut worst, mut worst_uu): (f64, f64) = (0.0, 0.0);
         for law in [
             Law { radial_ratio: 0.5, slip_scale: 0.0, truth: false, truth_radial: false, sharpness: 1.0 },
             Law { radial_ratio: 0.0, slip_scale: 0.05, truth: false, truth_radial: false, sharpness: 1.0 },
@@ -1489,6 +1683,17 @@ mod tests {
                     assert!((an - fd).abs() < 1e-9 * fd.abs().max(1.0), "{law:?} y={y} u={u}: {an} vs {fd}");
                 }
                 assert!(at.torque_du < 0.0);
+                let fd = d(|x| x.torque_du);
+                if law.truth {
+                    assert!(at.torque_uu.is_nan(), "{law:?} y={y} u={u}: {}", at.torque_uu);
+                } else {
+                    worst_uu = worst_uu.max((at.torque_uu - fd).abs() / fd.abs().max(1.0));
+                    assert!(
+                        (at.torque_uu - fd).abs() < 1e-6 * fd.abs().max(1.0),
+                        "{law:?} y={y} u={u}: ∂²torque/∂u² {} vs {fd}",
+                        at.torque_uu
+                    );
+                }
                 // carried over a last Newton step (≤ 1e-8, solve::general_interface)
                 let du = 1e-8;
                 let (c, e) = (at.carried(du), factors(&ct, u + du, &law));
@@ -1497,7 +1702,7 @@ mod tests {
                 }
             }
         }
-        eprintln!("worst relative difference {worst:.1e}");
+        eprintln!("worst relative difference {worst:.1e}, of ∂²torque/∂u² {worst_uu:.1e}");
     }
 
     /// The rule against adaptive Gauss–Kronrod (`crate::quad`, 1e-12 relative) of the

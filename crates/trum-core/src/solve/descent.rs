@@ -5,7 +5,7 @@
 
 use super::bracket::SignBracket;
 use super::finish::{clamped_trial, finish};
-use super::trial::{trial, Drive, Trial};
+use super::trial::{trial_after, Drive, Trial};
 use super::{OperatingPoint, Prepared, Solution, Status};
 use crate::interface::AngleCarry;
 use crate::stator::{elastic_detuning, stiffness_crossing};
@@ -84,6 +84,9 @@ struct Trials<'a> {
     /// The last trial's amplitude W [m] and its contact and stick angles with their
     /// derivatives in W (the Coulomb interface only).
     carried: Option<(f64, [Option<AngleCarry>; 2])>,
+    /// True when the last trial stalled: the next one's speed solve then starts with the
+    /// rotor at rest (`trial_after`).
+    stalled: bool,
 }
 
 impl<'a> Trials<'a> {
@@ -95,7 +98,7 @@ impl<'a> Trials<'a> {
         let phi_guess =
             top.and_then(|t| t.contact_rad).or(guess.map(|g| g.contact_half_angle_rad)).filter(|t| t.is_finite());
         let general = p.law.radial_ratio != 0.0 || p.compliance != 0.0;
-        Trials { p, d, evals: 0, ts_guess, phi_guess, general, history: [None, None], carried: None }
+        Trials { p, d, evals: 0, ts_guess, phi_guess, general, history: [None, None], carried: None, stalled: false }
     }
 
     /// The trial at amplitude `w` [m].
@@ -112,7 +115,8 @@ impl<'a> Trials<'a> {
         let start = |i: usize, plain: Option<f64>| {
             carried.and_then(|(from, c)| c[i]?.start_at(from, w)).or(plain.map(|g| (g, None)))
         };
-        let t = trial(self.p, self.d, w, start(1, guess), start(0, self.phi_guess));
+        let t = trial_after(self.p, self.d, w, start(1, guess), start(0, self.phi_guess), self.stalled);
+        self.stalled = t.stalled;
         self.ts_guess = Some(t.ts);
         self.phi_guess = Some(t.contact.half_angle_rad).filter(|_| !t.contact.full);
         self.history = [self.history[1], Some((w, t.ts))];

@@ -31,10 +31,14 @@ pub(super) fn clamped_trial(p: &Prepared, d: &Drive) -> Trial {
 }
 
 /// The torque factor with the rotor at rest: the generalised interface leaves this
-/// integral to the converged trial (NaN until then).
+/// integral to the converged trial (NaN until then). Taken by the rule the speed solve
+/// takes at u = 0 (`factors_reusing`: the speed-free nodes where the integrand's nearest
+/// singularity is far from the contact, within 1e-12 of the split rule), so it is the
+/// value the speed solve finds wherever it integrates at rest itself.
 pub(super) fn rest_torque_factor(p: &Prepared, d: &Drive, t: &Trial) -> f64 {
     if t.tf0.is_nan() {
-        crate::interface::factors(&t.contact, 0.0, &interface_law(p, d, &t.contact)).torque
+        let law = interface_law(p, d, &t.contact);
+        crate::interface::factors_reusing(&t.contact, 0.0, &law, &mut crate::interface::SpeedFreeRule::new()).torque
     } else {
         t.tf0
     }

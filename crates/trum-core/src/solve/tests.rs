@@ -903,3 +903,99 @@ fn the_bounded_descent_finds_the_reference_descents_root() {
     assert!(multi >= 100, "only {multi} of {points} points have several fixed points");
     assert!(evals_bounded < evals_ref, "{evals_bounded} trials bounded, {evals_ref} reference");
 }
+
+/// The speed solve of the generalised interface (`interface::general_interface`) against
+/// its plain-Newton reference (`REFERENCE_SPEED_SOLVE`: from the guess, Newton steps, a
+/// step carried only after two): its faster route starts a trial after a stalled one with
+/// the rotor at rest, takes Halley steps where the node sums give ∂²torque/∂u² and judges
+/// the carried step by it. Both solve the same unique root of a falling torque(u) to 1e-14,
+/// so every point must come out with the same status and every quantity within 1e-9
+/// relative (of the value, or of 1e-3 of the quantity's largest value over the motor's
+/// points where the value is smaller: just below stall the speed is a difference of nearly
+/// equal torques), with fewer integrals. Random points through running and stalled states
+/// of `radial_friction` (small to large ρ, candidate and truth forms), `tangential_compliance`
+/// (tanh and the sharper saturation, which has no second derivative and keeps Newton's
+/// steps), both together, and `trum60a` as shipped.
+#[test]
+fn faster_speed_solves_give_the_plain_newton_solves_points() {
+    use crate::interface::{REFERENCE_SPEED_SOLVE, SPEED_SOLVE_INTEGRALS};
+    use crate::quantities::{values, QUANTITIES};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(20_261_129);
+    let sets: [(&str, &[&str], bool); 10] = [
+        ("trum60a as shipped", &[], false),
+        ("radial_friction=0.05", &["none", "radial_friction=0.05"], false),
+        ("radial_friction=1", &["none", "radial_friction=1"], false),
+        ("radial_friction=2.5", &["none", "radial_friction=2.5"], false),
+        ("radial_friction=0.5 truth", &["none", "radial_friction=0.5"], true),
+        ("tangential_compliance=1", &["none", "tangential_compliance=1"], false),
+        ("tangential_compliance=0.1", &["none", "tangential_compliance=0.1"], false),
+        (
+            "tangential_compliance sharp",
+            &["none", "tangential_compliance:shear_compliance_ratio=1,stick_sharpness=3"],
+            false,
+        ),
+        ("both", &["none", "radial_friction=0.5", "tangential_compliance=1"], false),
+        ("tangential_compliance=1 truth", &["none", "tangential_compliance=1"], true),
+    ];
+    let integrals = |f: &mut dyn FnMut() -> Solution| {
+        let before = SPEED_SOLVE_INTEGRALS.with(std::cell::Cell::get);
+        let s = f();
+        (s, SPEED_SOLVE_INTEGRALS.with(std::cell::Cell::get) - before)
+    };
+    let mut differ = Vec::new();
+    let (mut n_ref, mut n_fast, mut worst) = (0u64, 0u64, 0.0f64);
+    for (label, assignments, truth) in sets {
+        let mut m = crate::presets::preset("trum60a").expect("preset");
+        for a in assignments {
+            m.effects.parse_assignment(a).expect("assignment");
+        }
+        if truth {
+            m.effects.set_truth_forms(true);
+        }
+        let mut pairs = Vec::new();
+        let (mut stalled, mut running) = (0, 0);
+        for _ in 0..250 {
+            let op = OperatingPoint::new(
+                rng.random_range(60.0..400.0),
+                rng.random_range(0.0..1.4),
+                rng.random_range(100.0..300.0),
+                rng.random_range(41e3..45e3),
+            );
+            REFERENCE_SPEED_SOLVE.with(|c| c.set(true));
+            let (a, ia) = integrals(&mut || solve(&m, &op));
+            REFERENCE_SPEED_SOLVE.with(|c| c.set(false));
+            let (b, ib) = integrals(&mut || solve(&m, &op));
+            (n_ref, n_fast) = (n_ref + ia, n_fast + ib);
+            match a.status {
+                Status::Stall => stalled += 1,
+                Status::Ok => running += 1,
+                _ => {}
+            }
+            pairs.push((op, a, b));
+        }
+        println!("{label}: {stalled} stalled, {running} running points");
+        assert!(stalled >= 10 && running >= 10, "{label}: {stalled} stalled, {running} running points");
+        let largest: Vec<f64> = (0..QUANTITIES.len())
+            .map(|i| pairs.iter().map(|(_, a, _)| values(a)[i].abs()).filter(|v| v.is_finite()).fold(0.0, f64::max))
+            .collect();
+        for (op, a, b) in &pairs {
+            if a.status != b.status {
+                differ.push(format!("{label} {op:?}: status {:?} reference, {:?} fast", a.status, b.status));
+                continue;
+            }
+            for (i, (x, y)) in values(a).iter().zip(values(b)).enumerate() {
+                let scale = x.abs().max(1e-3 * largest[i]);
+                let same = x == &y || (x.is_nan() && y.is_nan()) || (x - y).abs() <= 1e-9 * scale;
+                if x != &y && x.is_finite() {
+                    worst = worst.max((x - y).abs() / scale);
+                }
+                if !same {
+                    differ.push(format!("{label} {op:?}: {} {x:e} reference, {y:e} fast", QUANTITIES[i].name));
+                }
+            }
+        }
+    }
+    println!("interface integrals: {n_ref} reference, {n_fast} fast; largest difference {worst:.1e} of the scale");
+    assert!(differ.is_empty(), "{} differences:\n{}", differ.len(), differ.join("\n"));
+    assert!(n_fast * 10 < n_ref * 9, "{n_fast} integrals fast, {n_ref} reference");
+}

@@ -184,6 +184,21 @@ pub(super) fn trial(
     ts_guess: Option<contact::AngleStart>,
     phi_guess: Option<contact::AngleStart>,
 ) -> Trial {
+    trial_after(p, d, w, ts_guess, phi_guess, false)
+}
+
+/// [`trial`] after a trial of the same descent that stalled (`after_stall`): the
+/// generalised interface then decides stall by the rotor-at-rest integral before it tries
+/// the guess (`general_interface`'s `rest_first`; the same trial, fewer integrals where it
+/// stalls again). The Coulomb interface ignores it.
+pub(super) fn trial_after(
+    p: &Prepared,
+    d: &Drive,
+    w: f64,
+    ts_guess: Option<contact::AngleStart>,
+    phi_guess: Option<contact::AngleStart>,
+    after_stall: bool,
+) -> Trial {
     let a = contact::force_scale_n(p.n, p.kf, w, p.k);
     let (ct, s0, c0) = contact::contact_from_ratio_near(d.f_n / a, phi_guess);
     let v0 = stator::crest_surface_speed_m_s(p.k, p.h0, d.omega, w);
@@ -205,7 +220,7 @@ pub(super) fn trial(
             let visc = p.dr * v0 / p.r0;
             contact::stick_half_angle_sin_cos(&ct, (s0, c0), tscale, d.t_load, visc, None).map(|r| r.0)
         });
-        let (t, v, st, fac, t0) = general_interface(p, d, &ct, tscale, v0, &law, guess);
+        let (t, v, st, fac, t0) = general_interface(p, d, &ct, tscale, v0, &law, guess, after_stall);
         (ts, vr, stalled, tf, pf, rf, tf0) = (t, v, st, fac.torque, fac.power, fac.radial, t0);
         (dpf, carry) = (f64::NAN, [None; 2]);
     }
