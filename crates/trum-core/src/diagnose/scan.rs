@@ -392,7 +392,9 @@ mod tests {
         for e in ALL {
             let mut forms: Vec<Vec<u64>> = grid(e, &[0.1, 0.2, 0.3])
                 .iter()
-                .map(|(_, v, _)| e.info().params.iter().zip(v).filter(|(q, _)| q.shape).map(|(_, x)| x.to_bits()).collect())
+                .map(|(_, v, _)| {
+                    e.info().params.iter().zip(v).filter(|(q, _)| q.shape).map(|(_, x)| x.to_bits()).collect()
+                })
                 .collect();
             forms.sort();
             forms.dedup();
