@@ -160,6 +160,15 @@ def test_step_settles_near_the_steady_solver_and_reverses():
     assert abs(standing.averages["speed_rpm"]) < 1e-3 * r.averages["speed_rpm"]
     assert standing.steady["status"] == "not_comparable" and "standing wave" in standing.steady["note"]
     assert math.isnan(standing.steady["speed_rpm"]) and math.isnan(standing.speed_difference())
+    # the load brakes either way: under a load -90 deg mirrors +90 deg, steady comparison included
+    fwd_l = trum.step(BASE, torque_nm=0.1, **FAST)
+    back_l = trum.step(BASE, phase_difference_deg=-90.0, torque_nm=0.1, **FAST)
+    assert back_l.averages["speed_rpm"] == pytest.approx(-fwd_l.averages["speed_rpm"], rel=1e-6)
+    assert 0 < fwd_l.averages["speed_rpm"] < r.averages["speed_rpm"]
+    assert back_l.steady["status"] == "ok" and back_l.steady["note"] is None
+    assert back_l.steady["speed_rpm"] == -fwd_l.steady["speed_rpm"]
+    assert back_l.steady["contact_torque_nm"] == -fwd_l.steady["contact_torque_nm"]
+    assert back_l.speed_difference() == pytest.approx(fwd_l.speed_difference(), abs=1e-6)
 
 
 def test_step_runs_the_bar_type_motor_at_the_papers_conditions():

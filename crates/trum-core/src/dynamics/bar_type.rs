@@ -370,7 +370,9 @@ pub struct BarStepConfig {
     pub nodes: usize,
     /// Phase of the y moment behind the x moment [rad]; π/2 travelling wave, 0 standing.
     pub phase_difference_rad: f64,
-    /// Load torque on the rotor [N·m], ≥ 0.
+    /// Load torque on the rotor T_load [N·m], ≥ 0: a Coulomb brake, T_load·sign Ω against
+    /// the rotation in either direction, holding the rotor at rest while |T_c| ≤ T_load
+    /// (the paper's eq. 4; the ring model's integrator, [`crate::dynamics::transient`]).
     pub load_torque_nm: f64,
     /// Drive moment amplitude per axis M₀ [N·m], > 0.
     pub moment_amplitude_nm: f64,
@@ -454,6 +456,7 @@ fn plant(m: &BarMotor, cfg: &BarStepConfig) -> Plant {
         nodes_per_wavelength: cfg.nodes,
         record_every: cfg.record_every,
         snapshot_times_s: cfg.snapshot_times_s.clone(),
+        initial_rotor_speed_rad_s: 0.0,
     }
 }
 

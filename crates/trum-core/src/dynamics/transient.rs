@@ -6,8 +6,14 @@
 //! stator modes  m·q̈_A + c·q̇_A + k_s·q_A = Θ·V·cos ωt        + Q_A
 //!               m·q̈_B + c·q̇_B + k_s·q_B = Θ·V·cos(ωt − Δφ) + Q_B
 //! rotor, axial  m_r·z̈ + d_z·ż + k_sp·(z − z₀) = F_c − F_N      (the bar-type transient paper eq. 5)
-//! rotor, turn   J_r·Ω̇ + d_r·Ω = T_c − T_load                   (the bar-type transient paper eq. 4)
+//! rotor, turn   J_r·Ω̇ + d_r·Ω = T_c − T_load·sign Ω            (the bar-type transient paper eq. 4)
 //! ```
+//!
+//! The load is a Coulomb brake of magnitude T_load ≥ 0 (a brake, a dynamometer, bearing
+//! friction): it opposes the rotation in either direction, and at rest (Ω = 0) it holds
+//! the rotor against any contact torque |T_c| ≤ T_load. The rotor equation is therefore
+//! odd in Ω, so a reversed wave (Δφ = −90°) under a load is the mirror image of the
+//! forward one. While the rotor turns forwards it is the constant load of eq. 4.
 //!
 //! The surface displacement is w(x, t) = q_A·cos kx + q_B·sin kx (k = N/R0); Δφ = +90°
 //! gives a wave travelling towards +x. One wavelength is cut into `nodes_per_wavelength`
@@ -71,7 +77,9 @@ pub struct TransientConfig {
     pub nodes_per_wavelength: usize,
     /// Phase of phase B behind phase A [rad]; π/2 = travelling wave, 0 = standing wave.
     pub phase_difference_rad: f64,
-    /// Load torque on the rotor [N·m], ≥ 0.
+    /// Load torque on the rotor T_load [N·m], ≥ 0: a Coulomb brake, T_load·sign Ω against
+    /// the rotation in either direction, holding the rotor at rest while |T_c| ≤ T_load
+    /// (the bar-type transient paper eq. 4, see the module doc).
     pub load_torque_nm: f64,
     /// Drive voltage amplitude per phase, zero-to-peak [V], > 0.
     pub voltage_v: f64,
@@ -423,8 +431,8 @@ pub struct SteadyComparison {
     pub status: Status,
     /// Steady rotor speed [rpm], negative for a reversed wave (Δφ = −90°).
     pub speed_rpm: f64,
-    /// Contact torque at steady state: the load plus the rotor's viscous torque d_r·Ω [N·m]
-    /// (negative with the speed for a reversed wave).
+    /// Contact torque at steady state: the load plus the rotor's viscous torque,
+    /// (T_load + d_r·|Ω|)·sign Ω [N·m] (negative with the speed for a reversed wave).
     pub contact_torque_nm: f64,
     /// Steady wave amplitude [m].
     pub amplitude_m: f64,
@@ -444,13 +452,6 @@ pub enum SteadyGap {
         /// Phase of phase B behind phase A [deg].
         phase_difference_deg: f64,
     },
-    /// A reversed wave (−90°) under a load torque: the load acts against positive rotation
-    /// whatever the wave (`T_load` in the rotor equation), so it drives the reversed rotor
-    /// along, while the steady model's load always opposes the rotation.
-    LoadAlongReversedRotation {
-        /// Load torque [N·m].
-        load_torque_nm: f64,
-    },
 }
 
 impl SteadyGap {
@@ -458,7 +459,6 @@ impl SteadyGap {
     pub const fn as_str(self) -> &'static str {
         match self {
             SteadyGap::StandingPart { .. } => "standing_wave_part",
-            SteadyGap::LoadAlongReversedRotation { .. } => "load_along_rotation",
         }
     }
 }
@@ -471,37 +471,29 @@ impl std::fmt::Display for SteadyGap {
                 "a phase difference other than +90 or -90 deg makes the drive partly a standing wave; \
                  the steady model describes a pure travelling wave only",
             ),
-            SteadyGap::LoadAlongReversedRotation { load_torque_nm } => write!(
-                f,
-                "the load torque {load_torque_nm} N·m acts against positive rotation, so it drives the rotor \
-                 of a reversed wave (-90 deg) along; the steady model's load always opposes the rotation"
-            ),
         }
     }
 }
 
 /// Solves the steady model ([`crate::solve`]) at the preload, load, voltage and frequency
-/// of `cfg`, for the direction of its travelling wave: at Δφ = +90° as it is; at −90° with
-/// no load mirrored (the rotor equation and the contact are symmetric under x → −x), so
-/// speed and contact torque take the reversed wave's negative sign. Any other phase
-/// difference, or a load under a reversed wave, is outside the steady model: the
-/// [`SteadyGap`] says why, and no number is given.
+/// of `cfg`, for the direction of its travelling wave: at Δφ = +90° as it is; at −90°
+/// mirrored, with or without load (the contact is symmetric under x → −x and the rotor
+/// equation, whose brake opposes the rotation either way, is odd in Ω), so speed and
+/// contact torque take the reversed wave's negative sign. Any other phase difference is
+/// outside the steady model: the [`SteadyGap`] says why, and no number is given.
 pub fn steady_comparison(motor: &Motor, cfg: &TransientConfig) -> Result<SteadyComparison, SteadyGap> {
     let (sin, cos) = cfg.phase_difference_rad.sin_cos();
     if cos.is_nan() || cos.abs() > TRAVELLING_WAVE_COS_TOLERANCE {
         return Err(SteadyGap::StandingPart { phase_difference_deg: cfg.phase_difference_rad.to_degrees() });
     }
     let direction = sin.signum();
-    if direction < 0.0 && cfg.load_torque_nm != 0.0 {
-        return Err(SteadyGap::LoadAlongReversedRotation { load_torque_nm: cfg.load_torque_nm });
-    }
     let s = solve(motor, &OperatingPoint::new(cfg.preload_n, cfg.load_torque_nm, cfg.voltage_v, cfg.frequency_hz));
     let valid = s.status.is_valid();
     let v = |x: f64| if valid { x } else { f64::NAN };
     Ok(SteadyComparison {
         status: s.status,
         speed_rpm: v(direction * s.speed_rpm),
-        contact_torque_nm: v(cfg.load_torque_nm + motor.rotor.viscous_damping_nms * direction * s.speed_rad_s),
+        contact_torque_nm: v(direction * (cfg.load_torque_nm + motor.rotor.viscous_damping_nms * s.speed_rad_s)),
         amplitude_m: v(s.amplitude_m),
     })
 }

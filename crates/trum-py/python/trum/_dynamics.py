@@ -290,9 +290,9 @@ class Snapshot:
 @dataclass(frozen=True)
 class StepResult:
     """Result of :func:`step`. ``steady`` is ``None`` for a bar-type motor (no steady solver);
-    at a phase difference other than ±90° (partly a standing wave), or under a load with the
-    reversed wave (−90°), its numbers are NaN, its ``status`` is ``'not_comparable'`` and its
-    ``note`` says why (``note`` is ``None`` otherwise)."""
+    at a phase difference other than ±90° (partly a standing wave) its numbers are NaN, its
+    ``status`` is ``'not_comparable'`` and its ``note`` says why (``note`` is ``None``
+    otherwise). At −90° it is the +90° solution mirrored, with or without load."""
 
     series: Dict[str, np.ndarray]
     metrics: Dict[str, Optional[float]]
@@ -386,6 +386,10 @@ def step(
     10 ms) or a bar-type motor (preset name such as
     ``"bar36"`` or a bar-type motor file path; driven by ``moment_nm``, every default from
     the motor's ``[drive]``: 0.25 N·m at 36.7 kHz, 40 N, 15 ms for ``bar36``).
+
+    ``torque_nm``: load torque T_load [N·m], ≥ 0, a Coulomb brake ([BarTransient] eq. 4 with
+    T_load·sign Ω): it opposes the rotation either way and holds the rotor at rest while
+    the contact torque stays within it.
 
     ``steps_per_period``: time steps per drive period; by default 64, raised in steps of 16
     on a ring motor where the explicit scheme would be unstable (``time_step_s`` of the

@@ -17,6 +17,8 @@
 //!   so the discrete forced response at the drive frequency equals the continuous one
 //!   (without it the 2.25 kHz detuning of `trum60a` would be off by 0.8 % at 64
 //!   steps/period). The remaining error is O(h²) in the contact forces.
+//! * The load is a Coulomb brake (T_load·sign Ω while turning, holding up to T_load at
+//!   rest), taken implicitly in both rotor kicks; see [`Model::rotor_kick`].
 //! * Stability: ω_max·h < 1.5 for the stiffest contact mode (all nodes sticking, the
 //!   tangential springs between stator modes and rotor), checked before the run.
 
@@ -90,7 +92,8 @@ pub(crate) struct Plant {
     pub normal_coupling: f64,
     /// Stator torsion, if modelled.
     pub torsion: Option<Torsion>,
-    /// Operating point and run settings.
+    /// Operating point and run settings; `load_torque_nm` is the magnitude of the Coulomb
+    /// brake T_load [N·m] (see [`Model::rotor_kick`]).
     pub preload_n: f64,
     pub load_torque_nm: f64,
     pub frequency_hz: f64,
@@ -100,6 +103,8 @@ pub(crate) struct Plant {
     pub nodes_per_wavelength: usize,
     pub record_every: usize,
     pub snapshot_times_s: Vec<f64>,
+    /// Rotor speed at t = 0 [rad/s]: 0 for a step from rest; a coasting rotor otherwise.
+    pub initial_rotor_speed_rad_s: f64,
 }
 
 /// The ring motor of [`crate::params::Motor`] at the settings of `cfg`.
@@ -140,6 +145,7 @@ pub(crate) fn ring_plant(motor: &Motor, cfg: &TransientConfig) -> Plant {
         nodes_per_wavelength: cfg.nodes_per_wavelength,
         record_every: cfg.record_every,
         snapshot_times_s: cfg.snapshot_times_s.clone(),
+        initial_rotor_speed_rad_s: 0.0,
     }
 }
 
@@ -161,6 +167,7 @@ struct Model {
     k_sp: f64,
     d_z: f64,
     preload: f64,
+    /// Magnitude of the Coulomb brake on the rotor T_load [N·m], ≥ 0.
     load: f64,
     coupling: f64,
     cos: Vec<f64>,
@@ -241,6 +248,38 @@ impl Model {
             torque: n * self.r0 * ft,
             n_contact,
             n_stick,
+        }
+    }
+
+    /// Rotor speed [rad/s] after a kick of length `hh` [s] from `om` [rad/s] under the
+    /// contact torque `tc` [N·m], the viscous torque d_r·Ω and the brake (the bar-type
+    /// transient paper eq. 4 with T_load·sign Ω). The viscous torque is taken at `om` in the
+    /// first half-kick (`implicit_damping` false) and at the new speed in the second.
+    ///
+    /// The brake's sign(Ω) is solved for with the new speed, like the nodes' return
+    /// mapping: the speed the kick would reach without the brake, `free`, is compared with
+    /// the change the brake can make, h½·T_load/J_r. Within it the brake stops the rotor in
+    /// this kick and the speed is exactly 0; at rest it holds as long as |T_c| ≤ T_load.
+    /// Beyond it the rotor turns, and the brake acts against the way it turns at the end of
+    /// the kick. Taking sign(Ω) at the old speed instead would flip ±T_load from step to
+    /// step around Ω = 0 (chatter) and let a held rotor creep by h·T_load/J_r per step.
+    /// While the rotor keeps turning forwards this is the constant-load kick exactly (same
+    /// operations, so the same rounding).
+    fn rotor_kick(&self, om: f64, tc: f64, hh: f64, implicit_damping: bool) -> f64 {
+        let hold = hh * self.load / self.j_r;
+        if implicit_damping {
+            let free = om + hh / self.j_r * tc;
+            if free.abs() <= hold {
+                return 0.0;
+            }
+            let tq = tc - self.load.copysign(free);
+            (om + hh / self.j_r * tq) / (1.0 + hh * self.d_r / self.j_r)
+        } else {
+            let free = om + hh * ((tc - self.d_r * om) / self.j_r);
+            if free.abs() <= hold {
+                return 0.0;
+            }
+            om + hh * ((tc - self.load.copysign(free) - self.d_r * om) / self.j_r)
         }
     }
 
@@ -329,7 +368,7 @@ pub(crate) fn run(p: &Plant) -> Result<RunOutput, TransientError> {
         vb: 0.0,
         z: z0,
         vz: 0.0,
-        om: 0.0,
+        om: p.initial_rotor_speed_rad_s,
         th: 0.0,
         om_s: 0.0,
         delta: vec![0.0; n_nodes],
@@ -351,7 +390,6 @@ pub(crate) fn run(p: &Plant) -> Result<RunOutput, TransientError> {
             (d.0 + f.qa - model.k_num * s.qa - model.c_num * s.va) / m,
             (d.1 + f.qb - model.k_num * s.qb - model.c_num * s.vb) / m,
             (f.fz - model.preload - model.k_sp * (s.z - z0) - model.d_z * s.vz) / model.m_r,
-            (f.torque - model.load - model.d_r * s.om) / model.j_r,
             tor.map_or(0.0, |t| (-f.torque - t.stiffness_nm_per_rad * s.th - t.damping_nms * s.om_s) / t.inertia_kg_m2),
         )
     };
@@ -386,8 +424,8 @@ pub(crate) fn run(p: &Plant) -> Result<RunOutput, TransientError> {
             s.va += hh * a.0;
             s.vb += hh * a.1;
             s.vz += hh * a.2;
-            s.om += hh * a.3;
-            s.om_s += hh * a.4;
+            s.om = model.rotor_kick(s.om, f.torque, hh, false);
+            s.om_s += hh * a.3;
             let (dqa, dqb) = (h * s.va, h * s.vb);
             s.qa += dqa;
             s.qb += dqb;
@@ -400,11 +438,10 @@ pub(crate) fn run(p: &Plant) -> Result<RunOutput, TransientError> {
             let fa = d.0 + f.qa - model.k_num * s.qa;
             let fb = d.1 + f.qb - model.k_num * s.qb;
             let fzz = f.fz - model.preload - model.k_sp * (s.z - z0);
-            let tq = f.torque - model.load;
             s.va = (s.va + hh / m * fa) / (1.0 + hh * model.c_num / m);
             s.vb = (s.vb + hh / m * fb) / (1.0 + hh * model.c_num / m);
             s.vz = (s.vz + hh / model.m_r * fzz) / (1.0 + hh * model.d_z / model.m_r);
-            s.om = (s.om + hh / model.j_r * tq) / (1.0 + hh * model.d_r / model.j_r);
+            s.om = model.rotor_kick(s.om, f.torque, hh, true);
             if let Some(t) = tor {
                 let ts = -f.torque - t.stiffness_nm_per_rad * s.th;
                 s.om_s = (s.om_s + hh / t.inertia_kg_m2 * ts) / (1.0 + hh * t.damping_nms / t.inertia_kg_m2);
