@@ -45,7 +45,7 @@ pub struct StepArgs {
     /// Axial preload [N] (ring default 260; bar-type: the motor's [drive]).
     #[arg(long)]
     preload_n: Option<f64>,
-    /// Load torque [N·m].
+    /// Load torque [N·m]: a brake that opposes the rotation in either direction and holds a rotor at rest against a smaller contact torque.
     #[arg(long, default_value_t = 0.0)]
     torque_nm: f64,
     /// Simulated time [s] (ring default 0.01, bar-type 0.015).
