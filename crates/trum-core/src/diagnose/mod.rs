@@ -39,7 +39,7 @@ mod tests;
 mod verdict;
 mod where_;
 
-use crate::calibrate::FitOptions;
+use crate::calibrate::{residuals, FitOptions};
 use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
 use crate::observable::{Observable, ObservedRow};
@@ -49,6 +49,7 @@ use candidates::{Fits, Scorer};
 use context::Context;
 use folds::pseudo_inverse;
 pub use folds::OUTLIER_Z2;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 use verdict::{GapTests, Verdict};
 
@@ -298,7 +299,7 @@ pub fn diagnose(
             ));
             base1 = baseline::with_held_out(&ctx, cal)?;
             probes1 = candidates::probe(&ctx, &base1);
-            let scorer = Scorer::new(&ctx, &base1, &probes1);
+            let scorer = Scorer::new(&ctx, &base1, &probes1).with_earlier_fits(&fits0.fits);
             let mut fits = Fits::default();
             let ranking = candidates::score_singles(&scorer, &mut fits);
             (&base1, &probes1, scorer, fits, ranking)
@@ -363,6 +364,20 @@ pub fn diagnose(
             &probes.base_sigs,
         );
         notes.append(&mut decided.notes);
+        // (a single-effect verdict: the effects the whole data do not separate from it)
+        if Effect::from_name(&decided.verdict).is_ok() {
+            let z2: BTreeMap<String, Vec<f64>> = fits
+                .fits
+                .par_iter()
+                .filter(|(name, _)| Effect::from_name(name).is_ok())
+                .map(|(name, c)| (name.clone(), residuals(&c.motor, &ctx.rows).iter().map(|z| z * z).collect()))
+                .collect();
+            for e in verdict::inseparable(&ranking, &decided.verdict, &z2) {
+                if !decided.confounded.contains(&e) {
+                    decided.confounded.push(e);
+                }
+            }
+        }
     } else {
         notes.push(format!(
             "the calibrated baseline predicts the held-out regions at the noise level (mean squared normalised residual {:.2}; {:.2} with each quantity's noise level at the upper end of its estimate's 90 % interval) and no candidate effect is supported; no effect is needed",

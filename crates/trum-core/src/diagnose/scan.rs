@@ -246,7 +246,7 @@ pub(crate) fn valleys(bases: &[&Motor], fitted: &Motor, rows: &[ObservedRow], e:
                 let own = i > 0 && p.3 < OWN_VALLEY_LEFT * s[0].3;
                 if lower || fenced || own {
                     let valley = Valley { base: (*base).clone(), values: p.2.clone(), chi2: p.3 };
-                    found.push(Found { valley, left: p.3 / s[0].3, form: shape_of(&p.2) });
+                    found.push(Found { valley, left: p.3 / s[0].3, form: shape_of(&p.2), base: b });
                 }
             }
         }
@@ -262,15 +262,22 @@ struct Found {
     left: f64,
     /// The effect's shape parameters there (bit patterns): its form.
     form: Vec<u64>,
+    /// Which base motor it was scanned from.
+    base: usize,
 }
 
 /// The valleys handed back, best first, at most [`MAX_VALLEYS`]: the lowest χ², then the
-/// best of each other form by the part of its base's miss it leaves. The held shape
-/// levels are forms no fit moves between, and χ² from different bases do not compare (the
-/// nominal motor's is of a motor nothing was fitted to): a softening that falls with the
-/// preload, scanned from the nominal motor, left an eighth of that motor's miss, where
-/// two rising forms from the calibrated baseline were a little lower in χ² but fitted to
-/// nothing, and only its own fit reached the noise.
+/// best of each other form by the part of its base's miss it leaves, then, while there is
+/// room, the best of each form from the other base. The held shape levels are forms no fit
+/// moves between, and χ² from different bases do not compare (the nominal motor's is of a
+/// motor nothing was fitted to): a softening that falls with the preload, scanned from the
+/// nominal motor, left an eighth of that motor's miss, where two rising forms from the
+/// calibrated baseline were a little lower in χ² but fitted to nothing, and only its own
+/// fit reached the noise. For the same reason one form's valley from the calibrated
+/// baseline (often a small step off the fit) does not stand for the same form's valley
+/// from the nominal motor: a `radial_friction` at the top of its range on a combined
+/// campaign of `generic60` reached the noise only from the nominal motor's valley of the
+/// form the calibrated baseline's lowest valley already had.
 fn pick(mut found: Vec<Found>) -> Vec<Valley> {
     found.sort_by(|a, b| a.valley.chi2.total_cmp(&b.valley.chi2));
     let mut chosen: Vec<Found> = Vec::new();
@@ -278,11 +285,21 @@ fn pick(mut found: Vec<Found>) -> Vec<Valley> {
     chosen.extend(rest.next());
     let mut rest: Vec<Found> = rest.collect();
     rest.sort_by(|a, b| a.left.total_cmp(&b.left));
+    let mut later = Vec::new();
     for f in rest {
+        if !chosen.iter().any(|c| c.form == f.form) {
+            if chosen.len() < MAX_VALLEYS {
+                chosen.push(f);
+            }
+        } else {
+            later.push(f);
+        }
+    }
+    for f in later {
         if chosen.len() == MAX_VALLEYS {
             break;
         }
-        if !chosen.iter().any(|c| c.form == f.form) {
+        if !chosen.iter().any(|c| c.form == f.form && c.base == f.base) {
             chosen.push(f);
         }
     }
@@ -403,33 +420,53 @@ mod tests {
     }
 
     /// The lowest valley first, then the best of each other form by the part of its base's
-    /// miss it leaves, one per form, at most `MAX_VALLEYS`.
+    /// miss it leaves, one per form, then each form's best from the other base while there
+    /// is room, at most `MAX_VALLEYS`.
     #[test]
     fn the_valleys_handed_back_are_the_lowest_and_each_forms_best() {
-        let base = crate::presets::preset("generic60").expect("preset");
-        let f = |chi2: f64, left: f64, form: u64, strength: f64| Found {
-            valley: Valley { base: base.clone(), values: vec![strength, form as f64], chi2 },
+        let motor = crate::presets::preset("generic60").expect("preset");
+        let f = |chi2: f64, left: f64, form: u64, strength: f64, base: usize| Found {
+            valley: Valley { base: motor.clone(), values: vec![strength, form as f64], chi2 },
             left,
             form: vec![form],
+            base,
         };
         let found = vec![
-            // near the calibrated baseline: lowest in χ², little of its miss removed
-            f(2169.0, 0.99, 2, 0.1),
-            f(2178.0, 0.99, 3, 0.1),
-            // from the nominal motor: far above in χ², most of its miss removed
-            f(18865.0, 0.06, 1, 3.0),
-            f(19500.0, 0.07, 1, 10.0),
-            f(33260.0, 0.12, 0, 100.0),
-            f(48024.0, 0.15, 4, 3.0),
+            // near the calibrated baseline (base 0): lowest in χ², little of its miss removed
+            f(2169.0, 0.99, 2, 0.1, 0),
+            f(2178.0, 0.99, 3, 0.1, 0),
+            // from the nominal motor (base 1): far above in χ², most of its miss removed
+            f(18865.0, 0.06, 1, 3.0, 1),
+            f(19500.0, 0.07, 1, 10.0, 1),
+            f(33260.0, 0.12, 0, 100.0, 1),
+            f(48024.0, 0.15, 4, 3.0, 1),
         ];
         let out = pick(found);
         let got: Vec<(f64, f64)> = out.iter().map(|v| (v.chi2, v.values[1])).collect();
-        // the lowest; then by what they leave: form 1's best (not its second valley), form
-        // 0, form 4 (0.15 left), form 3 (0.99); returned by χ²
+        // the lowest; then by what they leave: form 1's best (not its second valley from the
+        // same base), form 0, form 4 (0.15 left), form 3 (0.99); returned by χ²
         assert_eq!(got, vec![(2169.0, 2.0), (2178.0, 3.0), (18865.0, 1.0), (33260.0, 0.0), (48024.0, 4.0)]);
-        // fewer than the cap: every distinct form
-        let two = pick(vec![f(5.0, 0.9, 1, 1.0), f(7.0, 0.2, 1, 3.0), f(9.0, 0.5, 2, 1.0)]);
+        // fewer than the cap: every distinct form, and a form's valley from the other base
+        let two = pick(vec![f(5.0, 0.9, 1, 1.0, 0), f(7.0, 0.2, 1, 3.0, 0), f(9.0, 0.5, 2, 1.0, 0)]);
         assert_eq!(two.iter().map(|v| v.chi2).collect::<Vec<_>>(), vec![5.0, 9.0]);
+        // the lowest valley is a small step off the fit from the calibrated baseline; the
+        // nominal motor's valley of the same form is fitted too
+        let strong = pick(vec![
+            f(108_129.0, 1.0, 0, 0.1, 0),
+            f(5_766_888.0, 0.162, 0, 3.0, 1),
+            f(246_707.0, 0.007, 5, 3.0, 1),
+            f(430_803.0, 0.012, 10, 3.0, 1),
+        ]);
+        assert_eq!(
+            strong.iter().map(|v| v.chi2).collect::<Vec<_>>(),
+            vec![108_129.0, 246_707.0, 430_803.0, 5_766_888.0]
+        );
+        // at the cap, every form's best comes before a second base's valley of a form
+        let mut many: Vec<Found> = (0..6).map(|k| f(100.0 + k as f64, 0.5, k, 1.0, 0)).collect();
+        many.push(f(5000.0, 0.01, 0, 3.0, 1));
+        let capped = pick(many);
+        assert_eq!(capped.len(), MAX_VALLEYS);
+        assert!(capped.iter().all(|v| v.chi2 < 1000.0));
         assert!(pick(Vec::new()).is_empty());
     }
 

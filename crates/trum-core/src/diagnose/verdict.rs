@@ -270,6 +270,63 @@ pub(super) fn decide(
     Verdict { verdict, complete, confounded, partial, notes }
 }
 
+/// One-sided 5 % point of the standard normal: the evidence separates two fitted models
+/// when their difference exceeds this many of its standard errors ([`evidence_z`]).
+pub(super) const SEPARATED_Z: f64 = 1.645;
+
+/// How many standard errors the evidence of model A lies above that of model B, from their
+/// full-data fits' squared normalised residuals `z2_a` and `z2_b` on the same readings:
+/// (ev_A − ev_B) / (√n · s), with s the standard deviation of the readings' log-likelihood
+/// differences ½(z²_B − z²_A) (Vuong 1989, "Likelihood ratio tests for model selection and
+/// non-nested hypotheses", Econometrica 57, section 5: the likelihood ratio over √n times
+/// that standard deviation, corrected by the Schwarz criterion, which the evidence carries). Non-nested candidates whose forms all differ
+/// from the data's (as on a real bench) are compared so: the evidence's likelihood ratio
+/// alone assumes one of them is the truth, and its size then grows with the readings
+/// whatever the spread of the per-reading differences. Each z² is clipped at
+/// [`super::folds::OUTLIER_Z2`] for the spread, so a single reading without a solution
+/// does not make every pair inseparable. +∞ where the differences have no spread and A's
+/// evidence is higher (−∞ where lower, 0 where equal).
+pub(super) fn evidence_z(ev_a: f64, ev_b: f64, z2_a: &[f64], z2_b: &[f64]) -> f64 {
+    let clip = |x: f64| x.min(super::folds::OUTLIER_Z2);
+    let d: Vec<f64> = z2_a.iter().zip(z2_b).map(|(a, b)| 0.5 * (clip(*b) - clip(*a))).collect();
+    let n = d.len();
+    let gap = ev_a - ev_b;
+    if n < 2 || !gap.is_finite() {
+        return if gap.is_nan() { 0.0 } else { gap.signum() * f64::INFINITY };
+    }
+    let mean = d.iter().sum::<f64>() / n as f64;
+    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+    let se = (n as f64 * var).sqrt();
+    if se > 0.0 && se.is_finite() {
+        gap / se
+    } else if gap == 0.0 {
+        0.0
+    } else {
+        gap.signum() * f64::INFINITY
+    }
+}
+
+/// The single effects that the full-data evidence does not separate from the single-effect
+/// verdict `verdict` ([`evidence_z`] below [`SEPARATED_Z`]; one with more evidence than the
+/// verdict is never separated from it), that the data support on their own (evidence > 5)
+/// and that the held-out data do not reject (the upper ends of both bootstrap intervals of
+/// their shrink above zero). `z2`: each scored single's full-data fit's squared normalised
+/// residuals, by name. The verdict is chosen by its held-out gain; where another effect
+/// fits the whole data as well or better and predicts held-out data no worse than the
+/// baseline, the data do not tell the two apart, and the diagnosis says so.
+pub(super) fn inseparable(ranking: &[RankEntry], verdict: &str, z2: &BTreeMap<String, Vec<f64>>) -> Vec<String> {
+    let (Some(best), Some(z2_best)) = (ranking.iter().find(|r| r.effect == verdict), z2.get(verdict)) else {
+        return Vec::new();
+    };
+    ranking
+        .iter()
+        .filter(|r| r.effect != verdict && !r.effect.contains('+'))
+        .filter(|r| r.evidence > 5.0 && r.shrink_interval.1 > 0.0 && r.z2_shrink_interval.1 > 0.0)
+        .filter(|r| z2.get(&r.effect).is_some_and(|z| evidence_z(best.evidence, r.evidence, z2_best, z) < SEPARATED_Z))
+        .map(|r| r.effect.clone())
+        .collect()
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
@@ -445,5 +502,69 @@ mod tests {
         assert!(!GapTests::supported(&worse));
         let weak = RankEntry { evidence: 4.0, ..wide };
         assert!(!GapTests::supported(&weak));
+    }
+
+    /// Vuong's statistic: the evidence gap over the standard error of the summed
+    /// per-reading log-likelihood differences. Two fits with identical residuals but for
+    /// a shift of every reading's z² by δ have no spread: any evidence gap separates them.
+    /// Alternating differences of ±1 over 400 readings have a standard error of
+    /// ½·√400 = 10, so an evidence gap of 10 is one standard error.
+    #[test]
+    fn the_evidence_gap_is_measured_in_its_standard_errors() {
+        let a = vec![1.0; 400];
+        let shifted = vec![1.5; 400];
+        assert_eq!(evidence_z(8.0, 3.0, &a, &shifted), f64::INFINITY);
+        assert_eq!(evidence_z(3.0, 8.0, &a, &shifted), f64::NEG_INFINITY);
+        assert_eq!(evidence_z(3.0, 3.0, &a, &a), 0.0);
+        let alternating: Vec<f64> = (0..400).map(|i| if i % 2 == 0 { 3.0 } else { 1.0 }).collect();
+        // d = ½(z²_B − z²_A) = ±1 around zero: sample s.d. √(400/399)
+        let z = evidence_z(10.0, 0.0, &a, &alternating);
+        assert!((z - 1.0 / (400.0f64 / 399.0).sqrt()).abs() < 1e-12, "{z}");
+        // a reading without a solution (z² 2500) counts as at most OUTLIER_Z2
+        let mut lost = a.clone();
+        lost[0] = 2500.0;
+        let mut capped = a.clone();
+        capped[0] = crate::diagnose::OUTLIER_Z2;
+        assert_eq!(evidence_z(10.0, 0.0, &a, &lost), evidence_z(10.0, 0.0, &a, &capped));
+        assert_eq!(evidence_z(1.0, 0.0, &a[..1], &a[..1]), f64::INFINITY);
+    }
+
+    /// A verdict chosen by its held-out gain is confounded with an effect that the whole
+    /// data fit as well (within the evidence's standard error, or better) and the held-out
+    /// data do not reject; not with one the held-out data reject, one the data do not
+    /// support, nor one the evidence separates from it.
+    #[test]
+    fn effects_the_evidence_does_not_separate_are_confounded() {
+        let n = 280;
+        let noisy = |k: usize| -> Vec<f64> { (0..n).map(|i| 1.0 + ((i * 7 + k) % 5) as f64 * 0.4).collect() };
+        let verdict = RankEntry { evidence: 25.3, shrink: 0.15, ..ranked("radial_friction", 0.76, 0.058) };
+        let higher = RankEntry {
+            evidence: 34.4,
+            shrink: -0.02,
+            shrink_interval: (-0.06, 0.04),
+            z2_shrink_interval: (-0.002, 0.14),
+            ..ranked("tangential_compliance", 1.23, 0.07)
+        };
+        let rejected = RankEntry {
+            evidence: 29.4,
+            shrink: -0.69,
+            shrink_interval: (-1.34, -0.09),
+            z2_shrink_interval: (-0.05, 0.02),
+            ..ranked("eccentricity", 1.46, 0.116)
+        };
+        let unsupported = RankEntry { evidence: 3.0, ..ranked("voltage_sag", 1.4, 0.07) };
+        let far = RankEntry { evidence: -200.0, ..ranked("hertz_softening", 1.4, 0.07) };
+        let ranking = vec![higher, rejected, verdict, unsupported, far];
+        let z2: BTreeMap<String, Vec<f64>> =
+            ranking.iter().enumerate().map(|(k, r)| (r.effect.clone(), noisy(k))).collect();
+        assert_eq!(inseparable(&ranking, "radial_friction", &z2), vec!["tangential_compliance".to_string()]);
+        // the evidence far ahead of every other: nothing confounded
+        let mut ahead = ranking.clone();
+        ahead[2].evidence = 5000.0;
+        assert!(inseparable(&ahead, "radial_friction", &z2).is_empty());
+        // without the verdict's fit there is nothing to compare
+        let mut without = z2.clone();
+        without.remove("radial_friction");
+        assert!(inseparable(&ranking, "radial_friction", &without).is_empty());
     }
 }
