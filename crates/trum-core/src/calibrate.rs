@@ -8,6 +8,7 @@
 
 use crate::effects::{Effect, Instrument};
 use crate::error::TrumError;
+use crate::lsq::LeastSquares;
 pub use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
 use crate::sensitivity::{solve_kept, Solved};
@@ -942,24 +943,19 @@ fn remaining_gain(j: &DMatrix<f64>, r: &DVector<f64>, u: &DVector<f64>) -> f64 {
 /// decrement (Boyd and Vandenberghe, Convex Optimization, § 9.5.1). Small in the flat tail
 /// of a converged fit, large along a slow crawl down a shallow valley (where the steps are
 /// short but the model still sees far to go). Infinite when it cannot be computed.
+///
+/// Computed as ‖Uᵀr‖² from the SVD of J itself ([`crate::lsq`]), not from JᵀJ, whose
+/// condition number is the square of J's. Directions with a singular value of J at or
+/// below 1e-6 of the largest take no part (the eigenvalues of JᵀJ below 1e-12 of its
+/// largest). No free parameter (zero columns, all pressed against bounds): 0.
 fn gauss_newton_decrement(j: &DMatrix<f64>, r: &DVector<f64>) -> f64 {
-    // no free parameter (all pressed against bounds): no step (nalgebra's SVD asserts on
-    // an empty matrix)
     if j.ncols() == 0 {
         return 0.0;
     }
-    let g = j.transpose() * r;
-    let h = j.transpose() * j;
-    if !g.iter().chain(h.iter()).all(|x| x.is_finite()) {
+    if !r.iter().all(|x| x.is_finite()) {
         return f64::INFINITY;
     }
-    match h.try_svd(true, true, 1e-15, 500) {
-        Some(svd) => {
-            let smax = svd.singular_values.max();
-            svd.solve(&g, smax * 1e-12).map(|x| g.dot(&x).max(0.0)).unwrap_or(f64::INFINITY)
-        }
-        None => f64::INFINITY,
-    }
+    LeastSquares::new(j, 1e-6).map_or(f64::INFINITY, |l| l.decrement(r))
 }
 
 impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
@@ -1401,21 +1397,11 @@ fn fit(
     }
     let dof = (n_read + n_prior).saturating_sub(params.len()).max(1) as f64;
     let s2 = (chi2 / dof).max(1e-300);
-    let jtj = jp.transpose() * &jp;
-    // nalgebra's plain `svd` iterates without bound on non-finite input; `try_svd` with an
-    // iteration cap returns None instead.
-    let nan = || DMatrix::from_element(params.len(), params.len(), f64::NAN);
-    let cov = if jtj.iter().all(|x| x.is_finite()) {
-        match jtj.clone().try_svd(true, true, 1e-15, 500) {
-            Some(svd) => {
-                let smax = svd.singular_values.max();
-                svd.pseudo_inverse(smax * 1e-14).unwrap_or_else(|_| nan())
-            }
-            None => nan(),
-        }
-    } else {
-        nan()
-    };
+    // (JᵀJ)⁺ from the SVD of J itself (κ(JᵀJ) = κ(J)²), singular values of J at or below
+    // 1e-7 of the largest dropped: the eigenvalues of JᵀJ below 1e-14 of its largest. A
+    // non-finite Jacobian has no covariance (NaN: no standard error).
+    let cov = LeastSquares::new(&jp, 1e-7)
+        .map_or_else(|| DMatrix::from_element(params.len(), params.len(), f64::NAN), |l| l.covariance());
     let mut out = Vec::new();
     for (k, fp) in params.iter().enumerate() {
         let value = fp.param.get(&fitted);
@@ -1434,7 +1420,8 @@ fn fit(
         // With a prior, the data identify a parameter when they narrow it to well inside
         // the prior's width; otherwise it is held by its prior, which is no fault.
         let prior_sd = fp.prior.map(|p| p.sd);
-        let identifiable = jtj[(k, k)] > 0.0 && se.is_finite() && rel < prior_sd.map_or(1.0, |sd| (0.7 * sd).min(1.0));
+        let identifiable =
+            jp.column(k).norm_squared() > 0.0 && se.is_finite() && rel < prior_sd.map_or(1.0, |sd| (0.7 * sd).min(1.0));
         if abandoned {
             out.push(FittedParam {
                 name: fp.param.name(),

@@ -34,9 +34,9 @@
 //!   dynamics and modal stiffness), `interface` (friction laws beyond 2-D Coulomb),
 //!   `losses`, `thermal`, `fluctuation`; `solve/` puts them together (its `mod.rs` maps
 //!   its files); `solution` and `quantities` hold what it reports.
-//! - Bench data and fits: `synth`, `noise`, `calibrate` (with `sensitivity`), and
-//!   `diagnose/`, one file per stage (`baseline`, `candidates`, `scan`, `signature`,
-//!   `pairs`, `verdict`, `where_`, `json`).
+//! - Bench data and fits: `synth`, `noise`, `calibrate` (with `sensitivity`, and `lsq`,
+//!   dense least squares on the SVD of the Jacobian), and `diagnose/`, one file per stage
+//!   (`baseline`, `candidates`, `scan`, `signature`, `pairs`, `verdict`, `where_`, `json`).
 //! - Dynamics: `dynamics::hertz` (the Hertzian-contact oscillator), `dynamics::transient`
 //!   (stick-slip start-up), `dynamics::bar_type`.
 //! - Checks of the papers: `papers` (closed forms as printed and corrected) and `quad`.
@@ -64,6 +64,7 @@ pub mod interface;
 pub mod layout;
 pub mod limits;
 pub mod losses;
+mod lsq;
 pub mod measurements;
 pub mod noise;
 mod normal;

@@ -8,6 +8,7 @@ use super::{DiagnoseOptions, RankEntry};
 use crate::calibrate::{prior_residuals, residuals, with_prior_rows, Calibration, FitOptions};
 use crate::effects::Effect;
 use crate::error::TrumError;
+use crate::lsq::LeastSquares;
 use crate::observable::{Observable, ObservedRow};
 use crate::params::Motor;
 use crate::solve::{solve_prepared, Prepared};
@@ -78,10 +79,10 @@ pub(super) struct CvResult {
 
 /// Approximate leave-block-out refits. From the full-data optimum û (where the gradient
 /// of the full χ² vanishes), simplified Gauss–Newton steps on the training readings with
-/// the full-data Jacobian, u ← u − (J_Tᵀ J_T)⁺ J_Tᵀ r_T(u), remove the held-out block's
-/// influence on the parameters — to first order after one step (exact for a model linear
-/// in u; the approximate leave-out estimators of Beirami et al. 2017 and Rad & Maleki
-/// 2020 rest on the same step), closer after the second, which uses the training
+/// the full-data Jacobian, u ← u − J_T⁺ r_T(u) = u − (J_Tᵀ J_T)⁺ J_Tᵀ r_T(u), remove the
+/// held-out block's influence on the parameters — to first order after one step (exact for
+/// a model linear in u; the approximate leave-out estimators of Beirami et al. 2017 and
+/// Rad & Maleki 2020 rest on the same step), closer after the second, which uses the training
 /// residuals at the new point. The held-out block is then predicted with the nonlinear
 /// model. Cost: about two passes over the data per model instead of one full fit per
 /// fold. `DiagnoseOptions::exact_cv` refits instead; a test checks the two agree.
@@ -117,7 +118,10 @@ pub(super) fn approx_cv(
         let jt = with_prior_rows(lin.jacobian.select_rows(idx.iter()), &lin.params, &lin.u);
         let w: Vec<f64> = idx.iter().map(|&j| lin.weights[j]).collect();
         let train_rows: Vec<ObservedRow> = train.iter().map(|&i| rows[i].clone()).collect();
-        let hinv = pseudo_inverse(&(jt.transpose() * &jt));
+        // (one SVD of J_T for both steps, singular values at or below 1e-5 of the largest
+        // dropped: the eigenvalues of J_TᵀJ_T below 1e-10 of its largest; a non-finite
+        // Jacobian takes no step)
+        let lsq = LeastSquares::new(&jt, 1e-5);
         let weighted = |u: &DVector<f64>| -> DVector<f64> {
             let r = residuals(&lin.motor_at(u), &train_rows);
             let prior = prior_residuals(&lin.params, u);
@@ -128,7 +132,7 @@ pub(super) fn approx_cv(
             DVector::from_iterator(idx.len() + prior0.len(), idx.iter().map(|&j| lin.residuals[j]).chain(prior0));
         let mut best = (lin.u.clone(), r.norm_squared());
         for iteration in 0..2 {
-            let step = &hinv * (jt.transpose() * &r);
+            let step = lsq.as_ref().map_or_else(|| DVector::zeros(jt.ncols()), |l| l.solve(&r));
             // a step that leaves the region where the linearisation holds is cut back
             let big = step.amax();
             let full = if big > 2.0 { step * (2.0 / big) } else { step };
@@ -178,20 +182,14 @@ pub(super) fn approx_cv(
     CvResult { preds, in_sample }
 }
 
-/// Moore–Penrose inverse of a small symmetric normal matrix; directions the training data
-/// do not determine (singular values below 1e-10 of the largest) are left unchanged.
-pub(super) fn pseudo_inverse(h: &DMatrix<f64>) -> DMatrix<f64> {
-    let zero = || DMatrix::zeros(h.nrows(), h.ncols());
-    if !h.iter().all(|x| x.is_finite()) {
-        return zero();
-    }
-    match h.clone().try_svd(true, true, 1e-15, 500) {
-        Some(svd) => {
-            let smax = svd.singular_values.max();
-            svd.pseudo_inverse(smax * 1e-10).unwrap_or_else(|_| zero())
-        }
-        None => zero(),
-    }
+/// The Moore–Penrose inverse J⁺ (n × m) of a weighted Jacobian or set of columns `j`
+/// (m × n), so that J⁺r is the minimum-norm least-squares coefficient vector for residuals
+/// r: directions the data do not determine (singular values of J at or below 1e-5 of the
+/// largest, i.e. the eigenvalues of JᵀJ below 1e-10 of its largest) get none. From the
+/// SVD of J itself ([`crate::lsq`]): forming JᵀJ would square its condition number. Zero
+/// for a non-finite `j`; a `j` without columns gives a 0 × m matrix.
+pub(super) fn pseudo_inverse(j: &DMatrix<f64>) -> DMatrix<f64> {
+    LeastSquares::new(j, 1e-5).map_or_else(|| DMatrix::zeros(j.ncols(), j.nrows()), |l| l.pseudo_inverse())
 }
 
 #[allow(clippy::too_many_arguments)]

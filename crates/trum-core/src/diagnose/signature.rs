@@ -16,6 +16,7 @@
 use super::pseudo_inverse;
 use crate::calibrate::{residuals, Calibration};
 use crate::effects::Effect;
+use crate::lsq::LeastSquares;
 use crate::observable::ObservedRow;
 use nalgebra::{DMatrix, DVector};
 
@@ -70,8 +71,10 @@ pub(crate) fn signature(cal: &Calibration, rows: &[ObservedRow], e: Effect) -> O
     if !s.iter().all(|x| x.is_finite()) {
         return None;
     }
-    let j = &cal.lin.jacobian;
-    let st = &s - j * (pseudo_inverse(&(j.transpose() * j)) * (j.transpose() * &s));
+    // (I − U Uᵀ) S from the SVD of J, directions with a singular value at or below 1e-5 of
+    // the largest not refitted (the eigenvalues of JᵀJ below 1e-10 of its largest); a
+    // non-finite Jacobian refits nothing
+    let st = LeastSquares::new(&cal.lin.jacobian, 1e-5).map_or_else(|| s.clone(), |l| l.orthogonal_part(&s));
     let shape: Vec<bool> = info.params.iter().filter(|p| !p.held).map(|p| p.shape).collect();
     let (linear_chi2_drop, linear_change) = one_sided_drop(&st, r, info.params[0].min >= 0.0, &shape);
     let s0 = st.column(0);
@@ -94,7 +97,7 @@ fn one_sided_drop(st: &DMatrix<f64>, r: &DVector<f64>, bounded: bool, shape: &[b
         if s.ncols() == 0 {
             return (0.0, DVector::zeros(r.len()), 0.0);
         }
-        let a = -(pseudo_inverse(&(s.transpose() * s)) * (s.transpose() * r));
+        let a = -(pseudo_inverse(s) * r);
         let change = s * &a;
         // ‖r‖² − ‖r + S̃a‖² = −rᵀS̃a at the least-squares a
         ((-r.dot(&change)).max(0.0), change, a[0])
