@@ -47,7 +47,6 @@ use crate::params::Motor;
 use crate::solve::Status;
 use candidates::{Fits, Scorer};
 use context::Context;
-use folds::pseudo_inverse;
 pub use folds::OUTLIER_Z2;
 use rayon::prelude::*;
 use std::collections::BTreeMap;

@@ -13,7 +13,7 @@
 //! one-sided for an effect whose strength is bounded below by off: a residual that only a
 //! negative strength would remove is no evidence for the effect.
 
-use super::pseudo_inverse;
+use super::folds::pseudo_inverse;
 use crate::calibrate::{residuals, Calibration};
 use crate::effects::Effect;
 use crate::lsq::LeastSquares;
