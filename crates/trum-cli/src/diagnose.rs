@@ -15,7 +15,7 @@ use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::time::Duration;
 use trum_core::diagnose::json::{to_json, Provenance};
-use trum_core::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
+use trum_core::diagnose::{diagnose, stated_noise_from_texts, DiagnoseOptions, Diagnosis};
 use trum_core::Motor;
 
 use trum_core::diagnose::json::{unit, EVIDENCE_SCALE};
@@ -54,6 +54,12 @@ pub struct DiagnoseArgs {
     /// Write a self-contained HTML report (plots, tables, method) here.
     #[arg(long, value_name = "OUT.html")]
     report: Option<PathBuf>,
+    /// Noise level of a sensor as the bench states it, in place of the default and of the
+    /// estimate from the data: COLUMN=SD (standard deviation in the column's unit) or
+    /// COLUMN=SD,REL (plus REL × the reading), e.g. speed_rpm=0.3,0.005 (repeatable;
+    /// docs/DIAGNOSIS.md, "Noise levels from the data").
+    #[arg(long = "sensor-noise", value_name = "COLUMN=SD[,REL]")]
+    sensor_noise: Vec<String>,
     /// Refit every model on every cross-validation fold instead of the approximate
     /// leave-block-out refit (slower; docs/DIAGNOSIS.md).
     #[arg(long)]
@@ -82,6 +88,7 @@ pub fn run(a: &DiagnoseArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
         exact_cv: a.exact_cv,
         max_fit_rows: a.fit_rows,
         tolerances: crate::motor::load_tolerances(&a.motor)?,
+        stated_noise: stated_noise_from_texts(&a.sensor_noise, "--sensor-noise")?,
         ..DiagnoseOptions::default()
     };
     let d = diagnose(&motor, &bench.rows, &bench.groups, &opts);
@@ -139,6 +146,7 @@ fn run_fleet(a: &DiagnoseArgs, files: &[String], out: &mut dyn Write, err: &mut 
     let opts = DiagnoseOptions {
         exact_cv: a.exact_cv,
         tolerances: crate::motor::load_tolerances(&a.motor)?,
+        stated_noise: stated_noise_from_texts(&a.sensor_noise, "--sensor-noise")?,
         ..DiagnoseOptions::default()
     };
     let run = crate::fleet::FleetRun { files, summary, threads: a.threads, quiet: a.quiet };

@@ -8,7 +8,7 @@ use pyo3::types::PyDict;
 use trum_core::bench::observations;
 use trum_core::calibrate::{rescale_uncertainties, Calibration, FitOptions};
 use trum_core::diagnose::json::{to_json, Provenance};
-use trum_core::diagnose::{diagnose, DiagnoseOptions};
+use trum_core::diagnose::{diagnose, stated_noise_from_texts, DiagnoseOptions};
 use trum_core::measurements::{parse_measurements_with, PlausibleRanges};
 
 /// Diagnoses the measurement CSV `data` (its bytes; `source` names it in messages) against
@@ -18,10 +18,11 @@ use trum_core::measurements::{parse_measurements_with, PlausibleRanges};
 /// ranges (`COLUMN=LOW:HIGH` or `COLUMN=any`, as the CLI's `--plausible`), after the
 /// `[plausible]` table of `plausible_toml` (a TOML file's text and name). The priors of
 /// the calibration are the `[tolerances]` table of `tolerances_toml` (text, name), then the
-/// `(key, value)` pairs of `tolerances` ([`tolerances_in_force`]). The work runs with the
-/// GIL released.
+/// `(key, value)` pairs of `tolerances` ([`tolerances_in_force`]). `sensor_noise`: the
+/// sensors' stated noise levels, `COLUMN=SD[,REL]` as the CLI's `--sensor-noise`. The work
+/// runs with the GIL released.
 #[pyfunction]
-#[pyo3(signature = (motor, data, source, motor_source, exact_cv = false, plausible = Vec::new(), plausible_toml = None, tolerances = Vec::new(), tolerances_toml = None))]
+#[pyo3(signature = (motor, data, source, motor_source, exact_cv = false, plausible = Vec::new(), plausible_toml = None, tolerances = Vec::new(), tolerances_toml = None, sensor_noise = Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 pub fn diagnose_csv(
     py: Python<'_>,
@@ -34,14 +35,17 @@ pub fn diagnose_csv(
     plausible_toml: Option<(String, String)>,
     tolerances: Vec<(String, f64)>,
     tolerances_toml: Option<(String, String)>,
+    sensor_noise: Vec<String>,
 ) -> PyResult<(String, Vec<String>)> {
     let m = motor.get().inner.clone();
     let ranges = plausible_ranges(py, &plausible, plausible_toml.as_ref())?;
     let tolerances = tolerances_in_force(py, &tolerances, tolerances_toml.as_ref())?;
+    let stated_noise =
+        stated_noise_from_texts(&sensor_noise, "sensor_noise").map_err(|e| input_err(py, e.to_string()))?;
     let out = detached(py, move || -> Result<(String, Vec<String>), String> {
         let meas = parse_measurements_with(&data, &source, &ranges).map_err(|e| e.to_string())?;
         let bench = observations(&meas, &m);
-        let opts = DiagnoseOptions { exact_cv, tolerances, ..DiagnoseOptions::default() };
+        let opts = DiagnoseOptions { exact_cv, tolerances, stated_noise, ..DiagnoseOptions::default() };
         let d =
             diagnose(&m, &bench.rows, &bench.groups, &opts).map_err(|e| format!("cannot diagnose '{source}': {e}"))?;
         let src = Provenance { motor_name: &m.name, motor_source: &motor_source, data: &source, lines: &bench.lines };

@@ -192,3 +192,16 @@ def test_tolerances_from_a_motor_file_give_the_clis_calibration(tmp_path):
     assert [p["name"] for p in py.params] == [p["name"] for p in cli["params"]]
     for a, b in zip(py.params, cli["params"]):
         assert a["value"] == pytest.approx(b["value"], rel=1e-12)
+
+
+def test_stated_sensor_noise_replaces_the_estimate():
+    d = trum.diagnose(RING, DATA, sensor_noise={"speed_rpm": (0.5, 0.01), "speed_std_rpm": 0.05})
+    note = next(n for n in d["notes"] if n.startswith("noise levels as stated"))
+    assert "speed_rpm σ = 0.5 + 0.01 × reading" in note and "speed_std_rpm σ = 0.05 + 0 × reading" in note
+    assert all(q["quantity"] not in ("speed_rpm", "speed_std_rpm") for q in d["gap"]["noise_scale"])
+    with pytest.raises(trum.InputError, match="unknown column 'speed'"):
+        trum.diagnose(RING, DATA, sensor_noise={"speed": 1.0})
+    with pytest.raises(trum.InputError, match="> 0"):
+        trum.diagnose(RING, DATA, sensor_noise={"speed_rpm": 0.0})
+    with pytest.raises(TypeError):
+        trum.diagnose(RING, DATA, sensor_noise={"speed_rpm": (1.0, 2.0, 3.0)})

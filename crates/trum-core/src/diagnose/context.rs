@@ -59,12 +59,41 @@ impl<'a> Context<'a> {
         groups: &[String],
         opts: &DiagnoseOptions,
     ) -> Result<Context<'a>, TrumError> {
+        // The sensors' noise levels where the user states them, the defaults elsewhere.
+        let stated = with_stated_noise(rows, &opts.stated_noise)?;
         // The bench model first: set points read back with noise are taken at their run's
         // mean, quantised readings carry their rounding error (`bench`).
-        let (unscaled, mut bench_notes) = bench_model(rows, groups);
+        let (unscaled, mut bench_notes) = bench_model(&stated, groups);
         // Noise levels from the data, so that χ² and the evidence are on the scale of the
-        // actual noise; clamped to [1/4, 4] × the stated levels.
-        let est = crate::noise::estimate(&unscaled, groups);
+        // actual noise; clamped to [1/4, 4] × the default levels. A level the user states
+        // is kept as stated: the estimate is reported beside it.
+        let mut est = crate::noise::estimate(&unscaled, groups);
+        let estimated_for_stated: Vec<String> = opts
+            .stated_noise
+            .keys()
+            .filter_map(|o| {
+                est.get(o)
+                    .map(|n| format!("{} {:.2} × its stated level ({} residuals)", o.column(), n.factor, n.residuals))
+            })
+            .collect();
+        for (o, n) in est.iter_mut() {
+            if opts.stated_noise.contains_key(o) {
+                n.factor = 1.0;
+            }
+        }
+        if !opts.stated_noise.is_empty() {
+            let list: Vec<String> = opts
+                .stated_noise
+                .iter()
+                .map(|(o, (a, r))| format!("{} σ = {} + {} × reading", o.column(), a, r))
+                .collect();
+            let estimate = if estimated_for_stated.is_empty() {
+                String::new()
+            } else {
+                format!("; the data's own estimate: {}", estimated_for_stated.join(", "))
+            };
+            bench_notes.push(format!("noise levels as stated for the bench's sensors: {}{estimate}", list.join(", ")));
+        }
         // Large data: the fits see a systematic subsample; the set points, the noise levels
         // and the best noise levels come from every row (each a pass over the rows, against
         // hundreds for the fits).
@@ -100,8 +129,11 @@ impl<'a> Context<'a> {
         };
         let n_read: usize = unscaled.iter().map(|r| r.readings.len()).sum();
         let rows = &scaled[..];
-        let noise_scale: Vec<(String, f64, usize)> =
-            est.iter().map(|(&o, n)| (o.column().to_string(), applied_factor(&est, o), n.residuals)).collect();
+        let noise_scale: Vec<(String, f64, usize)> = est
+            .iter()
+            .filter(|(o, _)| !opts.stated_noise.contains_key(o))
+            .map(|(&o, n)| (o.column().to_string(), applied_factor(&est, o), n.residuals))
+            .collect();
         if rows.len() < 4 {
             return Err(TrumError::input(format!(
                 "{} rows are too few to diagnose anything; need at least 4 operating points",
@@ -260,6 +292,37 @@ pub(super) fn bench_model(rows: &[ObservedRow], groups: &[String]) -> (Vec<Obser
     let (snapped, snap_note) = bench::snap_set_points(rows, groups);
     let (out, quantum_note) = bench::account_for_quantisation(&snapped);
     (out, snap_note.into_iter().chain(quantum_note).collect())
+}
+
+/// `rows` with the σ of every reading of a quantity in `stated` set to its stated level,
+/// `absolute + relative · |reading|`. Errors on a part that is negative or not finite, and
+/// on an absolute part of zero (a reading of zero would have no noise and weigh
+/// infinitely).
+fn with_stated_noise(
+    rows: &[ObservedRow],
+    stated: &BTreeMap<Observable, (f64, f64)>,
+) -> Result<Vec<ObservedRow>, TrumError> {
+    for (o, &(a, r)) in stated {
+        let ok = a.is_finite() && r.is_finite() && a > 0.0 && r >= 0.0;
+        if !ok {
+            return Err(TrumError::input(format!(
+                "stated noise level of {}: the absolute part ({a}) must be a finite number > 0 and the relative part ({r}) a finite number >= 0",
+                o.column()
+            )));
+        }
+    }
+    Ok(rows
+        .iter()
+        .map(|row| {
+            let mut row = row.clone();
+            for x in row.readings.iter_mut() {
+                if let Some(&(a, r)) = stated.get(&x.0) {
+                    x.2 = a + r * x.1.abs();
+                }
+            }
+            row
+        })
+        .collect())
 }
 
 /// The factor applied to the stated noise levels of quantity `o`: its estimate clamped to

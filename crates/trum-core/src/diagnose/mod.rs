@@ -79,12 +79,63 @@ pub struct DiagnoseOptions {
     /// the held-out figures of the subsample; set points and noise levels still come from
     /// every row. 0: every row, however many (the cost then grows with the rows).
     pub max_fit_rows: usize,
+    /// Noise levels of the bench's sensors as the user states them, by quantity: (absolute
+    /// standard deviation in the quantity's unit, relative part), a reading's σ being
+    /// `absolute + relative · |reading|`, the absolute part > 0 and the relative one ≥ 0
+    /// (an error names the quantity otherwise). A stated level replaces the default one
+    /// ([`Observable::default_sigma`]) and is not rescaled by the estimate from the data
+    /// (docs/DIAGNOSIS.md, "Noise levels from the data"). Empty by default.
+    pub stated_noise: BTreeMap<Observable, (f64, f64)>,
 }
 
 /// The default [`DiagnoseOptions::max_fit_rows`]: the size at which a diagnosis with all
 /// seven candidates stays near a second on two cores (docs/PERFORMANCE.md), and where a
 /// candidate that matters reaches an evidence of hundreds on nominal bench noise.
 pub const MAX_FIT_ROWS: usize = 160;
+
+/// Reads stated sensor noise levels from `COLUMN=SD` or `COLUMN=SD,REL` texts (`SD` the
+/// absolute standard deviation in the column's unit, `REL` the relative part, 0 when
+/// left out) for [`DiagnoseOptions::stated_noise`]. `source` names where the texts come
+/// from in errors (a flag, an argument). Errors name the text and why: an unknown column
+/// (with the valid ones), a number that does not parse, a level out of range, a column
+/// stated twice.
+pub fn stated_noise_from_texts(texts: &[String], source: &str) -> Result<BTreeMap<Observable, (f64, f64)>, TrumError> {
+    let columns = || Observable::ALL.iter().map(|o| o.column()).collect::<Vec<_>>().join(", ");
+    let mut out = BTreeMap::new();
+    for t in texts {
+        let (col, levels) = t
+            .split_once('=')
+            .ok_or_else(|| TrumError::input(format!("{source} '{t}': expected COLUMN=SD or COLUMN=SD,REL")))?;
+        let col = col.trim();
+        let o = Observable::ALL.into_iter().find(|o| o.column() == col).ok_or_else(|| {
+            TrumError::input(format!("{source} '{t}': unknown column '{col}'; measured columns are {}", columns()))
+        })?;
+        let mut parts = levels.split(',').map(str::trim);
+        let number = |x: Option<&str>, what: &str| -> Result<Option<f64>, TrumError> {
+            match x {
+                None => Ok(None),
+                Some(x) => x
+                    .parse::<f64>()
+                    .map(Some)
+                    .map_err(|_| TrumError::input(format!("{source} '{t}': {what} '{x}' is not a number"))),
+            }
+        };
+        let sd = number(parts.next(), "the standard deviation")?.unwrap_or(f64::NAN);
+        let rel = number(parts.next(), "the relative part")?.unwrap_or(0.0);
+        if parts.next().is_some() {
+            return Err(TrumError::input(format!("{source} '{t}': expected COLUMN=SD or COLUMN=SD,REL")));
+        }
+        if !(sd.is_finite() && sd > 0.0 && rel.is_finite() && rel >= 0.0) {
+            return Err(TrumError::input(format!(
+                "{source} '{t}': the standard deviation must be a finite number > 0 (in the column's unit) and the relative part a finite number >= 0"
+            )));
+        }
+        if out.insert(o, (sd, rel)).is_some() {
+            return Err(TrumError::input(format!("{source}: column '{col}' is stated twice")));
+        }
+    }
+    Ok(out)
+}
 
 impl Default for DiagnoseOptions {
     fn default() -> Self {
@@ -98,6 +149,7 @@ impl Default for DiagnoseOptions {
             exact_cv: false,
             tolerances: BTreeMap::new(),
             max_fit_rows: MAX_FIT_ROWS,
+            stated_noise: BTreeMap::new(),
         }
     }
 }

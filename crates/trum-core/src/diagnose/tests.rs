@@ -815,3 +815,57 @@ fn the_parameters_the_data_leave_at_their_priors_are_named() {
     assert!(full.baseline_held_near_prior.len() < small.baseline_held_near_prior.len());
     assert!(!full.baseline_held_near_prior.iter().any(|n| n == "stator.resonance_frequency_hz"));
 }
+
+/// A sensor noise level the user states replaces the default and the estimate from the
+/// data: the note says so with the data's own estimate beside it, the stated quantity
+/// leaves the list of estimated factors, and a level four times the default lowers the
+/// baseline's held-out z² (each of the quantity's readings weighs a sixteenth as much).
+#[test]
+fn a_stated_sensor_noise_level_replaces_the_estimate() {
+    let (nominal, rows, groups) = sag_data();
+    let opts =
+        DiagnoseOptions { candidates: vec![Effect::VoltageSag], try_pairs: false, bootstrap: 20, ..quick(false) };
+    let plain = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+    let speed_sd = |v: f64| 4.0 * Observable::SpeedRpm.default_sigma(v);
+    let stated = DiagnoseOptions {
+        stated_noise: BTreeMap::from([(Observable::SpeedRpm, (speed_sd(0.0), 0.04))]),
+        ..opts.clone()
+    };
+    let d = diagnose(&nominal, &rows, &groups, &stated).expect("diagnosis");
+    let note = d.notes.iter().find(|n| n.starts_with("noise levels as stated")).expect("stated note");
+    assert!(note.contains("speed_rpm σ = 2 + 0.04 × reading") && note.contains("its stated level"), "{note}");
+    assert!(d.noise_scale.iter().all(|(q, _, _)| q != "speed_rpm"), "{:?}", d.noise_scale);
+    assert!(plain.noise_scale.iter().any(|(q, _, _)| q == "speed_rpm"));
+    assert!(
+        d.baseline_heldout_chi2_per_reading < plain.baseline_heldout_chi2_per_reading,
+        "{} against {}",
+        d.baseline_heldout_chi2_per_reading,
+        plain.baseline_heldout_chi2_per_reading
+    );
+    // a level out of range is refused with the quantity's name
+    let zero = DiagnoseOptions { stated_noise: BTreeMap::from([(Observable::CurrentA, (0.0, 0.01))]), ..opts };
+    let e = diagnose(&nominal, &rows, &groups, &zero).expect_err("refused").to_string();
+    assert!(e.contains("current_a") && e.contains("> 0"), "{e}");
+}
+
+/// The texts of `--sensor-noise` (and Python's `sensor_noise`): `COLUMN=SD` or
+/// `COLUMN=SD,REL`; errors name the text and list the valid columns.
+#[test]
+fn stated_sensor_noise_texts_are_read_or_refused_with_the_reason() {
+    let t =
+        |xs: &[&str]| stated_noise_from_texts(&xs.iter().map(|x| x.to_string()).collect::<Vec<_>>(), "--sensor-noise");
+    let ok = t(&["speed_rpm=0.3,0.005", "current_a = 0.002"]).expect("read");
+    assert_eq!(ok[&Observable::SpeedRpm], (0.3, 0.005));
+    assert_eq!(ok[&Observable::CurrentA], (0.002, 0.0));
+    let err = |xs: &[&str]| t(xs).expect_err("refused").to_string();
+    let e = err(&["speed=1"]);
+    assert!(e.contains("'speed=1'") && e.contains("speed_rpm, input_power_w"), "{e}");
+    assert!(err(&["speed_rpm"]).contains("COLUMN=SD"));
+    assert!(err(&["speed_rpm=fast"]).contains("'fast' is not a number"));
+    assert!(err(&["speed_rpm=1,2,3"]).contains("COLUMN=SD,REL"));
+    assert!(err(&["speed_rpm=0"]).contains("> 0"));
+    assert!(err(&["speed_rpm=1,-0.1"]).contains(">= 0"));
+    assert!(err(&["speed_rpm=inf"]).contains("finite"));
+    assert!(err(&["speed_rpm=1", "speed_rpm=2"]).contains("stated twice"));
+    assert!(t(&[]).expect("none").is_empty());
+}

@@ -115,6 +115,24 @@ def _plausible_args(plausible: Plausible) -> Tuple[List[str], Optional[Tuple[str
 
 
 Tolerances = Union[None, Mapping[str, float], str, "os.PathLike[str]"]
+SensorNoise = Optional[Mapping[str, Union[float, Tuple[float, float]]]]
+
+
+def _sensor_noise_args(sensor_noise: SensorNoise) -> List[str]:
+    """``sensor_noise=`` as the extension takes it: ``COLUMN=SD`` or ``COLUMN=SD,REL`` texts."""
+    if sensor_noise is None:
+        return []
+    if not isinstance(sensor_noise, Mapping):
+        raise TypeError("sensor_noise must be a mapping of column names to sd or (sd, rel)")
+    out = []
+    for col, level in sensor_noise.items():
+        if isinstance(level, (tuple, list)):
+            if len(level) != 2:
+                raise TypeError(f"sensor_noise[{col!r}]: expected sd or (sd, rel), got {level!r}")
+            out.append(f"{col}={float(level[0])!r},{float(level[1])!r}")
+        else:
+            out.append(f"{col}={float(level)!r}")
+    return out
 
 
 def _tolerances_args(tolerances: Tolerances) -> Tuple[List[Tuple[str, float]], Optional[Tuple[str, str]]]:
@@ -234,6 +252,7 @@ def diagnose(
     exact_cv: bool = False,
     plausible: Plausible = None,
     tolerances: Tolerances = None,
+    sensor_noise: SensorNoise = None,
 ) -> Diagnosis:
     """Where the calibrated baseline misses the measurements, which unmodelled effect
     causes it, and how far the held-out gap shrinks once it is added.
@@ -262,13 +281,24 @@ def diagnose(
     parameter, ``float("inf")`` fits it without a prior; the bench keys state the sensors'
     specs). Without it the default tolerances apply. An unknown key raises
     ``trum.InputError`` listing the valid ones.
+
+    ``sensor_noise`` states the noise levels of the bench's sensors, in place of the
+    default levels and of their estimate from the data (as ``trum diagnose
+    --sensor-noise``; docs/DIAGNOSIS.md, "Noise levels from the data"): a mapping of
+    measured columns to the standard deviation in the column's unit, or to a pair
+    (standard deviation, relative part), a reading's σ being ``sd + rel * |reading|``:
+    ``{"speed_rpm": (0.3, 0.005), "current_a": 0.002}``. An unknown column or a level out
+    of range raises ``trum.InputError``.
     """
     m = _motor(motor)
     raw, source = _read_data(data)
     motor_source = motor if isinstance(motor, str) else (m.preset or m.name)
     specs, toml = _plausible_args(plausible)
     tol, tol_toml = _tolerances_args(tolerances)
-    text, notes = _trum.diagnose_csv(m, raw, source, motor_source, bool(exact_cv), specs, toml, tol, tol_toml)
+    noise = _sensor_noise_args(sensor_noise)
+    text, notes = _trum.diagnose_csv(
+        m, raw, source, motor_source, bool(exact_cv), specs, toml, tol, tol_toml, noise
+    )
     for w in notes:
         warnings.warn(w, stacklevel=2)
     return Diagnosis(json.loads(text))

@@ -9,7 +9,16 @@ import warnings
 from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 from ._api import _motor
-from ._diagnosis import Plausible, Tolerances, _plausible_args, _portable, _tolerances_args, calibrate, diagnose
+from ._diagnosis import (
+    Plausible,
+    SensorNoise,
+    Tolerances,
+    _plausible_args,
+    _portable,
+    _tolerances_args,
+    calibrate,
+    diagnose,
+)
 from ._errors import InputError
 from ._motor import Motor
 from ._result import _require_pandas
@@ -79,8 +88,12 @@ def _row(work: Callable[[str], Dict[str, Any]], path: str) -> Dict[str, Any]:
     return row
 
 
-def _diagnose_cells(path: str, motor: Motor, plausible: Any, tolerances: Any, exact_cv: bool) -> Dict[str, Any]:
-    d = diagnose(motor, path, exact_cv=exact_cv, plausible=plausible, tolerances=tolerances)
+def _diagnose_cells(
+    path: str, motor: Motor, plausible: Any, tolerances: Any, exact_cv: bool, sensor_noise: SensorNoise = None
+) -> Dict[str, Any]:
+    d = diagnose(
+        motor, path, exact_cv=exact_cv, plausible=plausible, tolerances=tolerances, sensor_noise=sensor_noise
+    )
     ranking = d.get("ranking", [])
     verdict = d["verdict"]
     of_verdict = next((r for r in ranking if _same_set(r["effect"], verdict)), None)
@@ -184,6 +197,7 @@ def diagnose_fleet(
     exact_cv: bool = False,
     plausible: Plausible = None,
     tolerances: Tolerances = None,
+    sensor_noise: SensorNoise = None,
 ) -> Any:
     """Diagnoses every measurement file in ``files`` on its own, in parallel on Dask, and
     returns one summary row per file as a pandas DataFrame, the table of ``trum diagnose
@@ -202,7 +216,7 @@ def diagnose_fleet(
 
     ``client``: a ``distributed.Client`` (default: the running default client, else
     threads of this process). ``npartitions``: Dask tasks (default one per file).
-    ``exact_cv``, ``plausible`` and ``tolerances`` as for :func:`trum.diagnose`; a
+    ``exact_cv``, ``plausible``, ``tolerances`` and ``sensor_noise`` as for :func:`trum.diagnose`; a
     ``plausible`` or ``tolerances`` TOML file is read once here and its text shipped to the
     workers. Rows come in the order of the
     file list."""
@@ -214,6 +228,7 @@ def diagnose_fleet(
         plausible=_portable(plausible, _plausible_args),
         tolerances=_portable(tolerances, _tolerances_args),
         exact_cv=bool(exact_cv),
+        sensor_noise=dict(sensor_noise) if sensor_noise is not None else None,
     )
     return _frame(_map(work, paths, client, npartitions), DIAGNOSE_FLEET_COLUMNS)
 

@@ -150,6 +150,7 @@ def diagnose_csv(
     plausible_toml: Optional[Tuple[str, str]] = None,
     tolerances: List[Tuple[str, float]] = ...,
     tolerances_toml: Optional[Tuple[str, str]] = None,
+    sensor_noise: List[str] = ...,
 ) -> Tuple[str, List[str]]: ...
 def calibrate_csv(
     motor: Motor,
