@@ -435,3 +435,30 @@ fn a_presets_own_effects_are_synthesised_in_candidate_form() {
     let err = text(&o.stderr);
     assert!(err.contains("(truth forms: voltage_sag; candidate forms: radial_friction, preload_stiffening)"), "{err}");
 }
+
+/// `--sensor-noise` states a sensor's noise level: the JSON's notes say so, and a bad
+/// statement is refused before the run with the flag, the text and the reason.
+#[test]
+fn sensor_noise_is_stated_or_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = synth(dir.path(), "st.csv", &["--campaign", "stability", "--noise", "1", "--seed", "3"]);
+    let json = ok(&[
+        "diagnose",
+        "--motor",
+        MOTOR,
+        "--data",
+        &data,
+        "--sensor-noise",
+        "speed_std_rpm=0.08,0.1",
+        "--json",
+        "-",
+        "-q",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&json).expect("JSON");
+    let notes: Vec<&str> = v["notes"].as_array().expect("notes").iter().filter_map(|n| n.as_str()).collect();
+    assert!(notes.iter().any(|n| n.contains("speed_std_rpm σ = 0.08 + 0.1 × reading")), "{notes:?}");
+    let e = fails(&["diagnose", "--motor", MOTOR, "--data", &data, "--sensor-noise", "speed=1", "-q"], 1);
+    assert!(e.contains("--sensor-noise 'speed=1': unknown column 'speed'") && e.contains("speed_std_rpm"), "{e}");
+    let e = fails(&["diagnose", "--motor", MOTOR, "--data", &data, "--sensor-noise", "speed_rpm=0", "-q"], 1);
+    assert!(e.contains("must be a finite number > 0"), "{e}");
+}
