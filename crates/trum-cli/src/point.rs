@@ -53,7 +53,13 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
     let valid = s.status.is_valid();
     let limit_notes = motor.limits.describe(&LimitedQuantities::of_point(motor.thermal.ambient_c, &op, &s), s.warnings);
     let loaded_stall = loaded_stall(&motor, &op, &s);
-    let notes: Vec<String> = clamps_before_stall(loaded_stall, s.stall_torque_nm).into_iter().collect();
+    let mut notes: Vec<String> = clamps_before_stall(loaded_stall, s.stall_torque_nm).into_iter().collect();
+    if s.work_bound_reached {
+        notes.push(format!(
+            "the solve spent its work bound ({} units) before it found a steady state (docs/RELIABILITY.md)",
+            trum_core::solve::WORK_BOUND
+        ));
+    }
     let inputs: [(&str, f64, &str); 5] = [
         ("preload_n", op.preload_n, "N"),
         ("torque_nm", op.torque_nm, "N·m"),
@@ -82,6 +88,7 @@ pub fn run(a: &PointArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<i3
             "valid": valid,
             "full_contact": s.full_contact,
             "iterations": s.iterations,
+            "work_bound_reached": s.work_bound_reached,
             "warnings": s.warnings.keys().collect::<Vec<_>>(),
             "warning_details": limit_notes,
             "quantities": q,

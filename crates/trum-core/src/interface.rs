@@ -100,6 +100,26 @@ impl Factors {
 
 const NODES: usize = 12;
 
+thread_local! {
+    /// Integrand evaluations at quadrature nodes summed on this thread so far: the meter of
+    /// a solve's work bound (crate::solve's `Work`, read around each trial on the thread
+    /// that runs it). A meter rather than a counter passed down: the integrals are reached
+    /// through a dozen routes whose signatures the tests and the sensitivities share.
+    static INTEGRAND_EVALUATIONS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// Adds `n` integrand evaluations to this thread's meter.
+#[inline(always)]
+fn count_evaluations(n: usize) {
+    INTEGRAND_EVALUATIONS.with(|c| c.set(c.get().wrapping_add(n as u64)));
+}
+
+/// Integrand evaluations at quadrature nodes summed on this thread so far (wrapping): the
+/// difference across a computation on the same thread is the nodes it summed.
+pub(crate) fn integrand_evaluations() -> u64 {
+    INTEGRAND_EVALUATIONS.with(std::cell::Cell::get)
+}
+
 fn gauss_legendre() -> &'static [(f64, f64); NODES] {
     static GL: OnceLock<[(f64, f64); NODES]> = OnceLock::new();
     GL.get_or_init(|| {
@@ -366,6 +386,7 @@ fn coulomb_sums(nodes: &Nodes, c: f64, u: f64, rho: f64, weight: f64) -> Factors
     let mut t_uu = [0.0; L];
     // (panels add NODES = 12 nodes at a time)
     debug_assert_eq!(nodes.len % L, 0);
+    count_evaluations(nodes.len);
     for k0 in (0..nodes.len).step_by(L) {
         for l in 0..L {
             let k = k0 + l;
@@ -411,6 +432,7 @@ fn coulomb_sums(nodes: &Nodes, c: f64, u: f64, rho: f64, weight: f64) -> Factors
 fn compliance_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64, weight: f64) -> Factors {
     let inv_s = 1.0 / slip_scale;
     let (mut t, mut t_u, mut p, mut p_u, mut t_uu) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    count_evaluations(nodes.len);
     for k in 0..nodes.len {
         let (co, w) = (nodes.cos[k], nodes.weight[k]);
         let wq = w * (co - c).max(0.0);
@@ -631,6 +653,7 @@ fn compliance_factors(ct: &Contact, uc: f64, u: f64, law: &Law, z: Option<(f64, 
 fn compliance_window_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64) -> Factors {
     let inv_s = 1.0 / slip_scale;
     let (mut t, mut t_u, mut p, mut p_u, mut t_uu) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    count_evaluations(nodes.len);
     for k in 0..nodes.len {
         let (co, w) = (nodes.cos[k], nodes.weight[k]);
         let wq = w * (co - c).max(0.0);
@@ -701,6 +724,7 @@ fn node_sums(nodes: &Nodes, c: f64, u: f64, law: &Law) -> Factors {
         } else if law.slip_scale > 0.0 {
             // (no second derivative on this route)
             let mut g = Factors { torque_uu: f64::NAN, ..Factors::default() };
+            count_evaluations(nodes.len);
             for k in 0..nodes.len {
                 accumulate(&mut g, nodes.sin[k], nodes.cos[k], weight * nodes.weight[k], c, u, rho, law);
             }

@@ -28,7 +28,7 @@
 use crate::params::Motor;
 use crate::solve::{
     eccentric_average_with, finite_or_unconverged, iterated, map_solution, solve_clamped, solve_effects,
-    solve_prepared_with, state_map, OperatingPoint, Prepared, Solution, Status, Trial,
+    solve_prepared_with, state_map, OperatingPoint, Prepared, Solution, Status, Trial, Work,
 };
 use nalgebra::{Matrix3, Vector3};
 
@@ -167,8 +167,9 @@ pub(crate) struct Solved {
 /// `solve_prepared(p, motor, op, None)`, keeping the solves behind it for [`linearise`].
 pub(crate) fn solve_kept(p: &Prepared, motor: &Motor, op: &OperatingPoint) -> Solved {
     let mut calls = Vec::new();
-    let solution = solve_prepared_with(p, motor, op, None, |o, g| {
-        let s = solve_effects(p, o, g);
+    let work = Work::of(p);
+    let solution = solve_prepared_with(p, motor, op, None, &work, |o, g| {
+        let s = solve_effects(p, o, g, &work);
         calls.push((*o, s.clone()));
         s
     });

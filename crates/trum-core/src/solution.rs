@@ -19,7 +19,8 @@ pub enum Status {
     /// No steady state was found: the iteration did not converge, or, with `voltage_sag`
     /// or `thermal_drift`, the state jumps between a moving and a clamped (or stalled) one
     /// at every pass (the motor hunts, docs/EFFECTS.md). Numbers are the last iterate and
-    /// must not be used.
+    /// must not be used. Also the status of a solve that spent its work bound
+    /// ([`Solution::work_bound_reached`]).
     NoConvergence,
     /// The operating point itself is invalid (non-finite, non-positive preload, ...).
     InvalidInput,
@@ -123,6 +124,11 @@ pub struct Solution {
     /// The motor's `[limits]` this point exceeds ([`crate::limits`]); empty when it is
     /// inside all of them. Never changes the status or the numbers.
     pub warnings: LimitWarnings,
+    /// True when the solve stopped because it spent its work bound
+    /// ([`crate::solve::WORK_BOUND`], [`crate::solve::Prepared::with_work_bound`]) before it
+    /// found a steady state; the status is then `NoConvergence` and the numbers must not be
+    /// used. False for every other status and every other reason of `NoConvergence`.
+    pub work_bound_reached: bool,
 }
 
 impl Solution {
@@ -169,6 +175,7 @@ impl Solution {
             temperature_rise_at_elapsed_k: n,
             speed_std_rpm: n,
             warnings: LimitWarnings::NONE,
+            work_bound_reached: false,
         }
     }
 }

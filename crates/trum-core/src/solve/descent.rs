@@ -5,8 +5,8 @@
 
 use super::bracket::SignBracket;
 use super::finish::{clamped_trial, finish};
-use super::trial::{trial_after, Drive, Trial};
-use super::{OperatingPoint, Prepared, Solution, Status};
+use super::trial::{Drive, Trial};
+use super::{OperatingPoint, Prepared, Solution, Status, Work};
 use crate::interface::AngleCarry;
 use crate::stator::{elastic_detuning, stiffness_crossing};
 use std::f64::consts::PI;
@@ -20,9 +20,15 @@ const MULTI_BRANCH_STEP: f64 = 0.8;
 const DEEP_CLAMPED_STEP: f64 = 0.1;
 
 /// The steady amplitude under drive `d`: the descent from the cold bound onto the largest
-/// fixed point ([`solve_drive_below`]).
-pub(super) fn solve_drive(p: &Prepared, d: &Drive, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
-    solve_drive_below(p, d, op, guess, None)
+/// fixed point ([`solve_drive_below`]), its trials charged to `work`.
+pub(super) fn solve_drive(
+    p: &Prepared,
+    d: &Drive,
+    op: &OperatingPoint,
+    guess: Option<&Solution>,
+    work: &Work,
+) -> Solution {
+    solve_drive_below(p, d, op, guess, None, work)
 }
 
 /// A sweep's warm start of the amplitude descent (`solve_in_sweep`): a proven upper bound
@@ -69,6 +75,8 @@ pub(super) fn amplitude_rtol(p: &Prepared) -> f64 {
 struct Trials<'a> {
     p: &'a Prepared,
     d: &'a Drive,
+    /// The budget of the solve the descent belongs to, charged for every trial.
+    work: &'a Work,
     /// Amplitude evaluations so far.
     evals: u32,
     /// Stick half-angle θs [rad] that starts the next trial's stick solve.
@@ -92,13 +100,24 @@ struct Trials<'a> {
 impl<'a> Trials<'a> {
     /// No trial yet: the first starts its angle solves at the warm top's extrapolated
     /// angles, else at the neighbouring point's (`guess`).
-    fn new(p: &'a Prepared, d: &'a Drive, guess: Option<&Solution>, top: Option<&WarmTop>) -> Self {
+    fn new(p: &'a Prepared, d: &'a Drive, work: &'a Work, guess: Option<&Solution>, top: Option<&WarmTop>) -> Self {
         let ts_guess =
             top.and_then(|t| t.stick_rad).or(guess.map(|g| g.stick_half_angle_rad)).filter(|t| t.is_finite());
         let phi_guess =
             top.and_then(|t| t.contact_rad).or(guess.map(|g| g.contact_half_angle_rad)).filter(|t| t.is_finite());
         let general = p.law.radial_ratio != 0.0 || p.compliance != 0.0;
-        Trials { p, d, evals: 0, ts_guess, phi_guess, general, history: [None, None], carried: None, stalled: false }
+        Trials {
+            p,
+            d,
+            work,
+            evals: 0,
+            ts_guess,
+            phi_guess,
+            general,
+            history: [None, None],
+            carried: None,
+            stalled: false,
+        }
     }
 
     /// The trial at amplitude `w` [m].
@@ -115,7 +134,7 @@ impl<'a> Trials<'a> {
         let start = |i: usize, plain: Option<f64>| {
             carried.and_then(|(from, c)| c[i]?.start_at(from, w)).or(plain.map(|g| (g, None)))
         };
-        let t = trial_after(self.p, self.d, w, start(1, guess), start(0, self.phi_guess), self.stalled);
+        let t = self.work.trial_after(self.p, self.d, w, start(1, guess), start(0, self.phi_guess), self.stalled);
         self.stalled = t.stalled;
         self.ts_guess = Some(t.ts);
         self.phi_guess = Some(t.contact.half_angle_rad).filter(|_| !t.contact.full);
@@ -480,18 +499,21 @@ fn unbracketed_step(cur: &Trial, prev: Option<Trial>, stretch: &mut f64, cap: St
 /// then steps down ([`unbracketed_step`], capped by [`StepCap`]) until a root is
 /// bracketed, the windows at the crossing searched before the descent passes it
 /// ([`windows_at_crossing`]), and Newton or regula-falsi steps inside the bracket.
+///
+/// Every trial is charged to `work`; once it is spent the descent ends unconverged.
 pub(super) fn solve_drive_below(
     p: &Prepared,
     d: &Drive,
     op: &OperatingPoint,
     guess: Option<&Solution>,
     top: Option<WarmTop>,
+    work: &Work,
 ) -> Solution {
     let rtol = amplitude_rtol(p);
     // Upper bound: |Z| ≥ ω·c, so W' ≤ Θ·V/(ω·c).
     let w_hi0 = p.theta * d.v / (d.omega * d.c);
     let floor = d.clamp_floor(p.theta);
-    let mut trials = Trials::new(p, d, guess, top.as_ref());
+    let mut trials = Trials::new(p, d, work, guess, top.as_ref());
     let (warm_trial, below) = match top {
         Some(wt) => {
             let (t, below) = warm_top(&mut trials, &wt, rtol);
@@ -558,6 +580,9 @@ pub(super) fn solve_drive_below(
         SignBracket { neg: lo.map(|l| (l.w, l.w - l.w_next)), pos: Some((hi.w, hi.w - hi.w_next)), last_side: 0 };
     let mut stretch = 1.0; // fixed-point step multiplier, doubled per rejected secant
     for _ in 0..if multi_branch { 200 } else { 80 } {
+        if work.exhausted() {
+            break;
+        }
         let r = cur.w - cur.w_next;
         if r.abs() <= rtol * cur.w.max(1e-300) {
             converged = true;
@@ -602,7 +627,7 @@ pub(super) fn solve_drive_below(
     }
     let evals = trials.evals;
     if !converged {
-        if cur.w < floor {
+        if cur.w < floor && !work.exhausted() {
             return finish(p, d, op, &clamped_trial(p, d), Status::Clamped, evals);
         }
         let mut s = finish(p, d, op, &cur, Status::NoConvergence, evals);

@@ -119,5 +119,6 @@ fn finish_unchecked(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, sta
         temperature_rise_at_elapsed_k: rise_t,
         speed_std_rpm: 0.0,
         warnings: crate::limits::LimitWarnings::NONE,
+        work_bound_reached: false,
     }
 }

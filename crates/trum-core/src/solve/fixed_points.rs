@@ -7,7 +7,7 @@ use super::bracket::{bracketed_secant, dip_below_zero, SignBracket};
 use super::descent::{amplitude_rtol, solve_drive, solve_drive_below, WarmTop};
 use super::finish::{clamped_trial, finish, rest_torque_factor};
 use super::trial::{sagged_voltage_at, sagged_voltage_v, trial, Drive, Trial};
-use super::{OperatingPoint, Prepared, Solution, Status};
+use super::{OperatingPoint, Prepared, Solution, Status, Work};
 use crate::effects::Effect;
 use crate::stator;
 
@@ -22,8 +22,10 @@ use crate::stator;
 /// clamped …); the one consistent state lies between V and G(V) (210.1 V, moving). The
 /// secant step is therefore kept inside that interval ([`bracketed_secant`]): unbounded,
 /// it is faster but can leave it.
-pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
-    solve_effects_with(p, op, guess, true, |d, g, top| solve_drive_below(p, d, op, g, top))
+///
+/// Every trial is charged to `work`, the budget of the solve this one belongs to.
+pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&Solution>, work: &Work) -> Solution {
+    solve_effects_with(p, op, guess, true, work, |d, g, top| solve_drive_below(p, d, op, g, top, work))
 }
 
 /// The clamped state of `p` at `op` (W = 0) with the effects' fixed point solved on it,
@@ -32,18 +34,21 @@ pub(crate) fn solve_effects(p: &Prepared, op: &OperatingPoint, guess: Option<&So
 /// to slightly changed motors (the descent to W = 0 is the costliest solve there is: 10-80
 /// trials).
 pub(crate) fn solve_clamped(p: &Prepared, op: &OperatingPoint) -> Solution {
-    solve_effects_with(p, op, None, false, |d, _, _| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0))
+    // (no trial: nothing is charged to the budget)
+    let work = Work::of(p);
+    solve_effects_with(p, op, None, false, &work, |d, _, _| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0))
 }
 
 /// [`solve_effects`] with `drive(d, guess, top)` solving the amplitude under drive `d`
 /// (`top`: a proven upper bound of its largest fixed point, [`settle_with`]);
 /// `branches`: `drive` is the amplitude solve, whose lower (stalled) branch is searched
-/// where the electrode voltage jumps ([`settle_lower_branch`]).
+/// where the electrode voltage jumps ([`settle_lower_branch`]); `work`: the solve's budget.
 fn solve_effects_with(
     p: &Prepared,
     op: &OperatingPoint,
     guess: Option<&Solution>,
     branches: bool,
+    work: &Work,
     drive: impl Fn(&Drive, Option<&Solution>, Option<WarmTop>) -> Solution,
 ) -> Solution {
     let (thermal, sag) = iterated(p, op);
@@ -52,9 +57,11 @@ fn solve_effects_with(
     }
     let direct_warm = |d: &Drive, _: f64, g: Option<&Solution>, top: Option<WarmTop>| drive(d, g, top);
     let direct_cold = |d: &Drive, _: f64, g: Option<&Solution>, _: Option<WarmTop>| drive(d, g, None);
-    let (mut s, mut rise, mut settled) = settle_with(p, op, guess, (thermal, sag), 0.0, &direct_warm);
+    let (mut s, mut rise, mut settled) = settle_with(p, op, guess, (thermal, sag), 0.0, work, &direct_warm);
     if branches && sag && !thermal && !settled {
-        if let Some(stalled) = settle_lower_branch(p, op, &s, 0.0).or_else(|| settle_on_amplitude(p, op, 0.0)) {
+        if let Some(stalled) =
+            settle_lower_branch(p, op, &s, 0.0, work).or_else(|| settle_on_amplitude(p, op, 0.0, work))
+        {
             (s, settled) = (stalled, true);
         }
     }
@@ -90,9 +97,11 @@ fn solve_effects_with(
             // end 1.2e-9 off its own set voltage, beyond the 1e-9 a fixed point keeps;
             // tests/solver_convergence.rs `stress_self_consistent_effects`)
             let inner = |_: &Drive, r: f64, g: Option<&Solution>| {
-                let (mut s, _, mut ok) = settle_with(p, op, g, (false, true), r, &direct_cold);
+                let (mut s, _, mut ok) = settle_with(p, op, g, (false, true), r, work, &direct_cold);
                 if lower && !ok {
-                    if let Some(l) = settle_lower_branch(p, op, &s, r).or_else(|| settle_on_amplitude(p, op, r)) {
+                    if let Some(l) =
+                        settle_lower_branch(p, op, &s, r, work).or_else(|| settle_on_amplitude(p, op, r, work))
+                    {
                         (s, ok) = (l, true);
                     }
                 }
@@ -105,7 +114,7 @@ fn solve_effects_with(
                 }
                 s
             };
-            let (s, rise, settled) = settle(p, op, Some(&from), (true, false), rise0, &inner);
+            let (s, rise, settled) = settle(p, op, Some(&from), (true, false), rise0, work, &inner);
             (s, rise, settled && inner_settled.get())
         };
         (s, rise, settled) = nested(false);
@@ -133,16 +142,17 @@ fn solve_effects_with(
 /// at the drive of the latest temperature rise and electrode voltage and recomputes both
 /// from it. A temperature rise that does not iterate stays at `rise0`. Returns the last
 /// state, the rise and whether the passes settled; a state without valid numbers (no
-/// convergence) ends them.
+/// convergence) ends them, and so does the solve's budget `work` once it is spent.
 pub(super) fn settle(
     p: &Prepared,
     op: &OperatingPoint,
     guess: Option<&Solution>,
     flags: (bool, bool),
     rise0: f64,
+    work: &Work,
     state: &dyn Fn(&Drive, f64, Option<&Solution>) -> Solution,
 ) -> (Solution, f64, bool) {
-    settle_with(p, op, guess, flags, rise0, &|d, r, g, _| state(d, r, g))
+    settle_with(p, op, guess, flags, rise0, work, &|d, r, g, _| state(d, r, g))
 }
 
 /// Largest ratio of relative amplitude change to relative electrode-voltage change between
@@ -175,6 +185,7 @@ fn settle_with(
     guess: Option<&Solution>,
     (thermal, sag): (bool, bool),
     rise0: f64,
+    work: &Work,
     state: &WarmState,
 ) -> (Solution, f64, bool) {
     let mut d = Drive::at(p, op);
@@ -263,11 +274,11 @@ fn settle_with(
             warm.then_some(WarmTop { bound: prev.amplitude_m, predicted: None, contact_rad: None, stick_rad: None });
         older = Some((prev.amplitude_m, v_prev));
         s = state(&d, rise, Some(&prev).filter(|g| g.status.is_valid()), top);
-        if done {
+        if done && !work.exhausted() {
             settled = true;
             break;
         }
-        if !s.status.is_valid() {
+        if !s.status.is_valid() || work.exhausted() {
             break;
         }
     }
@@ -317,7 +328,7 @@ fn monotone_secant(x: f64, gx: f64, last: Option<(f64, f64)>) -> Option<f64> {
 /// or `s` is none of a stall, a clamped state or a running state. Such a point may still
 /// have a steady state this does not look for: one on the middle root of the amplitude
 /// map, unstable at a fixed voltage but possibly stable with the sag (docs/EFFECTS.md).
-fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f64) -> Option<Solution> {
+fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f64, work: &Work) -> Option<Solution> {
     let at = |v: f64| {
         let mut d = Drive::at(p, op);
         if rise != 0.0 {
@@ -330,7 +341,7 @@ fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f6
     // above the lowest root at or below it, below the middle one.
     let cap_from = |d: &Drive, mut w: f64, step: f64, n: usize| {
         for _ in 0..n {
-            let t = trial(p, d, w, None, None);
+            let t = work.trial(p, d, w, None, None);
             if t.w >= t.w_next {
                 return Some(w);
             }
@@ -340,7 +351,7 @@ fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f6
     };
     let low = match s.status {
         Status::Stall | Status::Clamped => s.clone(),
-        Status::Ok => solve_drive(p, &at(sagged_voltage_v(p, op, s)), op, Some(s)),
+        Status::Ok => solve_drive(p, &at(sagged_voltage_v(p, op, s)), op, Some(s), work),
         _ => return None,
     };
     let per_volt = match low.status {
@@ -351,10 +362,10 @@ fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f6
             // decides).
             let rest =
                 |d: &Drive, _: f64, _: Option<&Solution>| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0);
-            let (c, _, settled) = settle(p, op, Some(&low), (false, true), rise, &rest);
+            let (c, _, settled) = settle(p, op, Some(&low), (false, true), rise, work, &rest);
             let d = at(c.electrode_voltage_v);
             let tiny = d.clamp_floor(p.theta);
-            let t = trial(p, &d, tiny, None, None);
+            let t = work.trial(p, &d, tiny, None, None);
             if t.w >= t.w_next {
                 return (settled && c.status == Status::Clamped).then_some(c);
             }
@@ -374,20 +385,21 @@ fn settle_lower_branch(p: &Prepared, op: &OperatingPoint, s: &Solution, rise: f6
     let below = |d: &Drive, _: f64, g: Option<&Solution>| match cap_from(d, per_volt * d.v, 1.25, 12) {
         Some(bound) => {
             let top = WarmTop { bound, predicted: None, contact_rad: None, stick_rad: None };
-            solve_drive_below(p, d, op, g, Some(top))
+            solve_drive_below(p, d, op, g, Some(top), work)
         }
         None => Solution::invalid(Status::NoConvergence),
     };
-    let (lower, _, settled) = settle(p, op, Some(&low), (false, true), rise, &below);
+    let (lower, _, settled) = settle(p, op, Some(&low), (false, true), rise, work, &below);
     (settled && matches!(lower.status, Status::Stall | Status::Ok)).then_some(lower)
 }
 
 /// The sagging drive's balance h(W) = W − Θ·V_e(W)/|Z(W)| at amplitude `w` [m] under the
 /// drive `d` (its set voltage): (h [m], the trial at W, the electrode voltage V_e [V]). The
 /// phase admittance Y = I/V depends on W only, through Z(W) ([`stator::phase_current_a`]),
-/// so V_e(W) = V_set/|1 + Z_src·Y(W)| needs no passes, and each h(W) is one trial.
-pub(super) fn sag_balance(p: &Prepared, d: &Drive, op: &OperatingPoint, w: f64) -> (f64, Trial, f64) {
-    let t = trial(p, d, w, None, None);
+/// so V_e(W) = V_set/|1 + Z_src·Y(W)| needs no passes, and each h(W) is one trial, charged
+/// to `work`.
+pub(super) fn sag_balance(p: &Prepared, d: &Drive, op: &OperatingPoint, w: f64, work: &Work) -> (f64, Trial, f64) {
+    let t = work.trial(p, d, w, None, None);
     let (ire, iim) = stator::phase_current_a(d.v, d.omega, p.c0, p.tan_d, p.theta, t.z);
     let ve = sagged_voltage_at(p, op, (ire / d.v, iim / d.v));
     (w - t.w_next * ve / d.v, t, ve)
@@ -417,12 +429,12 @@ const SAG_SCAN_RATIO: f64 = 0.97;
 /// A dip narrower than about 3 % of W that does not pull a sample below its neighbours, or
 /// lies away from the least one, is still passed over, and the root found is then a lower
 /// one, also a steady state.
-fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<Solution> {
+fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64, work: &Work) -> Option<Solution> {
     let mut d = Drive::at(p, op);
     if rise != 0.0 {
         d.warm(p, rise);
     }
-    let h = |w: f64| sag_balance(p, &d, op, w);
+    let h = |w: f64| sag_balance(p, &d, op, w, work);
     let bound = p.theta * d.v / (d.omega * d.c);
     // A partly reactive source can raise the electrode voltage above the set one: grow the
     // top until h > 0.
@@ -488,7 +500,7 @@ fn settle_on_amplitude(p: &Prepared, op: &OperatingPoint, rise: f64) -> Option<S
     let Some((lo_w, lo_eval)) = lo else {
         // no root above W = 0: the clamped stator, at the voltage its own current leaves
         let rest = |d: &Drive, _: f64, _: Option<&Solution>| finish(p, d, op, &clamped_trial(p, d), Status::Clamped, 0);
-        let (c, _, settled) = settle(p, op, None, (false, true), rise, &rest);
+        let (c, _, settled) = settle(p, op, None, (false, true), rise, work, &rest);
         return (settled && c.status == Status::Clamped).then_some(c);
     };
     // Illinois regula falsi in the sign change, to the amplitude solve's tolerance

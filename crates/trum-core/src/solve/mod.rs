@@ -25,7 +25,8 @@
 //! - `eccentric`: the once-per-revolution average of `eccentricity`;
 //! - `finish`: every reported quantity from a converged trial;
 //! - `warm_start`: the next point of a sweep, started from the points before it;
-//! - `branches`: every steady amplitude at a point and the jump frequencies.
+//! - `branches`: every steady amplitude at a point and the jump frequencies;
+//! - `work`: the work bound of one solve, shared by every route it nests.
 //!
 //! The contact interface laws live in [`crate::interface`], the W-dependent modal
 //! stiffness in [`crate::stator`].
@@ -40,6 +41,7 @@ mod fixed_points;
 mod prepared;
 pub(crate) mod trial;
 mod warm_start;
+mod work;
 
 pub use at_amplitude::solve_at_amplitude;
 pub use branches::{amplitude_branches, jump_frequencies_hz, AmplitudeBranch};
@@ -48,6 +50,8 @@ pub(crate) use fixed_points::{iterated, solve_clamped, solve_effects, state_map}
 pub use prepared::Prepared;
 pub(crate) use trial::Trial;
 pub(crate) use warm_start::{solve_in_sweep, SweepPoint, SWEEP_HISTORY};
+pub(crate) use work::Work;
+pub use work::WORK_BOUND;
 
 pub use crate::operating_point::OperatingPoint;
 use crate::params::Motor;
@@ -64,26 +68,41 @@ pub fn solve(motor: &Motor, op: &OperatingPoint) -> Solution {
 }
 
 /// Solves one operating point, optionally warm-started from a neighbouring solution
-/// (sweeps use this; the result does not depend on the guess beyond the tolerance).
+/// (sweeps use this; the result does not depend on the guess beyond the tolerance). The
+/// solve is bounded in work ([`Prepared::with_work_bound`], default [`WORK_BOUND`]): one
+/// that spends its bound is `no_convergence` with [`Solution::work_bound_reached`].
 pub fn solve_prepared(p: &Prepared, motor: &Motor, op: &OperatingPoint, guess: Option<&Solution>) -> Solution {
-    solve_prepared_with(p, motor, op, guess, |o, g| solve_effects(p, o, g))
+    solve_prepared_counted(p, motor, op, guess).0
+}
+
+/// [`solve_prepared`] and the work it spent [units of [`WORK_BOUND`]].
+pub(crate) fn solve_prepared_counted(
+    p: &Prepared,
+    motor: &Motor,
+    op: &OperatingPoint,
+    guess: Option<&Solution>,
+) -> (Solution, u64) {
+    let work = Work::of(p);
+    let s = solve_prepared_with(p, motor, op, guess, &work, |o, g| solve_effects(p, o, g, &work));
+    (s, work.spent())
 }
 
 /// [`solve_prepared`] with `solve_at(op, guess)` in place of each steady-state solve it
-/// makes (one, or the nominal one and the ripple samples of an eccentric motor):
-/// crate::sensitivity keeps them.
+/// makes (one, or the nominal one and the ripple samples of an eccentric motor), each
+/// charging `work`, the budget they share: crate::sensitivity keeps them.
 pub(crate) fn solve_prepared_with(
     p: &Prepared,
     motor: &Motor,
     op: &OperatingPoint,
     guess: Option<&Solution>,
+    work: &Work,
     mut solve_at: impl FnMut(&OperatingPoint, Option<&Solution>) -> Solution,
 ) -> Solution {
     if op.invalid_reason().is_some() {
         return Solution::invalid(Status::InvalidInput);
     }
     let s = if p.runout_m > 0.0 { eccentric_average_with(p, motor, op, guess, solve_at) } else { solve_at(op, guess) };
-    with_warnings(motor, op, finite_or_unconverged(p, s))
+    with_warnings(motor, op, work.verdict(finite_or_unconverged(p, s)))
 }
 
 /// `s` with the warnings of the motor's `[limits]` it exceeds (every public solve path

@@ -85,6 +85,8 @@ pub struct Prepared {
     /// needs; calibration reads only the observables and leaves it out
     /// ([`Prepared::without_stall_torque`]).
     pub(crate) stall_torque: bool,
+    /// Work bound of each solve [units of [`super::WORK_BOUND`]].
+    pub(crate) work_bound: u64,
 }
 
 impl Prepared {
@@ -138,6 +140,7 @@ impl Prepared {
             truth_of: ALL.map(|e| fx.is_truth_form(e)),
             truth_b_of: ALL.map(|e| fx.is_truth_form_b(e)),
             stall_torque: true,
+            work_bound: super::WORK_BOUND,
         }
     }
 
@@ -159,6 +162,18 @@ impl Prepared {
     /// For the calibration's model passes, which read only the observables.
     pub(crate) fn without_stall_torque(mut self) -> Prepared {
         self.stall_torque = false;
+        self
+    }
+
+    /// The same motor with every solve bounded at `units` of work instead of
+    /// [`super::WORK_BOUND`]: interface-integrand evaluations at quadrature nodes (35-95 ns
+    /// each on the reference machine) plus 10 per amplitude trial (docs/RELIABILITY.md,
+    /// "The work bound of a solve"). Any value is valid: 0 computes no trial, `u64::MAX`
+    /// never ends a solve. A solve that spends its bound is `no_convergence` with
+    /// [`Solution::work_bound_reached`]; every other solve is bit for bit the one of
+    /// [`Prepared::new`].
+    pub fn with_work_bound(mut self, units: u64) -> Prepared {
+        self.work_bound = units;
         self
     }
 
@@ -190,6 +205,7 @@ impl Prepared {
             alpha_s: other.alpha_s,
             heat_cap: other.heat_cap,
             stall_torque: other.stall_torque,
+            work_bound: other.work_bound,
             ..self.clone()
         };
         outputs_only == *other && iterated(self, op) == (false, false)

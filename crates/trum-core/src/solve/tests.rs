@@ -160,7 +160,7 @@ fn clamped_closed_form_is_the_clamped_solve() {
             for &t in &[0.0, 0.4] {
                 let mut op = OperatingPoint::new(f, t, 200.0, 43e3);
                 op.elapsed_s = 600.0;
-                let s = solve_effects(&p, &op, None);
+                let s = solve_effects(&p, &op, None, &Work::of(&p));
                 if s.status != Status::Clamped {
                     continue;
                 }
@@ -417,8 +417,9 @@ fn sag_with_thermal_drift_settles_where_the_joint_passes_cycle() {
     let (m, p) = sag_and_drift_trum60a();
     let mut op = OperatingPoint::new(301.77607641416205, 0.7886468900037416, 227.28717512048937, 40163.644478763854);
     op.elapsed_s = 170.56565919703655;
-    let direct = |d: &Drive, _: f64, g: Option<&Solution>| solve_drive(&p, d, &op, g);
-    let (_, _, joint) = settle(&p, &op, None, (true, true), 0.0, &direct);
+    let work = Work::of(&p);
+    let direct = |d: &Drive, _: f64, g: Option<&Solution>| solve_drive(&p, d, &op, g, &work);
+    let (_, _, joint) = settle(&p, &op, None, (true, true), 0.0, &work, &direct);
     assert!(!joint, "the joint passes settle here: the test no longer reaches the fallback");
     let s = solve(&m, &op);
     assert_eq!(s.status, Status::Ok);
@@ -479,7 +480,7 @@ fn a_sagging_drive_stalls_where_its_running_state_sags_past_the_fold() {
         assert!(s.stall_torque_nm < t, "{op:?}: blocking torque {} N·m", s.stall_torque_nm);
         // a lower one: the descent from the top finds a running state at this voltage,
         // whose current sags the voltage by more than a volt below it
-        let top = solve_drive(&p, &d, &op, None);
+        let top = solve_drive(&p, &d, &op, None, &Work::of(&p));
         assert_eq!(top.status, Status::Ok, "{op:?}: {top:?}");
         assert!(top.amplitude_m > 2.0 * s.amplitude_m, "{op:?}: {top:?} vs {s:?}");
         assert!(sagged_voltage_v(&p, &op, &top) < s.electrode_voltage_v - 1.0, "{op:?}: {top:?}");
@@ -504,7 +505,7 @@ fn a_sagging_drive_stays_clamped_where_its_moving_state_sags_below_clamping() {
         let t = trial(&p, &d, w, None, None);
         assert!(t.w_next < t.w, "W = {w} m grows to {} m", t.w_next);
     }
-    let top = solve_drive(&p, &d, &op, None);
+    let top = solve_drive(&p, &d, &op, None, &Work::of(&p));
     assert_eq!(top.status, Status::Ok, "{top:?}");
     assert!(sagged_voltage_v(&p, &op, &top) < 0.6 * v, "{top:?}");
 }
@@ -541,7 +542,7 @@ fn a_sagging_drive_settles_on_the_middle_root_where_its_passes_hunt() {
     let up = 1.01 * s.amplitude_m;
     let t = trial(&p, &d, up, None, None);
     assert!(t.w_next > up, "at a fixed voltage W = {up} m should grow: {t:?}");
-    let top = solve_drive(&p, &d, &op, None);
+    let top = solve_drive(&p, &d, &op, None, &Work::of(&p));
     assert!(top.amplitude_m > 1.1 * s.amplitude_m, "{top:?}");
     // with the sag acting, the larger amplitude's current leaves a lower voltage, at
     // which it shrinks
@@ -564,7 +565,8 @@ fn a_sagging_drive_takes_the_largest_root_of_its_balance() {
     assert!((145.0..157.0).contains(&s.speed_rpm), "{s:?}");
     assert!(fixed_point_problem(&p, &op, &s).is_none(), "{:?}", fixed_point_problem(&p, &op, &s));
     let d = Drive::at(&p, &op);
-    let h = |w: f64| sag_balance(&p, &d, &op, w).0;
+    let work = Work::of(&p);
+    let h = |w: f64| sag_balance(&p, &d, &op, w, &work).0;
     assert!(h(s.amplitude_m).abs() < 1e-6 * s.amplitude_m, "h = {} m at the answer", h(s.amplitude_m));
     let mut w = p.theta * d.v / (d.omega * d.c);
     while w > 1.0005 * s.amplitude_m {
@@ -706,7 +708,7 @@ fn the_descent_does_not_crawl_just_past_a_fold() {
     let mut d = Drive::at(&p, &op);
     d.warm(&p, 40.0);
     d.v = 131.06413114605616;
-    let s = solve_drive(&p, &d, &op, None);
+    let s = solve_drive(&p, &d, &op, None, &Work::of(&p));
     assert!(s.status.is_valid() && s.iterations <= 72, "{:?} after {} trials", s.status, s.iterations);
     // below the fold's amplitude (2.94 µm): the running state there has folded away
     assert!(s.amplitude_m < 2.9e-6, "{s:?}");
@@ -998,4 +1000,147 @@ fn faster_speed_solves_give_the_plain_newton_solves_points() {
     println!("interface integrals: {n_ref} reference, {n_fast} fast; largest difference {worst:.1e} of the scale");
     assert!(differ.is_empty(), "{} differences:\n{}", differ.len(), differ.join("\n"));
     assert!(n_fast * 10 < n_ref * 9, "{n_fast} integrals fast, {n_ref} reference");
+}
+
+/// The motors of the work-bound census: every preset with no effect, each of the seven
+/// effects alone at its typical strength, and all seven together, each in candidate and
+/// truth form.
+fn work_census_motors() -> Vec<(String, crate::params::Motor)> {
+    let mut out = Vec::new();
+    for preset in crate::presets::PRESETS.iter().map(|p| p.name) {
+        for set in 0..=crate::effects::ALL.len() + 1 {
+            for truth in [false, true] {
+                let mut m = crate::presets::preset(preset).expect("preset");
+                m.effects.parse_assignment("none").expect("none");
+                let label = match set {
+                    0 => "none".to_string(),
+                    s if s <= crate::effects::ALL.len() => crate::effects::ALL[s - 1].name().to_string(),
+                    _ => "all seven".to_string(),
+                };
+                for (i, e) in crate::effects::ALL.iter().enumerate() {
+                    if set == i + 1 || set == crate::effects::ALL.len() + 1 {
+                        m.effects.set_strength(*e, e.info().params[0].typical);
+                    }
+                }
+                m.effects.set_truth_forms(truth);
+                m.validate("census", None).expect("a valid motor");
+                out.push((format!("{preset} {label} truth={truth}"), m));
+            }
+        }
+    }
+    out
+}
+
+/// Every converging point of a broad set (each preset with no effect, each effect alone and
+/// all seven together, candidate and truth forms, at ordinary and loaded operating points,
+/// cold and along warm-started torque sweeps) spends less than a twentieth of the default
+/// work bound, so the bound changes none of their answers; and none reports the bound.
+#[test]
+fn converging_points_stay_far_inside_the_work_bound() {
+    let ops = [(250.0, 0.3, 200.0, 43e3, 60.0), (400.0, 1.0, 250.0, 41.5e3, 600.0), (100.0, 0.1, 120.0, 44e3, 0.0)];
+    let (mut most, mut at, mut converged) = (0u64, String::new(), 0);
+    for (label, m) in work_census_motors() {
+        let p = Prepared::new(&m);
+        for &(f, t, v, hz, el) in &ops {
+            let mut op = OperatingPoint::new(f, t, v, hz);
+            op.elapsed_s = el;
+            let (s, spent) = solve_prepared_counted(&p, &m, &op, None);
+            assert!(!s.work_bound_reached, "{label} {op:?}: {spent} units");
+            if s.status.is_valid() {
+                converged += 1;
+                if spent > most {
+                    (most, at) = (spent, format!("{label} {op:?}"));
+                }
+            }
+        }
+        // a warm-started torque line, as maps solve them: the same answers as without a
+        // bound at all
+        let unbounded = Prepared::new(&m).with_work_bound(u64::MAX);
+        let grid = crate::sweep::Grid {
+            preload_n: crate::axis::Axis::fixed(250.0),
+            voltage_v: crate::axis::Axis::fixed(200.0),
+            frequency_hz: crate::axis::Axis::fixed(43e3),
+            torque_nm: crate::axis::Axis::linspace(0.0, 1.2, 7),
+        };
+        let mut line = Vec::new();
+        crate::sweep::solve_range(&m, &p, &grid, 0..7, |_, _, s| line.push(s.clone()));
+        let mut free = Vec::new();
+        crate::sweep::solve_range(&m, &unbounded, &grid, 0..7, |_, _, s| free.push(s.clone()));
+        // (Debug text: bit for bit, NaN included)
+        assert_eq!(format!("{line:?}"), format!("{free:?}"), "{label}");
+        assert!(line.iter().all(|s| !s.work_bound_reached), "{label}");
+    }
+    println!("{converged} converging points; the most work {most} units ({at})");
+    assert_eq!(converged, 162);
+    assert!(most * 20 < WORK_BOUND, "{most} units at {at}");
+}
+
+/// generic60 with all seven effects in truth form, `thermal_drift` at the top of its
+/// stiffness range and an interface fraction of 4140 (outside its valid range: the motor
+/// fails validation, but the fuzzer solves it), at 300 N, 0.5 N·m, 250 V, 43.5 kHz, 120 s:
+/// about 4·10⁸ units of work without a bound (483 000 amplitude trials, 13 s). Under a
+/// bound of 2·10⁷ units it ends as `no_convergence` with the bound as its reason, past the
+/// bound by less than one trial's work.
+#[test]
+fn a_slow_input_ends_at_the_work_bound() {
+    let mut m = crate::presets::preset("generic60").expect("preset");
+    m.effects.set(Effect::RadialFriction, &[1.0, 0.0]);
+    m.effects.set(Effect::VoltageSag, &[150.0, 0.0]);
+    m.effects.set(Effect::Eccentricity, &[2e-5, 0.0, 0.0]);
+    m.effects.set(Effect::ThermalDrift, &[0.05, -0.002, 0.0, 4140.0]);
+    m.effects.set(Effect::TangentialCompliance, &[1.0, 0.0]);
+    m.effects.set(Effect::PreloadStiffening, &[0.05, 0.0]);
+    m.effects.set(Effect::HertzSoftening, &[1e18, 0.004, 0.0]);
+    m.effects.set_truth_forms(true);
+    assert!(m.validate("slow", None).is_err());
+    let mut op = OperatingPoint::new(300.0, 0.5, 250.0, 43_500.0);
+    op.elapsed_s = 120.0;
+    let bound = 20_000_000;
+    let p = Prepared::new(&m).with_work_bound(bound);
+    let (s, spent) = solve_prepared_counted(&p, &m, &op, None);
+    println!("{} after {spent} units", s.status);
+    assert_eq!(s.status, Status::NoConvergence);
+    assert!(s.work_bound_reached);
+    assert!((bound..bound + 200_000).contains(&spent), "{spent} units");
+    // the public entry point says the same
+    let again = solve_prepared(&p, &m, &op, None);
+    assert_eq!((again.status, again.work_bound_reached), (Status::NoConvergence, true));
+}
+
+/// A tiny bound makes an ordinary point report the bound, never a wrong answer: cold, with
+/// each effect that nests routes, and along a warm-started sweep. A bound just at the work
+/// the point needs leaves its answer bit for bit.
+#[test]
+fn a_tiny_work_bound_reports_the_bound_rather_than_an_answer() {
+    let op = OperatingPoint::new(250.0, 0.3, 200.0, 43e3);
+    for fx in ["none", "voltage_sag=150", "eccentricity=2e-5", "thermal_drift=-4e-4", "tangential_compliance=1"] {
+        let mut m = crate::presets::preset("trum60a").expect("preset");
+        m.effects.parse_assignment(fx).expect("assignment");
+        let p = Prepared::new(&m);
+        let mut o = op;
+        o.elapsed_s = 600.0;
+        let (full, need) = solve_prepared_counted(&p, &m, &o, None);
+        assert!(full.status.is_valid() && !full.work_bound_reached, "{fx}: {full:?}");
+        for bound in [0, 1, 10, 25, need / 2, need - 1] {
+            let s = solve_prepared(&Prepared::new(&m).with_work_bound(bound), &m, &o, None);
+            assert_eq!((s.status, s.work_bound_reached), (Status::NoConvergence, true), "{fx}: bound {bound}");
+            assert!(s.warnings.is_empty(), "{fx}: {:?}", s.warnings);
+        }
+        let just = solve_prepared(&Prepared::new(&m).with_work_bound(need + 1), &m, &o, None);
+        assert_eq!(format!("{just:?}"), format!("{full:?}"), "{fx}");
+    }
+    let m = crate::presets::preset("trum60a").expect("preset");
+    let grid = crate::sweep::Grid {
+        preload_n: crate::axis::Axis::fixed(250.0),
+        voltage_v: crate::axis::Axis::fixed(200.0),
+        frequency_hz: crate::axis::Axis::fixed(43e3),
+        torque_nm: crate::axis::Axis::linspace(0.0, 1.2, 7),
+    };
+    let tiny = Prepared::new(&m).with_work_bound(25);
+    let mut n = 0;
+    crate::sweep::solve_range(&m, &tiny, &grid, 0..7, |_, _, s| {
+        assert_eq!((s.status, s.work_bound_reached), (Status::NoConvergence, true), "{s:?}");
+        n += 1;
+    });
+    assert_eq!(n, 7);
 }

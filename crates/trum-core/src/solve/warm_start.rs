@@ -2,7 +2,7 @@
 
 use super::descent::{solve_drive_below, WarmTop};
 use super::trial::Drive;
-use super::{iterated, solve_prepared, OperatingPoint, Prepared, Solution, Status};
+use super::{iterated, solve_prepared, OperatingPoint, Prepared, Solution, Status, Work};
 use crate::params::Motor;
 use std::f64::consts::PI;
 
@@ -33,6 +33,9 @@ use std::f64::consts::PI;
 /// trum60a's 100-torque rows (2.02 trials a point). The contact and stick angles are
 /// extrapolated the same way for the first trial's angle solves. Where r ≥ 0 at the
 /// prediction it is the top of the descent, else it and the bound bracket the root.
+///
+/// Bounded in work as [`solve_prepared`] is: the warm descent has the budget of a solve
+/// of its own.
 pub(crate) fn solve_in_sweep(
     p: &Prepared,
     motor: &Motor,
@@ -92,8 +95,9 @@ fn warm_solve(
     let stick_rad = predicted.map(|_| at(2)).filter(|&t| t > 0.0 && t < top.contact_half_angle_rad.min(0.5 * PI));
     let warm = WarmTop { bound: top.amplitude_m, predicted, contact_rad, stick_rad };
     // (every solution of solve_drive_below comes through `finish`, which has checked it
-    // for non-finite numbers)
-    solve_drive_below(p, &Drive::at(p, op), op, guess, Some(warm))
+    // for non-finite numbers; the descent has a budget of its own, as every solve)
+    let work = Work::of(p);
+    work.verdict(solve_drive_below(p, &Drive::at(p, op), op, guess, Some(warm), &work))
 }
 
 /// What a sweep keeps of a solved point for the warm start of the next ones.
