@@ -313,11 +313,10 @@ impl<'a> Scorer<'a> {
             }
         }
         // The fit of the same model from the baseline before it was refitted. Its priors,
-        // rows and weights are this fit's, so it is a start like any other; from the
-        // refitted baseline, whose parameters may have moved to mimic part of a strong
-        // effect, the effect's own valley can be out of reach (a `radial_friction` at the
-        // top of its range on `trum60-qut`: evidence 8 700 and the held-out gap closed
-        // from the first baseline, evidence 2 from the refitted one).
+        // rows and weights are this fit's, so it is a start like any other, and costs no
+        // fit: from the refitted baseline, whose parameters may have moved to mimic part
+        // of a strong effect, the effect's own valley can lie out of reach of every start
+        // above, and the better of the two optima is the model's fit.
         if nested.is_none() && effects.len() == 1 {
             let earlier = self.earlier.and_then(|f| f.get(&name)).filter(|c| !c.abandoned);
             let current = match &cal {
