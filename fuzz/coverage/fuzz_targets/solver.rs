@@ -3,12 +3,22 @@
 //! decoded from the bytes: values either raw f64 bits (NaN and infinities included) or a
 //! nominal value times 10^(-8..8). Properties: no panic; an
 //! invalid operating point gives `invalid_input`; for a motor that validates, a valid
-//! status has every quantity finite and the efficiency in [0, 1].
+//! status has every quantity finite and the efficiency in [0, 1]; a solve that spends its
+//! work bound says so and is `no_convergence`. Each solve is bounded at
+//! [`FUZZ_WORK_BOUND`], a fiftieth of the default bound's units, so that the inputs that
+//! reach the deepest routes (all seven effects, parameters at their ends) cost at most a
+//! second or two and the run keeps its rate; every path below that bound is the default
+//! solve's, bit for bit (docs/RELIABILITY.md, "The work bound of a solve").
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 use trum_core::effects::ALL as ALL_EFFECTS;
 use trum_core::quantities::QUANTITIES;
-use trum_core::{presets, solve, Motor, OperatingPoint, Status};
+use trum_core::solve::{solve_prepared, Prepared};
+use trum_core::{presets, Motor, OperatingPoint, Status};
+
+/// The work bound of each solve [interface-integrand evaluations; trum_core's
+/// `solve::WORK_BOUND` is 10⁹].
+const FUZZ_WORK_BOUND: u64 = 20_000_000;
 
 struct Bytes<'a>(&'a [u8]);
 
@@ -84,7 +94,10 @@ fuzz_target!(|data: &[u8]| {
         elapsed_s: if b.byte() < 128 { 0.0 } else { b.value(60.0) },
     };
     let valid_motor = m.validate("fuzz", None).is_ok();
-    let s = solve(&m, &op);
+    let s = solve_prepared(&Prepared::new(&m).with_work_bound(FUZZ_WORK_BOUND), &m, &op, None);
+    if s.work_bound_reached {
+        assert_eq!(s.status, Status::NoConvergence, "{op:?}");
+    }
     if op.invalid_reason().is_some() {
         assert_eq!(s.status, Status::InvalidInput, "{op:?}");
     }
