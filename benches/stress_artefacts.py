@@ -4,8 +4,8 @@ diagnosis makes of them (docs/DIAGNOSIS.md, "Bench-artefact stress set").
 
 Each case is a `trum synth` file of the frozen reference motor (tests/data/motors/ring60.toml,
 every parameter perturbed as in the blind benchmark) that this script then alters as a
-bench would: gains of the speed, torque, power or feedback readings, read-back noise of
-the preload or the frequency, a quantised torque, an offset or a lag of the temperature sensor,
+bench would: gains of the speed, torque, power, feedback, current or voltage readings, a
+zero offset of the preload reading, read-back noise of the preload or the frequency, a quantised torque, an offset or a lag of the temperature sensor,
 heavy-tailed speed noise, cells left empty, noise three times the nominal, noise that is
 all absolute or all relative. Null cases
 must come out `none`; effect cases (each effect at about twice its typical strength in
@@ -83,6 +83,17 @@ ARTEFACTS = {
     "heavy_tail": heavy_tail,
     "missing": missing,
 }
+
+# Artefacts of the preload, current and voltage readings, added after the set above was
+# first run and kept apart from it, so that the effect cases' random draws of two artefacts
+# stay as they were: the preload load cell's zero 10 N high, a current probe 5 % high, the
+# drive voltage read 3 % high.
+READINGS = {
+    "preload_offset": lambda rows, rng: alter(rows, "preload_n", lambda v: v + 10.0),
+    "current_gain": scale("current_a", 1.05),
+    "voltage_gain": scale("voltage_v", 1.03),
+}
+
 
 def sensor_lag(tau_s):
     """A first-order temperature sensor with time constant `tau_s` [s], run within each run
@@ -178,6 +189,19 @@ def cases():
         seed += 1
         out.append((f"tangential_compliance_{shape}", "tangential_compliance", [shape], "preload-torque", seed,
                     EFFECTS["tangential_compliance"], 0, []))
+    seed = 7300
+    for art in READINGS:
+        for campaign in ("preload-torque", "combined"):
+            seed += 1
+            out.append((f"null_{art}_{campaign}", "none", [art], campaign, seed, None, 1, ["--artefacts", DEV_ARTEFACTS]))
+    # the effects a reading's offset or gain could pass for: a stiffening with the preload
+    # under a preload offset, a source impedance under a current gain
+    for effect, art in (("preload_stiffening", "preload_offset"), ("voltage_sag", "current_gain"),
+                        ("voltage_sag", "voltage_gain")):
+        for campaign in ("preload-torque", "combined"):
+            seed += 1
+            out.append((f"{effect}_{art}_{campaign}", effect, [art], campaign, seed, EFFECTS[effect], 1,
+                        ["--artefacts", DEV_ARTEFACTS]))
     rng = random.Random(11)
     seed = 8100
     for effect, arg in EFFECTS.items():
@@ -200,7 +224,7 @@ def run(case, work):
         rows = list(csv.DictReader(f))
     rng = random.Random(seed)
     for art in arts:
-        {**ARTEFACTS, **NULL_ONLY}[art](rows, rng)
+        {**ARTEFACTS, **NULL_ONLY, **READINGS}[art](rows, rng)
     with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, list(rows[0].keys()))
         w.writeheader()

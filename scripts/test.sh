@@ -13,7 +13,7 @@ if cargo clippy --version >/dev/null 2>&1; then
 else
   echo "clippy is not installed with this toolchain: lint step skipped"
 fi
-# stable fuzz loops, 30 s per target (docs/RELIABILITY.md); CI bounds each input at 120 s and calls one over 240 s a hang (a point of a motor that fails validation, with every effect in truth form, can take 40 s on a quiet machine: docs/RELIABILITY.md, "Slow inputs"), not 200 ms, so a loaded CI machine cannot fail it by timing
+# stable fuzz loops, 30 s per target (docs/RELIABILITY.md); each solve is bounded at 2e6 work units (about 0.2 s of work on a quiet machine: docs/RELIABILITY.md, "The work bound of a solve"); CI calls an input over 120 s slow and one over 240 s a hang, not 200 ms, so a loaded CI machine cannot fail it by timing
 echo "== fuzz (stable driver)"
 # A new seed every run (so CI explores new inputs), printed so that a failure can be
 # replayed; TRUM_FUZZ_SEED fixes it.

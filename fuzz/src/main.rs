@@ -13,9 +13,12 @@
 //!   from its own `to_csv_string()`.
 //! * `solver`: a motor (preset plus arbitrary overrides of any dotted key with any f64,
 //!   NaN and infinities included, plus effects with in- and out-of-range parameters) and
-//!   an operating point (any f64). `Motor::validate` first, then `solve`. Properties: no
-//!   panic; an invalid operating point gives `invalid_input`; for a motor that validates,
-//!   a solution whose status is valid has no NaN or infinity in any quantity.
+//!   an operating point (any f64). `Motor::validate` first, then a solve bounded at
+//!   [`FUZZ_WORK_BOUND`] work units (the default solve, bit for bit, wherever it needs
+//!   less; at most about 0.2 s of work, so one input cannot take a run's time). Properties:
+//!   no panic; an invalid operating point gives `invalid_input`; for a motor that
+//!   validates, a solution whose status is valid has no NaN or infinity in any quantity; a
+//!   solve that spends its bound says so and is `no_convergence`.
 //!
 //! Every input runs under `catch_unwind` and is timed: an input slower than `--slow-ms`
 //! (checked twice, to ignore scheduler noise) is a failure, one slower than `--hang-s`
@@ -43,7 +46,8 @@ use std::time::{Duration, Instant};
 use trum_core::effects::{Effect, ALL as ALL_EFFECTS, MAX_PARAMS};
 use trum_core::measurements::{parse_measurements, Measurements, COLUMNS};
 use trum_core::quantities::QUANTITIES;
-use trum_core::{presets, solve, Motor, OperatingPoint, Status};
+use trum_core::solve::{solve_prepared, Prepared};
+use trum_core::{presets, Motor, OperatingPoint, Status};
 
 const SRC_TOML: &str = "fuzz.toml";
 const SRC_CSV: &str = "fuzz.csv";
@@ -436,6 +440,10 @@ impl Case {
     }
 }
 
+/// The work bound of each solve [interface-integrand evaluations; trum_core's
+/// `solve::WORK_BOUND` is 10⁹], as in the coverage-guided solver target.
+const FUZZ_WORK_BOUND: u64 = 2_000_000;
+
 fn check_solver(c: &Case) -> Verdict {
     let m = c.motor();
     let motor_ok = m.validate("fuzz", None).is_ok();
@@ -447,7 +455,10 @@ fn check_solver(c: &Case) -> Verdict {
         elapsed_s: c.op[4],
     };
     let op_ok = op.invalid_reason().is_none();
-    let s = solve(&m, &op);
+    let s = solve_prepared(&Prepared::new(&m).with_work_bound(FUZZ_WORK_BOUND), &m, &op, None);
+    if s.work_bound_reached && s.status != Status::NoConvergence {
+        return Verdict::Violation(format!("a solve that spent its work bound has status {} at {op:?}", s.status));
+    }
     if !op_ok && s.status != Status::InvalidInput {
         return Verdict::Violation(format!("invalid operating point {op:?} gives status {}", s.status));
     }

@@ -225,6 +225,12 @@ fn calibrate_writes_a_motor_file_that_point_reads() {
     assert!(params.len() >= 5);
     for q in params {
         let (v, se) = (q["value"].as_f64().expect("value"), q["std_error"].as_f64().expect("std error"));
+        if q["name"].as_str().is_some_and(|n| n.starts_with("bench.")) {
+            // a bench nuisance centred on zero (an offset, a gain error): its uncertainty
+            // is no fraction of its value, only positive
+            assert!(se > 0.0 && se.is_finite(), "{q}");
+            continue;
+        }
         // a plausible uncertainty: positive, and well below the value for this rich campaign
         assert!(se > 1e-9 * v.abs() && se < 0.5 * v.abs(), "{q}");
     }

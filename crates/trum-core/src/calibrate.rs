@@ -41,6 +41,10 @@ pub enum InstrumentParam {
     TemperatureOffsetK,
     /// [`crate::effects::Instrument::temperature_lag_s`].
     TemperatureLagS,
+    /// [`crate::effects::Instrument::preload_offset_n`].
+    PreloadOffsetN,
+    /// [`crate::effects::Instrument::current_gain_rel`].
+    CurrentGainRel,
 }
 
 impl ParamRef {
@@ -53,6 +57,8 @@ impl ParamRef {
             ParamRef::Instrument(InstrumentParam::TorqueOffsetNm) => "bench.torque_offset_nm".into(),
             ParamRef::Instrument(InstrumentParam::TemperatureOffsetK) => "bench.temperature_offset_k".into(),
             ParamRef::Instrument(InstrumentParam::TemperatureLagS) => "bench.temperature_lag_s".into(),
+            ParamRef::Instrument(InstrumentParam::PreloadOffsetN) => "bench.preload_offset_n".into(),
+            ParamRef::Instrument(InstrumentParam::CurrentGainRel) => "bench.current_gain_rel".into(),
         }
     }
 
@@ -63,6 +69,8 @@ impl ParamRef {
             ParamRef::Instrument(InstrumentParam::SpeedStdFloorRpm) => m.effects.instrument().speed_std_floor_rpm,
             ParamRef::Instrument(InstrumentParam::TorqueOffsetNm) => m.effects.instrument().torque_offset_nm,
             ParamRef::Instrument(InstrumentParam::TemperatureOffsetK) => m.effects.instrument().temperature_offset_k,
+            ParamRef::Instrument(InstrumentParam::PreloadOffsetN) => m.effects.instrument().preload_offset_n,
+            ParamRef::Instrument(InstrumentParam::CurrentGainRel) => m.effects.instrument().current_gain_rel,
             // a sensor without a stated lag starts the fit at the prior's centre (a lag
             // of 1 s moves no reading taken seconds apart; at zero it would sit below the
             // logarithmic range)
@@ -93,6 +101,8 @@ impl ParamRef {
                 m.effects.instrument_mut().temperature_offset_k = v
             }
             ParamRef::Instrument(InstrumentParam::TemperatureLagS) => m.effects.instrument_mut().temperature_lag_s = v,
+            ParamRef::Instrument(InstrumentParam::PreloadOffsetN) => m.effects.instrument_mut().preload_offset_n = v,
+            ParamRef::Instrument(InstrumentParam::CurrentGainRel) => m.effects.instrument_mut().current_gain_rel = v,
         }
     }
 }
@@ -236,6 +246,12 @@ pub fn baseline_params_with(
     if let Some(fp) = torque_offset_param(rows, overrides) {
         out.push(fp);
     }
+    if let Some(fp) = preload_offset_param(rows, overrides) {
+        out.push(fp);
+    }
+    if let Some(fp) = current_gain_param(rows, overrides) {
+        out.push(fp);
+    }
     if let Some(fp) = temperature_offset_param(rows, overrides) {
         out.push(fp);
     }
@@ -314,6 +330,78 @@ fn torque_offset_param(rows: &[ObservedRow], overrides: &std::collections::BTree
         log: false,
         prior: sd.is_finite().then_some(Prior { centre: 0.0, sd }),
     })
+}
+
+/// Default prior standard deviation of the preload reading's zero offset, relative to the
+/// largest preload reading: a load cell is specified to 0.1-0.5 % of its full scale, which
+/// is at least the largest preload it reads. Not wider: across a preload sweep an offset
+/// shifts the mean speed as an eccentric rotor's preload ripple does (averaged over a
+/// revolution, the speed-preload curve's bend), and a generic60 runout of 0.1 mm on a
+/// combined campaign, found with evidence 170 under this prior, is taken in by a 20 N offset
+/// under one of 1 % (4 N).
+pub const PRELOAD_OFFSET_SD_REL: f64 = 0.005;
+
+/// The preload reading's zero offset (a bench nuisance), where the data sweep the preload
+/// (at least 8 rows over preloads that span more than a fifth of the largest reading): a
+/// Gaussian prior centred on zero with a standard deviation of [`PRELOAD_OFFSET_SD_REL`] of
+/// the largest reading, bounded at ±5 standard deviations and above by half the smallest
+/// reading (the force on the contact stays positive). At one preload the offset would be
+/// one more stiffness of the contact; across a sweep it shifts the whole preload axis,
+/// which a baseline would otherwise bend its contact parameters to follow, and an effect
+/// fit an effect. A tolerance in `[tolerances]` under `bench.preload_offset_n` (in N)
+/// replaces the prior's width; 0 holds the offset at zero, `inf` fits it without a prior.
+fn preload_offset_param(rows: &[ObservedRow], overrides: &std::collections::BTreeMap<String, f64>) -> Option<FitParam> {
+    let top = rows.iter().map(|r| r.op.preload_n).fold(0.0, f64::max);
+    let lowest = rows.iter().map(|r| r.op.preload_n).fold(f64::INFINITY, f64::min);
+    if !(top > 0.0 && lowest > 0.0) || top - lowest <= 0.2 * top || rows.len() < 8 {
+        return None;
+    }
+    centred_nuisance(InstrumentParam::PreloadOffsetN, PRELOAD_OFFSET_SD_REL * top, 0.5 * lowest, overrides)
+}
+
+/// A bench nuisance `param` centred on zero: a Gaussian prior of standard deviation
+/// `default_sd`, or the motor file's tolerance under the parameter's key (0: not fitted;
+/// `inf`: no prior), bounded at ±5 standard deviations and at most ±`cap`.
+fn centred_nuisance(
+    param: InstrumentParam,
+    default_sd: f64,
+    cap: f64,
+    overrides: &std::collections::BTreeMap<String, f64>,
+) -> Option<FitParam> {
+    let param = ParamRef::Instrument(param);
+    let sd = overrides.get(&param.name()).copied().unwrap_or(default_sd);
+    if sd.is_nan() || sd <= 0.0 {
+        return None;
+    }
+    let half = if sd.is_finite() { (5.0 * sd).min(cap) } else { cap };
+    Some(FitParam {
+        param,
+        lo: -half,
+        hi: half,
+        log: false,
+        prior: sd.is_finite().then_some(Prior { centre: 0.0, sd }),
+    })
+}
+
+/// Default prior standard deviation of the current reading's relative gain error: a
+/// current probe or a shunt with its amplifier is specified to 1-3 % of the reading.
+pub const CURRENT_GAIN_SD: f64 = 0.02;
+
+/// The current reading's gain error (a bench nuisance), where `current_a` is read at least
+/// eight times: a Gaussian prior centred on zero with a standard deviation of
+/// [`CURRENT_GAIN_SD`], bounded at ±5 standard deviations. The model's phase current is a
+/// capacitive part that the clamped capacitance follows and a motional part tied by the
+/// force factor to the amplitude the speed and the feedback voltage fix; a probe a few
+/// percent off scales both, which the baseline cannot follow and a source impedance
+/// (`voltage_sag`), whose voltage drop grows with the current, partly can. A tolerance in
+/// `[tolerances]` under `bench.current_gain_rel` (relative) replaces the prior's width; 0
+/// holds the gain at one, `inf` fits it without a prior.
+fn current_gain_param(rows: &[ObservedRow], overrides: &std::collections::BTreeMap<String, f64>) -> Option<FitParam> {
+    let n = rows.iter().flat_map(|r| &r.readings).filter(|x| x.0 == Observable::CurrentA).count();
+    if n < 8 {
+        return None;
+    }
+    centred_nuisance(InstrumentParam::CurrentGainRel, CURRENT_GAIN_SD, 0.5, overrides)
 }
 
 /// Default prior standard deviation of the temperature reading's offset [K]: a class-1
@@ -1486,10 +1574,14 @@ fn fit(
     })
 }
 
+/// Relative singular-value cutoff of [`rescale_uncertainties`]' column-scaled Jacobian:
+/// √1e-13, an eigenvalue of the equilibrated normal matrix below 1e-13 of its largest.
+const COVARIANCE_RCOND: f64 = 3.2e-7;
+
 /// Standard errors recomputed with the Jacobian taken against *relative* parameter
-/// changes and the normal matrix equilibrated before inversion. (trum-core's values come
-/// from a pseudo-inverse of the unscaled JᵀJ, whose entries span ~30 decades between the
-/// friction coefficient and the Young's modulus, so its cutoff zeroes real variances.)
+/// changes and its columns scaled to unit norm before the covariance is formed. (The fit's
+/// own values come from the unscaled Jacobian, whose columns span ~30 decades between the
+/// friction coefficient and the Young's modulus, so a cutoff there zeroes real variances.)
 /// Identifiable = relative standard error below 1 (for a parameter with a prior: below
 /// 0.7 of the prior's width) and a well-conditioned column. `trum calibrate` and Python's
 /// `trum.calibrate` report these.
@@ -1521,31 +1613,39 @@ pub fn rescale_uncertainties(cal: &mut Calibration, rows: &[ObservedRow]) {
         let r1 = residuals(&mm, rows);
         cols.push(r1.iter().zip(&r0).map(|(a, b)| (a - b) / h).collect());
     }
-    let mut a = vec![vec![0.0; n]; n];
-    for i in 0..n {
-        for j in 0..n {
-            a[i][j] = cols[i].iter().zip(&cols[j]).map(|(x, y)| x * y).sum();
-        }
-        // a prior on ln p is one more residual, (ln p − centre)/sd: 1/sd² on the diagonal
-        if let Some(sd) = cal.params[i].prior_rel_sd {
-            a[i][i] += 1.0 / (sd * sd);
-        }
-    }
-    let d: Vec<f64> = (0..n).map(|i| a[i][i].max(0.0).sqrt()).collect();
-    for i in 0..n {
-        for j in 0..n {
-            a[i][j] = if d[i] > 0.0 && d[j] > 0.0 { a[i][j] / (d[i] * d[j]) } else { 0.0 };
+    // The Jacobian in ln p, its columns scaled to unit norm (with the prior's row), and its
+    // covariance from the SVD of J itself (crate::lsq): a singular value below 3e-7 of the
+    // largest (an eigenvalue of the scaled JᵀJ below 1e-13) makes the parameters jointly
+    // unidentifiable, and every standard error undefined, rather than the truncated
+    // inverse's small numbers along the directions the data do not see.
+    let priors: Vec<usize> = (0..n).filter(|&i| cal.params[i].prior_rel_sd.is_some()).collect();
+    let mut j = DMatrix::zeros(m + priors.len(), n);
+    for (i, c) in cols.iter().enumerate() {
+        for (k, x) in c.iter().enumerate() {
+            j[(k, i)] = *x;
         }
     }
-    let inv = invert(a);
+    // a prior on ln p is one more residual, (ln p − centre)/sd
+    for (row, &i) in priors.iter().enumerate() {
+        j[(m + row, i)] = 1.0 / cal.params[i].prior_rel_sd.unwrap_or(f64::INFINITY);
+    }
+    let d: Vec<f64> = j.column_iter().map(|c| c.norm()).collect();
+    for (mut c, dk) in j.column_iter_mut().zip(&d) {
+        if *dk > 0.0 {
+            c /= *dk;
+        }
+    }
+    let cov = LeastSquares::new(&j, COVARIANCE_RCOND)
+        .filter(|l| l.rank() == n && d.iter().all(|dk| *dk > 0.0))
+        .map(|l| l.covariance());
     let s2 = (cal.chi2 / (m - n) as f64).max(1e-300);
     let mut warn = Vec::new();
     for (k, p) in cal.params.iter_mut().enumerate() {
         // (with a prior: a posterior's covariance, the readings' σ as stated, as the core's)
         let s2k = if p.prior_rel_sd.is_some() { s2.max(1.0) } else { s2 };
-        let var_rel = match &inv {
-            Some(inv) if d[k] > 0.0 => inv[k][k] / (d[k] * d[k]) * s2k,
-            _ => f64::NAN,
+        let var_rel = match &cov {
+            Some(cov) => cov[(k, k)] / (d[k] * d[k]) * s2k,
+            None => f64::NAN,
         };
         let rel = if var_rel.is_finite() && var_rel >= 0.0 { var_rel.sqrt() } else { f64::NAN };
         p.std_error = rel * p.value.abs();
@@ -1565,38 +1665,6 @@ pub fn rescale_uncertainties(cal: &mut Calibration, rows: &[ObservedRow]) {
         warn.push(format!("held near their prior (the data do not narrow them): {}", held.join(", ")));
     }
     cal.warnings.extend(warn);
-}
-
-/// Gauss-Jordan inverse with partial pivoting of an equilibrated (unit-diagonal) matrix;
-/// `None` when it is singular to working precision.
-fn invert(mut a: Vec<Vec<f64>>) -> Option<Vec<Vec<f64>>> {
-    let n = a.len();
-    let mut inv: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| f64::from(u8::from(i == j))).collect()).collect();
-    for c in 0..n {
-        let p = (c..n).max_by(|&x, &y| a[x][c].abs().total_cmp(&a[y][c].abs()))?;
-        if a[p][c].abs() < 1e-13 {
-            return None;
-        }
-        a.swap(c, p);
-        inv.swap(c, p);
-        let piv = a[c][c];
-        for j in 0..n {
-            a[c][j] /= piv;
-            inv[c][j] /= piv;
-        }
-        for r in 0..n {
-            if r != c {
-                let f = a[r][c];
-                if f != 0.0 {
-                    for j in 0..n {
-                        a[r][j] -= f * a[c][j];
-                        inv[r][j] -= f * inv[c][j];
-                    }
-                }
-            }
-        }
-    }
-    Some(inv)
 }
 
 /// `x` with two significant digits, as the CLI prints numbers (fixed notation for
@@ -1668,6 +1736,8 @@ pub(crate) mod tests {
             "stator.modal_mass_kg",
             "electrical.dielectric_loss_tangent",
             "bench.speed_std_floor_rpm",
+            "bench.preload_offset_n",
+            "bench.current_gain_rel",
         ];
         TOLERANCES
             .iter()
@@ -1811,6 +1881,91 @@ pub(crate) mod tests {
             // the two optima agree within the subsample's standard error
             assert!((p.value - a.value).abs() < 3.0 * p.std_error, "{}: {} vs {}", a.name, p.value, a.value);
         }
+    }
+
+    /// The reported standard errors: for one parameter, √(s² / Σ(∂r/∂ln p)²) by hand from
+    /// forward differences of the residuals (an independent route, within 1 %); a parameter
+    /// the readings do not see (the heat capacity, with no temperature read) makes the
+    /// problem rank-deficient, and every standard error is then undefined (NaN, not
+    /// identifiable) rather than a small number from the directions that remain.
+    #[test]
+    fn standard_errors_follow_the_jacobian_and_fail_where_a_direction_is_unseen() {
+        let truth = reference_motor();
+        let mut rows = rows_on_grid(&truth, &[100.0, 200.0, 300.0, 400.0], &[0.0, 0.2, 0.4, 0.6]);
+        for (i, r) in rows.iter_mut().enumerate() {
+            for (k, x) in r.readings.iter_mut().enumerate() {
+                x.1 += x.2 * (1.3 * (i * 5 + k) as f64).sin();
+            }
+        }
+        let fit = |names: &[&str]| {
+            let params: Vec<FitParam> = names.iter().map(|n| fit_rel(&truth, n, 0.5, 2.0)).collect();
+            let mut cal = Calibration::builder(&truth, &rows).params(&params).run().expect("fit");
+            rescale_uncertainties(&mut cal, &rows);
+            cal
+        };
+        let one = fit(&["friction_layer.friction_coefficient"]);
+        let p = &one.params[0];
+        let r0 = residuals(&one.motor, &rows);
+        let mut moved = one.motor.clone();
+        moved.friction_layer.friction_coefficient *= 1.0 + 1e-5;
+        let col2: f64 = residuals(&moved, &rows).iter().zip(&r0).map(|(a, b)| ((a - b) / 1e-5).powi(2)).sum();
+        let s2 = one.chi2 / (r0.len() - 1) as f64;
+        let by_hand = (s2 / col2).sqrt() * p.value;
+        assert!((p.std_error / by_hand - 1.0).abs() < 0.01, "{} vs {by_hand}", p.std_error);
+        assert!(p.identifiable);
+        let unseen = fit(&["friction_layer.friction_coefficient", "thermal.heat_capacity_j_per_k"]);
+        for q in &unseen.params {
+            assert!(q.std_error.is_nan() && !q.identifiable, "{}: {}", q.name, q.std_error);
+        }
+    }
+
+    /// The preload reading's zero offset and the current reading's gain are nuisances the
+    /// fit recovers without moving the motor: rows of the reference motor whose preload
+    /// column reads the contact's force plus 8 N and whose current reads 4 % high give both
+    /// back without a prior (within 3 %), with μ where it was; without them the same fit is
+    /// left with a misfit or moves μ. Data at one preload, or without eight current
+    /// readings, fit neither. Readings at a tenth of the default noise.
+    #[test]
+    fn a_preload_offset_and_a_current_gain_are_recovered_and_not_put_on_the_motor() {
+        let truth = reference_motor();
+        let (offset, gain) = (8.0, 0.04);
+        let mut rows = rows_on_grid(&truth, &[150.0, 200.0, 250.0, 300.0, 350.0], &[0.0, 0.1, 0.2, 0.3]);
+        for r in &mut rows {
+            let s = crate::solve(&truth, &r.op);
+            let current = s.current_a * (1.0 + gain);
+            r.readings.push((Observable::CurrentA, current, Observable::CurrentA.default_sigma(current)));
+            r.readings.iter_mut().for_each(|x| x.2 *= 0.1);
+            r.op.preload_n += offset;
+        }
+        let free = std::collections::BTreeMap::from([
+            ("bench.preload_offset_n".to_string(), f64::INFINITY),
+            ("bench.current_gain_rel".to_string(), f64::INFINITY),
+        ]);
+        let mut params = vec![fit_rel(&truth, "friction_layer.friction_coefficient", 0.3, 3.0)];
+        let without = Calibration::builder(&truth, &rows).params(&params).run().unwrap();
+        let mu_without = without.motor.friction_layer.friction_coefficient;
+        assert!(without.chi2 > 1.0 || (mu_without - 0.3).abs() > 1e-3, "χ² {} μ {mu_without}", without.chi2);
+        params.push(preload_offset_param(&rows, &free).expect("a preload sweep"));
+        params.push(current_gain_param(&rows, &free).expect("current readings"));
+        assert!(params[1..].iter().all(|p| p.prior.is_none()));
+        let cal = Calibration::builder(&truth, &rows).params(&params).run().unwrap();
+        let inst = cal.motor.effects.instrument();
+        assert!((inst.preload_offset_n - offset).abs() < 0.03 * offset, "offset {}", inst.preload_offset_n);
+        assert!((inst.current_gain_rel - gain).abs() < 0.03 * gain, "gain {}", inst.current_gain_rel);
+        let mu = cal.motor.friction_layer.friction_coefficient;
+        assert!((mu - 0.3).abs() < 1e-3, "μ {mu}");
+        assert!(cal.chi2 < without.chi2, "{} vs {}", cal.chi2, without.chi2);
+        // the default priors: 0.5 % of the largest preload reading, 2 % of gain
+        let none = std::collections::BTreeMap::new();
+        let prior_of = |fp: Option<FitParam>| fp.and_then(|f| f.prior).map(|p| p.sd);
+        assert_eq!(prior_of(preload_offset_param(&rows, &none)), Some(PRELOAD_OFFSET_SD_REL * (350.0 + offset)));
+        assert_eq!(prior_of(current_gain_param(&rows, &none)), Some(CURRENT_GAIN_SD));
+        // one preload: no offset; a tolerance of zero: none; no current read: no gain
+        let one = rows_on_grid(&truth, &[250.0], &[0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35]);
+        assert!(preload_offset_param(&one, &none).is_none());
+        let held = std::collections::BTreeMap::from([("bench.preload_offset_n".to_string(), 0.0)]);
+        assert!(preload_offset_param(&rows, &held).is_none());
+        assert!(current_gain_param(&one, &none).is_none());
     }
 
     /// A torque transducer's zero offset is a nuisance the fit recovers: noise-free rows of

@@ -447,17 +447,31 @@ pub struct Instrument {
     /// Time constant of the stator temperature sensor [s]: a first-order sensor lags the
     /// stator's warm-up ([`crate::thermal::sensor_rise_k`]). 0: it follows at once.
     pub temperature_lag_s: f64,
+    /// Zero offset of the preload reading [N]: a row's preload column reads the axial force
+    /// on the contact plus this. The load cell's zero, and the friction of the axial guide
+    /// between the cell and the rotor, put the force the contact carries a few newtons off
+    /// the reading.
+    pub preload_offset_n: f64,
+    /// Relative gain error of the current reading (-): the instrument shows the phase
+    /// current times (1 + this). A current probe or shunt amplifier is good to 1-3 % of its
+    /// reading.
+    pub current_gain_rel: f64,
 }
 
 impl Instrument {
     /// The operating point the motor ran at when a row's set points read `op`: the load
     /// torque is the reading less the transducer's zero offset, never below zero (a
-    /// reading within the offset of zero is an unloaded rotor).
+    /// reading within the offset of zero is an unloaded rotor); the preload is the reading
+    /// less the load cell's offset (the fit's bounds keep it positive).
     pub fn operating_point(&self, op: &crate::OperatingPoint) -> crate::OperatingPoint {
-        if self.torque_offset_nm == 0.0 {
+        if self.torque_offset_nm == 0.0 && self.preload_offset_n == 0.0 {
             return *op;
         }
-        crate::OperatingPoint { torque_nm: (op.torque_nm - self.torque_offset_nm).max(0.0), ..*op }
+        crate::OperatingPoint {
+            torque_nm: (op.torque_nm - self.torque_offset_nm).max(0.0),
+            preload_n: op.preload_n - self.preload_offset_n,
+            ..*op
+        }
     }
 
     /// What the instrument shows of quantity `o` when the motor's value is `model`.
@@ -467,6 +481,7 @@ impl Instrument {
                 model.hypot(self.speed_std_floor_rpm)
             }
             crate::observable::Observable::TemperatureC => model + self.temperature_offset_k,
+            crate::observable::Observable::CurrentA => model * (1.0 + self.current_gain_rel),
             _ => model,
         }
     }

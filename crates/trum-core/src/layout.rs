@@ -39,6 +39,17 @@ pub fn status_meaning(s: Status) -> &'static str {
     }
 }
 
+/// Why a point has no steady state when its solve spent its work bound
+/// ([`crate::Solution::work_bound_reached`], [`crate::solve::WORK_BOUND`] units by default):
+/// the search was stopped, not proven fruitless (docs/RELIABILITY.md, "The work bound of a
+/// solve").
+pub fn work_bound_meaning() -> String {
+    format!(
+        "no steady state found: the solve spent its work bound ({} units by default) before it found one",
+        crate::solve::WORK_BOUND
+    )
+}
+
 /// The columns of the response table, in order.
 pub const RESPONSE_COLUMNS: [&str; 8] =
     ["voltage_v", "preload_n", "frequency_hz", "branch", "status", "amplitude_m", "phase_lag_rad", "stable"];

@@ -72,7 +72,6 @@ impl LeastSquares {
     }
 
     /// The numerical rank: the number of singular values kept.
-    #[cfg(test)]
     pub(crate) fn rank(&self) -> usize {
         self.s.len()
     }

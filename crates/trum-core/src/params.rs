@@ -289,7 +289,9 @@ pub fn plausible_from_toml_str(
 /// `bench.torque_offset_nm` (the prior's standard deviation in N·m; 0: no offset), the
 /// temperature reading's offset `bench.temperature_offset_k` (in K; 0: no offset), the
 /// temperature sensor's lag `bench.temperature_lag_s` (the standard deviation of its
-/// logarithm; 0: no lag). Empty
+/// logarithm; 0: no lag), the preload reading's offset `bench.preload_offset_n` (in N; 0:
+/// no offset) and the current reading's gain error `bench.current_gain_rel` (relative; 0:
+/// exact). Empty
 /// without a table; errors name
 /// the file, line and key.
 pub fn tolerances_from_toml_str(
@@ -337,8 +339,8 @@ pub fn tolerances_from_toml_str(
 
 /// The keys a `[tolerances]` table accepts: the parameters calibration fits
 /// ([`crate::tolerances::TOLERANCES`]) by dotted motor key, then the bench's
-/// `bench.speed_std_floor_rpm`, `bench.torque_offset_nm`, `bench.temperature_offset_k` and
-/// `bench.temperature_lag_s`.
+/// `bench.speed_std_floor_rpm`, `bench.torque_offset_nm`, `bench.temperature_offset_k`,
+/// `bench.temperature_lag_s`, `bench.preload_offset_n` and `bench.current_gain_rel`.
 pub fn tolerance_keys() -> Vec<String> {
     crate::tolerances::TOLERANCES
         .iter()
@@ -349,6 +351,8 @@ pub fn tolerance_keys() -> Vec<String> {
                 "bench.torque_offset_nm",
                 "bench.temperature_offset_k",
                 "bench.temperature_lag_s",
+                "bench.preload_offset_n",
+                "bench.current_gain_rel",
             ]
             .map(String::from),
         )

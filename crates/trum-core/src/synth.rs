@@ -98,7 +98,7 @@ pub struct Artefacts {
     /// Noise floor of the speed-stability instrument [rev/min]: it reads
     /// √(true² + floor²) (plus its noise).
     pub speed_std_floor_rpm: f64,
-    /// Zero offset of the torque sensor [N·m]: the file records the true load minus it.
+    /// Zero offset of the torque sensor [N·m]: the file records the true load plus it.
     pub torque_offset_nm: f64,
     /// Resolution of the speed readings [rev/min] (0: none): readings are rounded to it.
     pub speed_quantum_rpm: f64,
@@ -110,11 +110,17 @@ pub struct Artefacts {
     pub temperature_lag_s: f64,
     /// Fraction of readings replaced by gross outliers (a reading off by 5-15 of its σ).
     pub outlier_fraction: f64,
+    /// Zero offset of the preload reading [N]: the file records the axial force on the
+    /// contact plus this.
+    pub preload_offset_n: f64,
+    /// Relative gain error of the current reading (-): it shows the phase current times
+    /// (1 + this), before its noise.
+    pub current_gain_rel: f64,
 }
 
 impl Artefacts {
     /// Names of the artefacts as written in `name=value` lists.
-    pub const NAMES: [&'static str; 7] = [
+    pub const NAMES: [&'static str; 9] = [
         "readback_rel",
         "speed_std_floor_rpm",
         "torque_offset_nm",
@@ -122,6 +128,8 @@ impl Artefacts {
         "outlier_fraction",
         "temperature_offset_k",
         "temperature_lag_s",
+        "preload_offset_n",
+        "current_gain_rel",
     ];
 
     /// Parses `name=value,...` (e.g. `readback_rel=0.005,speed_std_floor_rpm=0.3`); the
@@ -147,6 +155,8 @@ impl Artefacts {
                 "outlier_fraction" => &mut a.outlier_fraction,
                 "temperature_offset_k" => &mut a.temperature_offset_k,
                 "temperature_lag_s" => &mut a.temperature_lag_s,
+                "preload_offset_n" => &mut a.preload_offset_n,
+                "current_gain_rel" => &mut a.current_gain_rel,
                 other => {
                     return Err(TrumError::input(format!(
                         "unknown bench artefact '{other}'; valid names are: {}",
@@ -168,6 +178,9 @@ impl Artefacts {
         }
         if a.temperature_lag_s < 0.0 {
             return bad("temperature_lag_s", "must be >= 0");
+        }
+        if !(-0.5..0.5).contains(&a.current_gain_rel) {
+            return bad("current_gain_rel", "must be in (-0.5, 0.5)");
         }
         Ok(a)
     }
@@ -395,6 +408,9 @@ pub fn synthesize(motor: &Motor, cfg: &SynthConfig) -> Result<Vec<SynthRow>, Tru
                         }
                         v += art.temperature_offset_k;
                     }
+                    if o == Observable::CurrentA {
+                        v *= 1.0 + art.current_gain_rel;
+                    }
                     let mut x = v + noise.gauss(reading_noise(o, v));
                     if art.outlier_fraction > 0.0 && bench.random::<f64>() < art.outlier_fraction {
                         let sign = if bench.random::<bool>() { 1.0 } else { -1.0 };
@@ -423,6 +439,9 @@ pub fn synthesize(motor: &Motor, cfg: &SynthConfig) -> Result<Vec<SynthRow>, Tru
             }
             if art.torque_offset_nm != 0.0 {
                 m_op.torque_nm = (m_op.torque_nm + art.torque_offset_nm).max(0.0);
+            }
+            if art.preload_offset_n != 0.0 {
+                m_op.preload_n = (m_op.preload_n + art.preload_offset_n).max(1.0);
             }
             rows.push(SynthRow { op: m_op, time_series: ts, readings, ambient_c: ambient, run_id: run });
         }

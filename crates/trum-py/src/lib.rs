@@ -368,7 +368,7 @@ fn solve_arrays<'py>(
     let m = &motor.get().inner;
     let (out, reasons) = detached(py, || {
         let out = vector::solve_points(m, &cols, n, par)?;
-        let r = vector::reasons(&cols, &out.status);
+        let r = vector::reasons(&cols, &out);
         Some((out, r))
     })?
     .ok_or_else(|| no_memory(n))?;
@@ -435,7 +435,7 @@ fn map_grid<'py>(
         .iter()
         .enumerate()
         .filter(|(_, &s)| !vector::is_valid_code(s))
-        .filter_map(|(i, &s)| vector::reason(s, &grid.point(i as u64)).map(|r| (i, r)))
+        .filter_map(|(i, &s)| vector::reason(s, &grid.point(i as u64), out.work_bound[i]).map(|r| (i, r)))
         .collect();
     let d = PyDict::new(py);
     for (name, col) in AXES.iter().zip(inputs) {

@@ -4,7 +4,7 @@
 //! cold start, and a map uses the core's fixed chunks (as `trum map` does).
 
 use rayon::prelude::*;
-use trum_core::layout::{status_code, status_meaning, status_of_code};
+use trum_core::layout::{status_code, status_meaning, status_of_code, work_bound_meaning};
 use trum_core::quantities::{values, QUANTITIES};
 use trum_core::solve::{solve_prepared, OperatingPoint, Prepared};
 use trum_core::sweep::{axis_values, chunk_range, solve_range, Grid, AXES, CHUNK_POINTS};
@@ -76,6 +76,8 @@ pub struct Columns {
     pub status: Vec<u8>,
     /// Limit warnings, bit i for `trum_core::limits::LIMIT_KEYS[i]`.
     pub warnings: Vec<u8>,
+    /// Whether the point's solve spent its work bound (`Solution::work_bound_reached`).
+    pub work_bound: Vec<bool>,
 }
 
 /// Mutable views of one chunk of every output column.
@@ -84,6 +86,7 @@ struct ChunkOut<'a> {
     values: Vec<&'a mut [f64]>,
     status: &'a mut [u8],
     warnings: &'a mut [u8],
+    work_bound: &'a mut [bool],
 }
 
 impl ChunkOut<'_> {
@@ -91,6 +94,7 @@ impl ChunkOut<'_> {
     fn write(&mut self, j: usize, s: &Solution) {
         self.status[j] = status_code(s.status);
         self.warnings[j] = s.warnings.bits();
+        self.work_bound[j] = s.work_bound_reached;
         let valid = s.status.is_valid();
         for (col, v) in self.values.iter_mut().zip(values(s)) {
             col[j] = if valid { v } else { f64::NAN };
@@ -109,7 +113,7 @@ impl Columns {
             Some(v)
         }
         let values = (0..QUANTITIES.len()).map(|_| zeros(n)).collect::<Option<Vec<_>>>()?;
-        Some(Columns { values, status: zeros(n)?, warnings: zeros(n)? })
+        Some(Columns { values, status: zeros(n)?, warnings: zeros(n)?, work_bound: zeros(n)? })
     }
 
     /// Splits every column into chunks of `chunk` points.
@@ -119,12 +123,14 @@ impl Columns {
             .status
             .chunks_mut(chunk)
             .zip(self.warnings.chunks_mut(chunk))
+            .zip(self.work_bound.chunks_mut(chunk))
             .enumerate()
-            .map(|(c, (status, warnings))| ChunkOut {
+            .map(|(c, ((status, warnings), work_bound))| ChunkOut {
                 start: c * chunk,
                 values: Vec::with_capacity(QUANTITIES.len()),
                 status,
                 warnings,
+                work_bound,
             })
             .collect();
         for col in self.values.iter_mut() {
@@ -174,20 +180,22 @@ pub fn is_valid_code(status: u8) -> bool {
 }
 
 /// Why a point with status code `status` is not valid (`None` when it is): the operating
-/// point's own reason for an invalid input, the status's meaning otherwise.
-pub fn reason(status: u8, op: &OperatingPoint) -> Option<String> {
+/// point's own reason for an invalid input, the work bound where the solve spent it
+/// (`work_bound`), the status's meaning otherwise.
+pub fn reason(status: u8, op: &OperatingPoint, work_bound: bool) -> Option<String> {
     match status_of_code(status)? {
         Status::InvalidInput => {
             Some(op.invalid_reason().unwrap_or_else(|| status_meaning(Status::InvalidInput).into()))
         }
+        Status::NoConvergence if work_bound => Some(work_bound_meaning()),
         s if !s.is_valid() => Some(status_meaning(s).into()),
         _ => None,
     }
 }
 
 /// Reasons for every non-valid point of a vectorised solve.
-pub fn reasons(cols: &[Column<'_>; 5], status: &[u8]) -> Vec<(usize, String)> {
-    status
+pub fn reasons(cols: &[Column<'_>; 5], out: &Columns) -> Vec<(usize, String)> {
+    out.status
         .iter()
         .enumerate()
         .filter(|(_, &s)| !is_valid_code(s))
@@ -199,7 +207,7 @@ pub fn reasons(cols: &[Column<'_>; 5], status: &[u8]) -> Vec<(usize, String)> {
                 frequency_hz: cols[3].at(i),
                 elapsed_s: cols[4].at(i),
             };
-            reason(s, &op).map(|r| (i, r))
+            reason(s, &op, out.work_bound[i]).map(|r| (i, r))
         })
         .collect()
 }
@@ -308,10 +316,35 @@ mod tests {
     #[test]
     fn every_status_code_has_its_reason_or_none() {
         let op = OperatingPoint::new(-5.0, 0.0, 200.0, 43e3);
-        assert_eq!(reason(status_code(Status::Ok), &op), None);
-        assert_eq!(reason(status_code(Status::Clamped), &op), None);
-        assert_eq!(reason(status_code(Status::InvalidInput), &op).as_deref(), Some("preload_n = -5 must be > 0"));
-        assert!(reason(status_code(Status::NoConvergence), &op).unwrap().starts_with("no steady state found"));
+        assert_eq!(reason(status_code(Status::Ok), &op, false), None);
+        assert_eq!(reason(status_code(Status::Clamped), &op, false), None);
+        assert_eq!(
+            reason(status_code(Status::InvalidInput), &op, false).as_deref(),
+            Some("preload_n = -5 must be > 0")
+        );
+        let stopped = reason(status_code(Status::NoConvergence), &op, false).unwrap();
+        assert!(stopped.starts_with("no steady state found") && !stopped.contains("work bound"), "{stopped}");
+        let bounded = reason(status_code(Status::NoConvergence), &op, true).unwrap();
+        assert!(bounded.starts_with("no steady state found") && bounded.contains("work bound"), "{bounded}");
         assert!(is_valid_code(2) && !is_valid_code(3) && !is_valid_code(200));
+    }
+
+    #[test]
+    fn a_point_that_spent_its_work_bound_says_so_in_its_reason() {
+        let m = trum_core::presets::preset("trum60a").expect("preset");
+        let op = OperatingPoint::new(250.0, 0.3, 200.0, 43e3);
+        let stopped = solve_prepared(&Prepared::new(&m).with_work_bound(10), &m, &op, None);
+        let solved = solve_prepared(&Prepared::new(&m), &m, &op, None);
+        let mut out = Columns::try_new(2).expect("memory");
+        {
+            let mut chunks = out.chunks(2);
+            chunks[0].write(0, &stopped);
+            chunks[0].write(1, &solved);
+        }
+        assert_eq!(out.work_bound, [true, false]);
+        let cols = [250.0, 0.3, 200.0, 43e3, 0.0].map(Column::Scalar);
+        let r = reasons(&cols, &out);
+        assert_eq!(r.len(), 1, "{r:?}");
+        assert_eq!(r[0], (0, work_bound_meaning()));
     }
 }

@@ -361,9 +361,9 @@ pub fn diagnose(
     let tests = GapTests { base_nrmse: base.nrmse, gap_noise: base.noise_best, base_z2: base.z2, n_read: ctx.n_read };
     // The gap is real when the baseline misses held-out data beyond twice the noise
     // variance, with the noise levels at the upper end of their estimates (a level
-    // estimated low by chance raises every z²), or when some effect closes a material part
-    // of it (a small, consistent gap).
-    let gap = base.z2_upper_noise > 2.0 || ranking.iter().any(|r| tests.material(r));
+    // estimated low by chance raises every z²), or when some effect shows it
+    // ([`verdict::GapTests::shows_gap`]: closes a material part of a small, consistent gap).
+    let gap = base.z2_upper_noise > 2.0 || ranking.iter().any(|r| tests.shows_gap(r));
     let mut decided = Verdict {
         verdict: String::from("none"),
         complete: true,
@@ -423,7 +423,9 @@ pub fn diagnose(
                 .filter(|(name, _)| Effect::from_name(name).is_ok())
                 .map(|(name, c)| (name.clone(), residuals(&c.motor, &ctx.rows).iter().map(|z| z * z).collect()))
                 .collect();
-            for e in verdict::inseparable(&ranking, &decided.verdict, &z2) {
+            let one_frequency = span_of(&ctx.rows, |r| r.op.frequency_hz) < verdict::ONE_FREQUENCY_SPAN;
+            let alike = one_frequency.then(|| verdict::alike_at_one_frequency(&ranking, &decided.verdict)).flatten();
+            for e in verdict::inseparable(&ranking, &decided.verdict, &z2).into_iter().chain(alike) {
                 if !decided.confounded.contains(&e) {
                     decided.confounded.push(e);
                 }
@@ -505,6 +507,20 @@ fn held_out(
         }
     }
     heldout
+}
+
+/// The span of `f` over `rows` relative to its largest magnitude, (max − min) / max|f|;
+/// 0 for no rows or a quantity that is zero throughout.
+fn span_of(rows: &[ObservedRow], f: impl Fn(&ObservedRow) -> f64) -> f64 {
+    let (lo, hi, top) = rows
+        .iter()
+        .map(&f)
+        .fold((f64::INFINITY, f64::NEG_INFINITY, 0.0_f64), |(lo, hi, top), x| (lo.min(x), hi.max(x), top.max(x.abs())));
+    if top > 0.0 && hi >= lo {
+        (hi - lo) / top
+    } else {
+        0.0
+    }
 }
 
 /// Two effect lists (`a+b`) name the same set.

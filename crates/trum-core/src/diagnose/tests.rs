@@ -47,7 +47,12 @@ pub(super) fn sag_data() -> (Motor, Vec<ObservedRow>, Vec<String>) {
 fn an_overshooting_fold_step_is_damped_not_dropped() {
     let (nominal, rows, _) = sag_data();
     let fit = FitOptions::default();
-    let (s0, params) = fit_params(&nominal, &nominal, &rows, &[], false, &BTreeMap::new());
+    // (the motor's parameters under their priors; the bench's preload offset and current
+    // gain held, whose near-degenerate directions with the sag's can leave a fold's step
+    // without a gain at any damping, the route this test is not about)
+    let held =
+        BTreeMap::from([("bench.preload_offset_n".to_string(), 0.0), ("bench.current_gain_rel".to_string(), 0.0)]);
+    let (s0, params) = fit_params(&nominal, &nominal, &rows, &[], false, &held);
     let cal = Calibration::builder(&s0, &rows).params(&params).options(&fit).run().expect("baseline");
     // folds by preload, so each held-out block moves the parameters
     let mut loads: Vec<f64> = rows.iter().map(|r| r.op.preload_n).collect();
@@ -408,7 +413,9 @@ fn an_effect_that_closes_a_sliver_of_the_gap_is_no_verdict() {
     for (truth_effect, strength, campaign, noise, seed, candidates) in cases {
         let d = diagnosed_single(truth_effect, strength, campaign, noise, seed, &candidates);
         let best = &d.ranking[0];
-        assert!(best.shrink < 0.2 && best.heldout_chi2_after > 3.0, "{truth_effect:?}: {best:?}");
+        // (a sliver: under a fifth of the NRMSE gone, the held-out z² left beyond the
+        // noise's 2)
+        assert!(best.shrink < 0.2 && best.heldout_chi2_after > 2.5, "{truth_effect:?}: {best:?}");
         assert_eq!(d.verdict, "unexplained", "{truth_effect:?}: {:?}", d.ranking);
     }
 }
@@ -733,6 +740,47 @@ fn a_temperature_sensor_offset_is_the_benchs_not_a_gap() {
     assert_sensor_misses_without(&d, &held);
 }
 
+/// A preload-torque campaign of the reference motor with nothing added, its preload read
+/// 10 N high and its current 5 % high (besides the development half's artefacts): both
+/// are the bench's. Fitted, they come back near their values and the verdict is `none`;
+/// held at zero (tolerance 0), the baseline cannot follow them and a candidate is fitted
+/// to the bench (on this seed `radial_friction`, with evidence 31, to the shifted preload
+/// axis) with more evidence than any has with them.
+#[test]
+fn a_preload_offset_and_a_current_gain_are_the_benchs_not_an_effect() {
+    let nominal = crate::calibrate::tests::reference_motor();
+    let cfg = SynthConfig {
+        campaign: Campaign::PreloadTorque,
+        noise: 1.0,
+        seed: 7301,
+        artefacts: crate::synth::Artefacts::parse(
+            "readback_rel=0.004,speed_std_floor_rpm=0.3,preload_offset_n=10,current_gain_rel=0.05",
+        )
+        .expect("artefacts"),
+        ..SynthConfig::default()
+    };
+    let (rows, groups) = synthesized(&nominal, &cfg);
+    let opts = DiagnoseOptions {
+        candidates: vec![Effect::RadialFriction, Effect::VoltageSag, Effect::PreloadStiffening, Effect::Eccentricity],
+        try_pairs: false,
+        bootstrap: 50,
+        ..DiagnoseOptions::default()
+    };
+    let d = diagnose(&nominal, &rows, &groups, &opts).expect("diagnosis");
+    assert_eq!(d.verdict, "none", "{:?}", d.ranking);
+    let got = |k: &str| d.baseline_params.iter().find(|(n, _)| n == k).map(|(_, v)| *v);
+    let offset = got("bench.preload_offset_n").expect("the preload offset is fitted");
+    assert!((offset - 10.0).abs() < 4.0, "fitted preload offset {offset} N against 10 N");
+    let gain = got("bench.current_gain_rel").expect("the current gain is fitted");
+    assert!((gain - 0.05).abs() < 0.015, "fitted current gain {gain} against 0.05");
+    let held_at_zero =
+        BTreeMap::from([("bench.preload_offset_n".to_string(), 0.0), ("bench.current_gain_rel".to_string(), 0.0)]);
+    let held =
+        diagnose(&nominal, &rows, &groups, &DiagnoseOptions { tolerances: held_at_zero, ..opts }).expect("diagnosis");
+    let best = |x: &Diagnosis| x.ranking.iter().map(|r| r.evidence).fold(f64::NEG_INFINITY, f64::max);
+    assert!(best(&held) > 5.0 && best(&held) > best(&d) + 5.0, "{} vs {}", best(&held), best(&d));
+}
+
 /// Without the sensor's nuisance parameter (`held`) the warm-up's baseline misses the
 /// held-out temperatures beyond twice the noise variance, and by more than half again
 /// what it misses with it (`fitted`). (Whether that gap is called real also depends on how
@@ -792,9 +840,9 @@ fn a_strong_compliance_is_reached_from_its_own_valley() {
 }
 
 /// The diagnosis names the baseline parameters its data leave at their priors, as
-/// calibration does: every one of them a calibrated parameter with a prior; fewer of them
-/// on a whole campaign than on a handful of its rows (more readings narrow more
-/// parameters), and on the whole campaign not the resonance frequency, which every reading
+/// calibration does: every one of them a calibrated parameter with a prior; no more of the
+/// motor's on a whole campaign than on a handful of its rows (more readings narrow as many
+/// parameters or more), and on the whole campaign not the resonance frequency, which every reading
 /// of a drive near resonance pins down.
 #[test]
 fn the_parameters_the_data_leave_at_their_priors_are_named() {
@@ -812,7 +860,15 @@ fn the_parameters_the_data_leave_at_their_priors_are_named() {
             assert!(!n.starts_with("effects."), "{n}");
         }
     }
-    assert!(full.baseline_held_near_prior.len() < small.baseline_held_near_prior.len());
+    // (the motor's parameters: the bench's nuisances are fitted only where the data have
+    // enough readings of theirs)
+    let motor_held = |d: &Diagnosis| d.baseline_held_near_prior.iter().filter(|n| !n.starts_with("bench.")).count();
+    assert!(
+        motor_held(&full) <= motor_held(&small),
+        "{:?} vs {:?}",
+        full.baseline_held_near_prior,
+        small.baseline_held_near_prior
+    );
     assert!(!full.baseline_held_near_prior.iter().any(|n| n == "stator.resonance_frequency_hz"));
 }
 

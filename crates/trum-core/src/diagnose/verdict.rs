@@ -16,6 +16,10 @@ use std::collections::BTreeMap;
 /// weak effects whose baseline is at the noise.
 pub(super) const CERTAIN_Z2_GAIN: f64 = 0.1;
 
+/// The part of the baseline's held-out NRMSE whose removal is material wherever the gap
+/// stands ([`GapTests::material`]): a fifth.
+pub(super) const MATERIAL_SHRINK: f64 = 0.2;
+
 /// The tests of a ranking entry against the held-out gap of the baseline.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct GapTests {
@@ -90,10 +94,30 @@ impl GapTests {
     /// 104, was `none`).
     pub(super) fn material(&self, r: &RankEntry) -> bool {
         Self::supported(r)
-            && (r.shrink >= 0.2
+            && (r.shrink >= MATERIAL_SHRINK
                 || self.excess_shrink(r) >= 0.25
                 || self.z2_excess_shrink(r) >= 0.25
-                || (r.shrink_interval.0 > 0.0 && r.z2_shrink_interval.0 >= CERTAIN_Z2_GAIN))
+                || (r.shrink_interval.0 > 0.0 && Self::certain_in_sigma(r)))
+    }
+
+    /// A held-out gain certain in σ: the bootstrap 5 % bound of the z² shrink at least
+    /// [`CERTAIN_Z2_GAIN`].
+    pub(super) fn certain_in_sigma(r: &RankEntry) -> bool {
+        r.z2_shrink_interval.0 >= CERTAIN_Z2_GAIN
+    }
+
+    /// Whether entry `r` shows a gap that the baseline's held-out z² alone does not: it is
+    /// material, and where the baseline's held-out mean z² is at most one (its readings
+    /// miss by no more than their noise, on the whole) it removes a fifth of the held-out
+    /// NRMSE or its gain is certain in σ. A quarter of the NRMSE's part "beyond the noise"
+    /// is no gap there: that part can be carried by a few readings of a quantity that
+    /// barely varies. (A null `trum60-qut` combined campaign near its clamping edge has a
+    /// few rows whose read-back set points fall on the other side of the edge from the
+    /// motor that ran; a compliance fit follows them and takes 0.11 of the held-out NRMSE,
+    /// 0.14 against 0.11 from noise alone, a quarter of its part beyond the noise, where the
+    /// baseline's z² is 0.66 and the compliance's z² gain is uncertain.)
+    pub(super) fn shows_gap(&self, r: &RankEntry) -> bool {
+        self.material(r) && (self.base_z2 > 1.0 || r.shrink >= MATERIAL_SHRINK || Self::certain_in_sigma(r))
     }
 
     /// An entry closes the gap when it removes a material part of it and what it leaves is
@@ -325,6 +349,48 @@ pub(super) fn inseparable(ranking: &[RankEntry], verdict: &str, z2: &BTreeMap<St
         .filter(|r| z2.get(&r.effect).is_some_and(|z| evidence_z(best.evidence, r.evidence, z2_best, z) < SEPARATED_Z))
         .map(|r| r.effect.clone())
         .collect()
+}
+
+/// The two effects that act on a stator at one drive frequency through the same channel:
+/// both move its modal stiffness, `preload_stiffening` with the preload (Sun et al. 2021,
+/// eq. 8; the radial-friction paper, section 5.3) and `hertz_softening` with the amplitude
+/// and, through its preload gain, the preload (the Hertzian driving-circuit paper, 2022,
+/// eq. 2-4; docs/EFFECTS.md). Across a frequency sweep they part:
+/// the first shifts the resonance with the preload alone, the second bends it with the
+/// amplitude (a leaning backbone). At one frequency each shows only as a detuning that
+/// follows the operating point, which either family can shape.
+const ALIKE_AT_ONE_FREQUENCY: [&str; 2] = ["preload_stiffening", "hertz_softening"];
+
+/// Data whose drive frequency spans less than this fraction of itself are read at one
+/// frequency for [`alike_at_one_frequency`]: the resonance of a 60 mm TRUM stator is a few
+/// hundred hertz wide near 40 kHz (half-power width c/(2π·m): 320 Hz with the TRUM60A's
+/// 10 N·s/m and 5 g), and a span under 1 % (about 400 Hz) does not trace its shape.
+pub(super) const ONE_FREQUENCY_SPAN: f64 = 0.01;
+
+/// Where the data hold one drive frequency ([`ONE_FREQUENCY_SPAN`]) and the verdict is one
+/// of [`ALIKE_AT_ONE_FREQUENCY`]: the other, when the data support it on their own
+/// (evidence > 5), the held-out data do not reject it (both bootstrap intervals of its
+/// shrink reach above zero) and it closes at least half the held-out gap the verdict
+/// closes. The evidence between the two then measures how well each family's form follows
+/// the data's, not which physics acts: a truth form outside both families can give either
+/// the lead (a softening whose contact share falls with the preload is followed by the
+/// stiffening family in part), so the diagnosis names both.
+pub(super) fn alike_at_one_frequency(ranking: &[RankEntry], verdict: &str) -> Option<String> {
+    if !ALIKE_AT_ONE_FREQUENCY.contains(&verdict) {
+        return None;
+    }
+    let best = ranking.iter().find(|r| r.effect == verdict)?;
+    ranking
+        .iter()
+        .filter(|r| r.effect != verdict && ALIKE_AT_ONE_FREQUENCY.contains(&r.effect.as_str()))
+        .find(|r| {
+            r.evidence > 5.0
+                && r.shrink_interval.1 > 0.0
+                && r.z2_shrink_interval.1 > 0.0
+                && best.shrink > 0.0
+                && r.shrink >= 0.5 * best.shrink
+        })
+        .map(|r| r.effect.clone())
 }
 
 #[cfg(test)]
@@ -566,5 +632,66 @@ mod tests {
         let mut without = z2.clone();
         without.remove("radial_friction");
         assert!(inseparable(&ranking, "radial_friction", &without).is_empty());
+    }
+
+    /// At one drive frequency a stiffening and a softening that both close the held-out gap
+    /// are named together; across a frequency sweep, or where the other closes too little,
+    /// they are not (the caller gives the sweep; here only the ranking's side).
+    #[test]
+    fn stiffening_and_softening_are_alike_at_one_frequency() {
+        let entry = |effect: &str, evidence: f64, shrink: f64| RankEntry {
+            evidence,
+            shrink,
+            shrink_interval: (0.6 * shrink, 1.4 * shrink),
+            z2_shrink_interval: (0.6 * shrink, 1.4 * shrink),
+            ..ranked(effect, 1.2, 0.1)
+        };
+        let ranking = vec![
+            entry("preload_stiffening", 112.0, 0.62),
+            entry("hertz_softening", 42.0, 0.32),
+            entry("radial_friction", 80.0, 0.6),
+        ];
+        assert_eq!(alike_at_one_frequency(&ranking, "preload_stiffening").as_deref(), Some("hertz_softening"));
+        // another verdict: nothing
+        assert_eq!(alike_at_one_frequency(&ranking, "radial_friction"), None);
+        // the softening closing under half of what the stiffening closes: apart
+        let mut little = ranking.clone();
+        little[1] = entry("hertz_softening", 42.0, 0.25);
+        assert_eq!(alike_at_one_frequency(&little, "preload_stiffening"), None);
+        // rejected by the held-out data, or unsupported: apart
+        let mut rejected = ranking.clone();
+        rejected[1].shrink_interval = (-0.3, -0.01);
+        assert_eq!(alike_at_one_frequency(&rejected, "preload_stiffening"), None);
+        let mut weak = ranking.clone();
+        weak[1].evidence = 4.0;
+        assert_eq!(alike_at_one_frequency(&weak, "preload_stiffening"), None);
+        // the other way round
+        let swapped = vec![entry("hertz_softening", 60.0, 0.5), entry("preload_stiffening", 50.0, 0.4)];
+        assert_eq!(alike_at_one_frequency(&swapped, "hertz_softening").as_deref(), Some("preload_stiffening"));
+    }
+
+    /// Where the baseline's held-out z² is at most one, a quarter of the NRMSE's part beyond
+    /// the noise shows no gap; a fifth of the whole NRMSE, or a gain certain in σ, does.
+    /// Above one, material is enough. (Numbers of a null `trum60-qut` campaign near its
+    /// clamping edge and of a `ring60` eccentricity on a combined campaign.)
+    #[test]
+    fn a_baseline_at_the_noise_in_sigma_needs_a_larger_gain_to_show_a_gap() {
+        let tests = GapTests { base_nrmse: 0.139, gap_noise: 0.114, base_z2: 0.66, n_read: 679 };
+        let entry = |shrink: f64, si: (f64, f64), z2: (f64, f64)| RankEntry {
+            evidence: 100.0,
+            shrink,
+            shrink_interval: si,
+            z2_shrink_interval: z2,
+            ..ranked("tangential_compliance", 0.57, 0.139 * (1.0 - shrink))
+        };
+        let sliver = entry(0.11, (0.063, 0.19), (0.029, 0.11));
+        assert!(tests.material(&sliver) && tests.excess_shrink(&sliver) >= 0.25);
+        assert!(!tests.shows_gap(&sliver));
+        let above = GapTests { base_z2: 1.5, ..tests };
+        assert!(above.shows_gap(&sliver));
+        let fifth = entry(0.56, (0.39, 0.66), (0.047, 0.108));
+        assert!(tests.shows_gap(&fifth));
+        let certain = entry(0.11, (0.063, 0.19), (0.12, 0.3));
+        assert!(tests.shows_gap(&certain));
     }
 }
