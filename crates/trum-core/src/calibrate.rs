@@ -566,7 +566,10 @@ pub struct FittedParam {
     /// parameter with a prior: its standard error is not well inside the prior's width,
     /// so the value rests on the prior).
     pub identifiable: bool,
-    /// Relative prior standard deviation (the tolerance), for parameters with a prior.
+    /// Prior standard deviation (the tolerance), for parameters with a prior: relative (of
+    /// ln p) for a parameter fitted on a logarithmic scale, in the parameter's own units for
+    /// the bench's additive nuisances (`bench.torque_offset_nm`, `bench.preload_offset_n`,
+    /// `bench.temperature_offset_k`, `bench.current_gain_rel`).
     pub prior_rel_sd: Option<f64>,
 }
 
@@ -1508,8 +1511,15 @@ fn fit(
         // With a prior, the data identify a parameter when they narrow it to well inside
         // the prior's width; otherwise it is held by its prior, which is no fault.
         let prior_sd = fp.prior.map(|p| p.sd);
-        let identifiable =
-            jp.column(k).norm_squared() > 0.0 && se.is_finite() && rel < prior_sd.map_or(1.0, |sd| (0.7 * sd).min(1.0));
+        // (a prior's width is on ln p for a parameter fitted on a logarithmic scale, in the
+        // parameter's own units otherwise: the bench's offsets and gain, centred on zero,
+        // where a relative error means nothing)
+        let narrowed = match prior_sd {
+            Some(sd) if !fp.log => se < 0.7 * sd,
+            Some(sd) => rel < (0.7 * sd).min(1.0),
+            None => rel < 1.0,
+        };
+        let identifiable = jp.column(k).norm_squared() > 0.0 && se.is_finite() && narrowed;
         if abandoned {
             out.push(FittedParam {
                 name: fp.param.name(),
@@ -1966,6 +1976,33 @@ pub(crate) mod tests {
         let held = std::collections::BTreeMap::from([("bench.preload_offset_n".to_string(), 0.0)]);
         assert!(preload_offset_param(&rows, &held).is_none());
         assert!(current_gain_param(&one, &none).is_none());
+    }
+
+    /// A bench nuisance centred on zero is identified when its standard error is well
+    /// inside its prior's width in its own units: the preload offset of precise readings
+    /// across a preload sweep is, that of readings a hundred times noisier is held by its
+    /// prior, whatever the ratio of its error to its (near-zero) value.
+    #[test]
+    fn an_offset_is_identified_against_its_prior_in_its_own_units() {
+        let truth = reference_motor();
+        let rows = rows_on_grid(&truth, &[150.0, 200.0, 250.0, 300.0, 350.0], &[0.0, 0.1, 0.2, 0.3]);
+        let fitted = |scale: f64| {
+            let mut rows = rows.clone();
+            for r in &mut rows {
+                r.readings.iter_mut().for_each(|x| x.2 *= scale);
+            }
+            let none = std::collections::BTreeMap::new();
+            let params = vec![
+                fit_rel(&truth, "friction_layer.friction_coefficient", 0.3, 3.0),
+                preload_offset_param(&rows, &none).expect("a preload sweep"),
+            ];
+            let cal = Calibration::builder(&truth, &rows).params(&params).run().unwrap();
+            cal.params.into_iter().find(|p| p.name == "bench.preload_offset_n").expect("fitted")
+        };
+        let precise = fitted(0.1);
+        assert!(precise.identifiable && precise.std_error < 0.7 * precise.prior_rel_sd.unwrap_or(0.0), "{precise:?}");
+        let noisy = fitted(100.0);
+        assert!(!noisy.identifiable, "{noisy:?}");
     }
 
     /// A torque transducer's zero offset is a nuisance the fit recovers: noise-free rows of
