@@ -17,7 +17,13 @@ carries to other motors, not a held-out score.
     cargo build --release -p trum-cli
     python3 benches/other_motors.py                       # both sets, every motor
     python3 benches/other_motors.py --set strong generic60
+    python3 benches/other_motors.py --set moderate --campaigns frequency-sweep,warm-up,stability trum60a
+    python3 benches/other_motors.py --set moderate --omit feedback_v,current_a,input_power_w trum60a
     TRUM=path/to/trum python3 benches/other_motors.py
+
+`--campaigns` replaces the two campaign kinds (a `thermal_drift` on a campaign without a
+time series cannot act: `none` is right there); `--omit` leaves columns out of every file,
+as a poorer bench records fewer quantities.
 
 Prints one line per case (verdict, complete, confounded set, the three strongest
 candidates with evidence/shrink) and, per motor and set, the cases right (the verdict is
@@ -67,11 +73,13 @@ CAMPAIGNS = ("preload-torque", "combined")
 ARTEFACTS = "readback_rel=0.004,speed_std_floor_rpm=0.3"
 
 
-def run_case(work, motor_name, set_name, effect, campaign, seed):
+def run_case(work, motor_name, set_name, effect, campaign, seed, omit=None):
     motor, drive = MOTORS[motor_name]
     base = os.path.join(work, f"{motor_name}_{set_name}_{effect}_{campaign}_{seed}")
     synth = [TRUM, "synth", "--motor", motor, "--campaign", campaign, "--noise", "1", "--seed", str(seed),
              "--motor-seed", str(seed), "--artefacts", ARTEFACTS, "-o", base + ".csv", *drive]
+    if omit:
+        synth += ["--omit", omit]
     if effect != "none":
         synth += ["--effect", SETS[set_name][effect]]
     r = subprocess.run(synth, capture_output=True, text=True)
@@ -86,7 +94,9 @@ def run_case(work, motor_name, set_name, effect, campaign, seed):
 
 
 def judge(d, effect, campaign):
-    truth = "none" if effect == "none" or (effect == "thermal_drift" and campaign == "preload-torque") else effect
+    # (thermal_drift acts through a time series: the warm-up, alone or in the combined campaign)
+    time_series = campaign in ("warm-up", "combined")
+    truth = "none" if effect == "none" or (effect == "thermal_drift" and not time_series) else effect
     right = d["verdict"] == truth or truth in d["confounded_with"]
     own = [r for r in d["ranking"] if r["effect"] == truth]
     weak = truth != "none" and not right and (not own or own[0]["evidence"] <= 5.0)
@@ -96,9 +106,19 @@ def judge(d, effect, campaign):
 def main():
     args = sys.argv[1:]
     sets = list(SETS)
+    campaigns = CAMPAIGNS
+    omit = None
     if "--set" in args:
         i = args.index("--set")
         sets = [args[i + 1]]
+        del args[i:i + 2]
+    if "--campaigns" in args:
+        i = args.index("--campaigns")
+        campaigns = tuple(args[i + 1].split(","))
+        del args[i:i + 2]
+    if "--omit" in args:
+        i = args.index("--omit")
+        omit = args[i + 1]
         del args[i:i + 2]
     motors = args or list(MOTORS)
     for m in motors:
@@ -115,11 +135,11 @@ def main():
         for s in sets:
             seed = 400 if s == "moderate" else 500
             for k, e in enumerate(list(SETS[s]) + ["none", "none"]):
-                for ci, c in enumerate(CAMPAIGNS):
-                    jobs.append((m, s, e, c, seed + 2 * k + ci))
+                for ci, c in enumerate(campaigns):
+                    jobs.append((m, s, e, c, seed + len(campaigns) * k + ci))
     tally = {}
     with ThreadPoolExecutor(2) as ex:
-        for (m, s, e, c, seed), (d, err) in zip(jobs, ex.map(lambda j: run_case(work, *j), jobs)):
+        for (m, s, e, c, seed), (d, err) in zip(jobs, ex.map(lambda j: run_case(work, *j, omit=omit), jobs)):
             t = tally.setdefault((m, s), [0, 0, 0, 0, 0])  # effect right, effect cases, weak, null right, nulls
             if err:
                 print(f"{m:<10} {s:<8} {e:<22} {c:<15} ERROR {err}", flush=True)
