@@ -13,6 +13,8 @@
 //! the sum of squared target misses, each divided by its tolerance (the tolerances of
 //! tests/papers.rs). It prints the fitted values and every target's paper and model value;
 //! `--report` prints the targets of the preset as it is, without fitting.
+//! `--driver-voltages` (trum60-qut) also holds the motor running at the no-load voltages
+//! Sun et al. 2021 measured at its driver (docs/PRESETS.md, "Targets not reached").
 
 use trum_core::criterion::{evaluate, region_overlap, CriterionConfig};
 use trum_core::params::Motor;
@@ -322,6 +324,17 @@ fn targets_qut(m: &Motor, _quick: bool) -> Vec<Target> {
     t
 }
 
+/// Hard (`--driver-voltages`): the TRUM-60 runs at no load at the voltages its driver
+/// delivered, Sun et al. 2021 section 3.1, Fig. 5a-b: 141 V at 50 N and 106 V at 350 N
+/// (where the paper also loads it), at 42 kHz.
+fn driver_voltage_target(m: &Motor) -> Target {
+    let off = [(50.0, 141.0), (350.0, 106.0)]
+        .iter()
+        .filter(|&&(f, u)| no_load(m, f, u, 42_000.0).status != Status::Ok)
+        .count();
+    plausible("points at the driver's voltages not running [-]", off as f64, (0.0, 0.0), 0.01)
+}
+
 fn cost(t: &[Target]) -> f64 {
     t.iter().map(|(_, p, m, tol)| if m.is_finite() { ((m - p) / tol).powi(2) } else { 1e6 }).sum()
 }
@@ -462,6 +475,14 @@ fn main() {
             }
         }
     }
+    let driver_voltages = args.iter().any(|a| a == "--driver-voltages");
+    let targets = |m: &Motor, quick: bool| {
+        let mut t = targets(m, quick);
+        if driver_voltages {
+            t.push(driver_voltage_target(m));
+        }
+        t
+    };
     let mut motor = base.clone();
     let show = |m: &Motor| {
         for (n, p, v, tol) in targets(m, false) {
