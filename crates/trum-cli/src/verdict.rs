@@ -70,6 +70,7 @@ mod tests {
             baseline_params: vec![],
             baseline_held_near_prior: vec![],
             heldout: vec![],
+            separating_campaigns: vec![],
         };
         let w = verdict_words(&d);
         assert!(w.starts_with("voltage_sag (incomplete") && w.contains("35 %"), "{w}");

@@ -468,3 +468,36 @@ fn sensor_noise_is_stated_or_refused() {
     let e = fails(&["diagnose", "--motor", MOTOR, "--data", &data, "--sensor-noise", "speed_rpm=0", "-q"], 1);
     assert!(e.contains("must be a finite number > 0"), "{e}");
 }
+
+/// A softening of the stator mode on a preload-torque campaign at one drive frequency: the
+/// verdict `hertz_softening` is confounded with `preload_stiffening` (at one frequency both
+/// are a detuning that follows the operating point), and the diagnosis says what would
+/// part them: a frequency sweep, by orders of magnitude more than another campaign of the
+/// kind the data are, which separates the two fits no better than the data do.
+#[test]
+fn a_confounded_verdict_names_the_campaign_that_separates_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let motor = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/motors/trum60a_baseline.toml");
+    let data = path(dir.path(), "soft.csv");
+    let json = path(dir.path(), "soft.json");
+    let run = ["--campaign", "preload-torque", "--voltage-v", "200", "--frequency-hz", "43000", "--noise", "1"];
+    let mut args = vec!["synth", "--motor", motor, "--effect", "hertz_softening=1e18", "--seed", "1", "-o", &data];
+    args.extend_from_slice(&run);
+    ok(&args);
+    let out = ok(&["diagnose", "--motor", motor, "--data", &data, "--json", &json]);
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("JSON");
+    assert_eq!(j["verdict"], "hertz_softening", "{out}");
+    assert_eq!(j["confounded_with"], serde_json::json!(["preload_stiffening"]), "{out}");
+    let s = &j["separating_campaigns"][0];
+    assert_eq!(s["effects"], serde_json::json!(["hertz_softening", "preload_stiffening"]), "{s}");
+    assert_eq!(s["best"], "frequency-sweep", "{s}");
+    let chi2 = |c: &str| {
+        s["campaigns"].as_array().expect("campaigns").iter().find(|x| x["campaign"] == c).expect(c)["chi2"]
+            .as_f64()
+            .expect("chi2")
+    };
+    let on_data = s["chi2_on_the_data"].as_f64().expect("chi2 on the data");
+    assert!(chi2("frequency-sweep") > 100.0 * chi2("preload-torque"), "{s}");
+    assert!(chi2("preload-torque") < 10.0 * on_data.max(1.0), "{s}");
+    assert!(out.contains("a frequency-sweep campaign at the data's drive would separate them"), "{out}");
+}

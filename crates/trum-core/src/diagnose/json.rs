@@ -144,6 +144,12 @@ pub fn to_json(d: &Diagnosis, src: &Provenance<'_>) -> Value {
             "signature_overlap": r.signature_overlap.map(num),
             "heldout_in_sample_folds": r.heldout_in_sample_folds,
         })).collect::<Vec<_>>(),
+        "separating_campaigns": d.separating_campaigns.iter().map(|s| json!({
+            "effects": [s.effects.0, s.effects.1],
+            "chi2_on_the_data": num(s.chi2_on_the_data),
+            "campaigns": s.chi2.iter().map(|(c, x)| json!({"campaign": c, "chi2": num(*x)})).collect::<Vec<_>>(),
+            "best": s.best().map(|b| b.0),
+        })).collect::<Vec<_>>(),
         "evidence_scale": EVIDENCE_SCALE,
         "notes": d.notes,
         "n_rows": d.n_rows,

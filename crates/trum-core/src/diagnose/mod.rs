@@ -33,6 +33,7 @@ mod folds;
 pub mod json;
 mod pairs;
 mod scan;
+pub mod separation;
 mod signature;
 #[cfg(test)]
 mod tests;
@@ -254,6 +255,10 @@ pub struct Diagnosis {
     /// Per held-out reading: (row index, observable, measured, baseline prediction,
     /// prediction with the verdict's effects) — for plots.
     pub heldout: Vec<HeldOut>,
+    /// For each effect the verdict is confounded with, how well each `trum synth` campaign
+    /// at the data's drive would separate the two fits ([`separation`]): what to measure
+    /// next. Empty when nothing is confounded.
+    pub separating_campaigns: Vec<separation::Separation>,
 }
 
 /// One held-out reading with its predictions.
@@ -439,6 +444,8 @@ pub fn diagnose(
     }
     let Verdict { verdict, complete, confounded, partial, .. } = decided;
     notes.extend(screened_note);
+    let separating_campaigns = separating_campaigns(&ctx.rows, &fits.fits, &verdict, &confounded);
+    notes.extend(separating_campaigns.iter().filter_map(separation_note));
     notes.extend(scorer.into_notes());
     notes.extend(folds::in_sample_note(base.cv.in_sample, &ranking, ctx.k));
     if ctx.reduced && verdict != "none" {
@@ -479,7 +486,40 @@ pub fn diagnose(
             .map(|p| p.name.clone())
             .collect(),
         heldout,
+        separating_campaigns,
     }))
+}
+
+/// The separation of the single-effect `verdict` from each effect it is `confounded` with,
+/// between their full-data fits (`fits`), at the drive of `rows`.
+fn separating_campaigns(
+    rows: &[ObservedRow],
+    fits: &BTreeMap<String, crate::calibrate::Calibration>,
+    verdict: &str,
+    confounded: &[String],
+) -> Vec<separation::Separation> {
+    let (Some(lead), Some((voltage_v, frequency_hz))) = (fits.get(verdict), separation::drive_of(rows)) else {
+        return Vec::new();
+    };
+    confounded
+        .par_iter()
+        .filter_map(|e| {
+            let other = fits.get(e)?;
+            Some(separation::separation((verdict, e), &lead.motor, &other.motor, rows, voltage_v, frequency_hz))
+        })
+        .collect()
+}
+
+/// The note that says what would separate two confounded effects, where a campaign does.
+fn separation_note(s: &separation::Separation) -> Option<String> {
+    let (campaign, chi2) = s.best()?;
+    Some(format!(
+        "{} and {} are not told apart by these data (their fits differ by χ² {} over the data's readings at the nominal bench noise of docs/SYNTH.md); a {campaign} campaign at the data's drive would separate them by χ² {} (`trum synth --campaign {campaign}` shows its operating points)",
+        s.effects.0,
+        s.effects.1,
+        pairs::rounded(s.chi2_on_the_data),
+        pairs::rounded(chi2),
+    ))
 }
 
 /// Every reading of `rows` with its baseline held-out prediction (`base_preds`) and the
