@@ -205,7 +205,26 @@ def main():
              ylim=(0, 42))
     png_plot(os.path.join(OUT, "papers_trum60a_contact_angle.png"), "TRUM60A 200 V 43 kHz (paper 1 = Chen 2020 Fig. 7)", "preload_n", "contact_angle_deg",
              list(zip(xs, num(pts, "contact_angle_deg"))), [(float(r["preload_n"]), float(r["value"])) for r in ang])
+    running = [r for r in pts if r["status"] == "ok"]
+    rx = num(running, "preload_n")
+    svg_plot(os.path.join(OUT, "papers_trum60a_driving_share.svg"),
+             "TRUM60A at 200 V, 43 kHz: driving share at no load",
+             "preload [N]", "driving zone / contact zone [-]",
+             [("trum", rx, num(running, "driving_ratio"), trum_c), ("Chen 2020: falls", [], [], paper_c)], ylim=(0.25, 0.35))
+    loss = [d + f for d, f in zip(num(running, "damping_loss_w"), num(running, "friction_loss_w"))]
+    svg_plot(os.path.join(OUT, "papers_trum60a_losses.svg"),
+             "TRUM60A at 200 V, 43 kHz, no load: losses against preload",
+             "preload [N]", "loss [W]",
+             [("trum: damping + friction", rx, loss, trum_c),
+              ("trum: dielectric", rx, num(running, "dielectric_loss_w"), "#27ae60")],
+             vlines=[("Chen 2020: to 460 N", float(get(chen, "loss_rise_limit_n")[0]["value"]), paper_c)])
     fl = table(trum("optimize", "--motor", "trum60a", "--preload-n", "150:500:36", "--frequency-hz", "43000", "-q", "-o", "-"))
+    svg_plot(os.path.join(OUT, "papers_trum60a_temperature.svg"),
+             "TRUM60A at 200 V, 43 kHz: temperature rise after a 10 s run",
+             "preload [N]", "temperature rise [K]",
+             [("trum", num(fl, "preload_n"), num(fl, "temperature_rise_after_run_k"), trum_c)],
+             vlines=[("Chen 2020: smallest", float(get(chen, "temperature_rise_min_n")[0]["value"]), paper_c),
+                     ("Chen 2020: largest", float(get(chen, "temperature_rise_max_n")[0]["value"]), "#8e44ad")])
     svg_plot(os.path.join(OUT, "papers_trum60a_fluctuation.svg"),
              "TRUM60A at 200 V, 43 kHz: speed fluctuation from a 5 µm runout",
              "preload [N]", "speed standard deviation [rpm]",
@@ -229,6 +248,16 @@ def main():
              list(zip(qx, num(q, "speed_rpm"))), [(float(r["preload_n"]), float(r["speed_rpm"])) for r in t2])
     png_plot(os.path.join(OUT, "papers_qut_feedback.png"), "TRUM-60 150 V 42 kHz (paper 1 = Sun 2021 Table 2)", "preload_n", "feedback_v",
              list(zip(qx, num(q, "feedback_v"))), [(float(r["preload_n"]), float(r["feedback_v"])) for r in t2])
+    # the paper's slope drawn from the contact its wording implies at 50 N (a quarter
+    # wavelength, 5.24 mm, reached at 400 N: tests/papers.rs, sun2021_contact_length_slope)
+    slope = float(get(sun, "contact_length_slope_mm_per_n")[0]["value"])
+    quarter = 2 * 3.141592653589793 * 30.0 / 9 / 4
+    svg_plot(os.path.join(OUT, "papers_qut_contact_length.svg"),
+             "TRUM-60 at 150 V, 42 kHz, no load: contact length",
+             "preload [N]", "contact length [mm]",
+             [("trum", qx, [1e3 * c for c in num(q, "contact_length_m")], trum_c),
+              ("Sun 2021: 1.8e-3 mm/N", [50.0, 400.0], [quarter - 350 * slope, quarter], paper_c),
+              ("quarter wave", [20.0, 420.0], [quarter, quarter], "#7f8c8d")])
     cur = get(sun, "current_a")
     amp = get(sun, "amplitude_peak_um")[0]
     svg_plot(os.path.join(OUT, "papers_qut_current_amplitude.svg"),
