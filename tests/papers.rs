@@ -109,6 +109,19 @@ fn trum60a_criterion() -> CriterionResult {
     evaluate(&m, &cfg, &mut |_, _| {}).expect("criterion")
 }
 
+/// The criterion at 200 V, 43 kHz (Chen et al. 2020's drive of Fig. 5-7) at `n` preloads
+/// from 150 to 450 N, 8 load torques a preload.
+fn trum60a_criterion_43khz(n: usize) -> CriterionResult {
+    let cfg = CriterionConfig {
+        preload_n: Axis::linspace(150.0, 450.0, n),
+        voltage_v: 200.0,
+        frequency_hz: 43e3,
+        torque_samples: 8,
+        ..CriterionConfig::seed000()
+    };
+    evaluate(&trum60a(), &cfg, &mut |_, _| {}).expect("criterion")
+}
+
 /// Chen et al. 2020 section 4.3 (Fig. 7, 200 V, 43 kHz): contact angle 24.15° at 150 N and
 /// 28.94° at 200 N.
 #[test]
@@ -245,15 +258,7 @@ fn chen2020_optimum_region() {
 /// the preload rises (up to 475 N).
 #[test]
 fn chen2020_speed_fluctuation_falls() {
-    let m = trum60a();
-    let cfg = CriterionConfig {
-        preload_n: Axis::linspace(150.0, 450.0, 7),
-        voltage_v: 200.0,
-        frequency_hz: 43e3,
-        torque_samples: 8,
-        ..CriterionConfig::seed000()
-    };
-    let r = evaluate(&m, &cfg, &mut |_, _| {}).expect("criterion");
+    let r = trum60a_criterion_43khz(7);
     let sd: Vec<f64> = r.rows.iter().map(|r| r.speed_std_rpm).collect();
     record(
         "Chen 2020 § 4.3: speed fluctuation 150 → 450 N",
@@ -583,14 +588,7 @@ fn chen2020_losses_grow_with_preload_to_460_n() {
 #[test]
 fn chen2020_temperature_rise_after_a_run() {
     let (hi, lo) = (paper(CHEN, "temperature_rise_max_n", None), paper(CHEN, "temperature_rise_min_n", None));
-    let cfg = CriterionConfig {
-        preload_n: Axis::linspace(150.0, 450.0, 13),
-        voltage_v: 200.0,
-        frequency_hz: 43e3,
-        torque_samples: 8,
-        ..CriterionConfig::seed000()
-    };
-    let r = evaluate(&trum60a(), &cfg, &mut |_, _| {}).expect("criterion");
+    let r = trum60a_criterion_43khz(13);
     let xs: Vec<f64> = r.rows.iter().map(|r| r.preload_n).collect();
     let dt: Vec<f64> = r.rows.iter().map(|r| r.temperature_rise_after_run_k).collect();
     record(
