@@ -102,6 +102,35 @@ pub fn sin_cos_step((s, c): (f64, f64), d: f64) -> (f64, f64) {
     (s + d * c - d2 * s - d3 * c, c - d * s - d2 * c + d3 * s)
 }
 
+/// True where [`sin_cos_rotated`] carries the sine and cosine of an angle in (0, π) with
+/// sine `sin_x` over the step `step` [rad]: sin x ≥ 1/4 and |δ| ≤ 0.1·sin x. Each
+/// rotation rounds the sine by about one unit in its last place, as a fresh `sin_cos`
+/// does, but the roundings of a chain of rotations add up, and the functions solved here
+/// amplify them where the angle is small (g(φ) = sin φ − φ·cos φ is a difference of
+/// nearly equal terms for a narrow contact: a root error of 1e-16/φ per rounding, 1e-14
+/// at φ = 0.01). From a quarter up a few roundings stay below 1e-14 of the angle; the
+/// bound on the step relative to the sine keeps the rotation's own error (about 1e-16·|δ|
+/// absolute) below the sine's rounding where g' = φ·sin φ vanishes towards full contact.
+#[inline]
+pub fn rotation_carries(sin_x: f64, step: f64) -> bool {
+    sin_x >= 0.25 && step.abs() <= 0.1 * sin_x
+}
+
+/// sin and cos of x + δ from those of x by the rotation through δ, with sin δ and
+/// cos δ − 1 from their Taylor series to δ⁹ and δ¹⁰ (truncation below δ¹¹/11! = 2.5e-19
+/// at |δ| ≤ 0.1; each rotation adds a rounding of a few units in the
+/// last place). About 20 flops where `sin_cos` costs about 80 instructions: the angle
+/// solves move their iterates by such steps.
+#[inline]
+pub fn sin_cos_rotated((s, c): (f64, f64), d: f64) -> (f64, f64) {
+    let d2 = d * d;
+    let sin_minus_d = -d * d2 * (1.0 / 6.0 - d2 * (1.0 / 120.0 - d2 * (1.0 / 5040.0 - d2 * (1.0 / 362_880.0))));
+    let cos_minus_1 =
+        -d2 * (0.5 - d2 * (1.0 / 24.0 - d2 * (1.0 / 720.0 - d2 * (1.0 / 40_320.0 - d2 * (1.0 / 3_628_800.0)))));
+    let sd = d + sin_minus_d;
+    (s + (c * sd + s * cos_minus_1), c + (c * cos_minus_1 - s * sd))
+}
+
 /// [`contact_from_ratio`] started from `guess` (a nearby φ0, e.g. of the previous
 /// amplitude iterate; the root is unique, so the start only changes the cost). Also
 /// returns (sin φ0, cos φ0), which the solver would otherwise recompute.
@@ -118,25 +147,31 @@ pub fn contact_from_ratio_near(y: f64, guess: Option<AngleStart>) -> (Contact, f
     } else {
         (PI - (2.0 * (PI - y) / PI).sqrt(), None)
     });
-    // g' = φ·sin φ, g'' = sin φ + φ·cos φ.
-    let (phi, s, c) = newton_sin_cos(|p, s, c| (s - p * c - y, p * s, s + p * c), (0.0, -y), (PI, PI - y), start);
+    // g' = φ·sin φ, g'' = sin φ + φ·cos φ, g''' = 2·cos φ − φ·sin φ.
+    let (phi, s, c) =
+        newton_sin_cos(|p, s, c| [s - p * c - y, p * s, s + p * c, 2.0 * c - p * s], (0.0, -y), (PI, PI - y), start);
     (Contact { half_angle_rad: phi, offset: c, full: false }, s, c)
 }
 
 /// Root of an increasing f on the bracket [lo, hi] (f(lo) ≤ 0 ≤ f(hi), values given) by
-/// safeguarded Newton. `f(x, sin x, cos x)` returns (f, f', f''): every function solved
-/// here is made of sin and cos of the unknown, so one `sin_cos` per iteration serves the
-/// value, the derivatives and the caller, who gets (x, sin x, cos x) back; a start with
-/// its sine and cosine saves the first.
+/// safeguarded Halley iteration. `f(x, sin x, cos x)` returns [f, f′, f″, f‴]: every
+/// function solved here is made of sin and cos of the unknown, so one sine and cosine per
+/// iteration serves the value, the derivatives and the caller, who gets (x, sin x, cos x)
+/// back; a start with its sine and cosine saves the first.
 ///
-/// A step that would leave the bracket is replaced by regula falsi on the bracket
-/// (bisection if that stalls): near a root at the bracket's edge, Newton from the far side
-/// overshoots, and plain bisection then needed ~30 iterations. Newton's error after a
-/// step δ is about |f''/(2f')|·δ²; once that is below 1e-16 relative the step is taken
-/// without another evaluation, and sin/cos are carried over it by their Taylor series
-/// (`sin_cos_step`, error δ⁴/24 < 1e-27).
+/// Halley's step is Newton's δ = f/f′ divided by 1 − δ·f″/(2f′), taken where that
+/// correction is at most a half (Newton's step otherwise): its error is about
+/// (c₂² − c₃)·δ³ with cₖ = f⁽ᵏ⁾/(k!·f′), against Newton's c₂·δ², so a start within 1e-2
+/// of the root needs two evaluations, not three. A step that would leave the bracket is
+/// replaced by regula falsi on the bracket (bisection if that stalls): near a root at the
+/// bracket's edge, a step from the far side overshoots, and plain bisection then needed
+/// ~30 iterations. Once the predicted error after a step is below 1e-16 relative the step
+/// is taken without another evaluation, and sin/cos are carried over it by their Taylor
+/// series (`sin_cos_step`, error δ⁴/24 < 1e-21). Between evaluations sin and cos are
+/// rotated through the step where [`rotation_carries`] allows it ([`sin_cos_rotated`])
+/// and recomputed after longer ones.
 fn newton_sin_cos(
-    f: impl Fn(f64, f64, f64) -> (f64, f64, f64),
+    f: impl Fn(f64, f64, f64) -> [f64; 4],
     (mut lo, mut flo): (f64, f64),
     (mut hi, mut fhi): (f64, f64),
     (start, start_sin_cos): AngleStart,
@@ -146,17 +181,23 @@ fn newton_sin_cos(
     let (mut s, mut c) = start_sin_cos.filter(|_| inside).unwrap_or_else(|| x.sin_cos());
     let mut stalled = 0;
     for _ in 0..100 {
-        let (v, d, dd) = f(x, s, c);
+        let [v, d, dd, ddd] = f(x, s, c);
         if v > 0.0 {
             (hi, fhi) = (x, v);
         } else {
             (lo, flo) = (x, v);
         }
-        let step = v / d;
+        let newton = v / d;
+        let (c2, c3) = (0.5 * dd / d, ddd / (6.0 * d));
+        let halley = (newton * c2).abs() <= 0.5;
+        let step = if halley { newton / (1.0 - newton * c2) } else { newton };
         let next = x - step;
+        let from = x;
         if d > 0.0 && next > lo && next < hi {
-            // (The step bound keeps the cubic term negligible where f'' happens to vanish.)
-            if step.abs() <= 1e-7 * x.abs() && step * step * dd.abs() <= 2e-16 * d * x.abs() {
+            // Predicted error after the step; the step bound keeps the next term of the
+            // series negligible where the leading one happens to vanish.
+            let error = if halley { (c2 * c2 + c3.abs()) * step.abs().powi(3) } else { c2.abs() * step * step };
+            if step.abs() <= if halley { 1e-5 } else { 1e-7 } * x.abs() && error <= 1e-16 * x.abs() {
                 // Converged: carry sin and cos over the last (tiny) step.
                 let (s1, c1) = sin_cos_step((s, c), -step);
                 return (next, s1, c1);
@@ -164,7 +205,7 @@ fn newton_sin_cos(
             x = next;
             stalled = 0;
         } else if d > 0.0 && next == x {
-            // The Newton step is below the rounding of x (v = 0 included): x is the root.
+            // The step is below the rounding of x (v = 0 included): x is the root.
             // It is also an end of the bracket now, so the regula falsi below would take
             // the far end and bisect from there (5-10 % of the warm-started solves in a
             // diagnosis would spend 28-50 evaluations here).
@@ -179,7 +220,7 @@ fn newton_sin_cos(
             }
         }
         // (sin and cos before the bracket test, so that they belong to the x returned)
-        (s, c) = x.sin_cos();
+        (s, c) = if rotation_carries(s, x - from) { sin_cos_rotated((s, c), x - from) } else { x.sin_cos() };
         if hi - lo <= 1e-15 * hi.abs().max(1e-300) {
             break;
         }
@@ -262,13 +303,14 @@ pub fn stick_half_angle_sin_cos(
         let val = torque_scale_nm * (2.0 * (s - t * c) - chi0) - load_torque_nm - viscous_nm_per_cos * co;
         let der = torque_scale_nm * 2.0 * (co - c) + viscous_nm_per_cos * s;
         let der2 = -torque_scale_nm * 2.0 * s + viscous_nm_per_cos * co;
-        (val, der, der2)
+        let der3 = -torque_scale_nm * 2.0 * co - viscous_nm_per_cos * s;
+        [val, der, der2, der3]
     };
-    let (fmax, _, _) = f(tmax, smax, cmax);
+    let fmax = f(tmax, smax, cmax)[0];
     if fmax < 0.0 {
         return None;
     }
-    let (f0, _, _) = f(0.0, 0.0, 1.0);
+    let f0 = f(0.0, 0.0, 1.0)[0];
     // Starting point: warm start, else the middle of the range.
     let start = guess.filter(|g| g.0 > 0.0 && g.0 < tmax).unwrap_or((0.5 * tmax, None));
     Some(newton_sin_cos(f, (0.0, f0), (tmax, fmax), start))
@@ -397,9 +439,9 @@ mod tests {
         let f = |t: f64, s: f64, co: f64| {
             n.set(n.get() + 1);
             let val = tscale * (2.0 * (s - t * c) - chi0) - visc * co;
-            (val, tscale * 2.0 * (co - c) + visc * s, -tscale * 2.0 * s + visc * co)
+            [val, tscale * 2.0 * (co - c) + visc * s, -tscale * 2.0 * s + visc * co, -tscale * 2.0 * co - visc * s]
         };
-        let (lo, hi) = ((0.0, f(0.0, 0.0, 1.0).0), (0.5 * PI, f(0.5 * PI, 1.0, 0.0).0));
+        let (lo, hi) = ((0.0, f(0.0, 0.0, 1.0)[0]), (0.5 * PI, f(0.5 * PI, 1.0, 0.0)[0]));
         for start in [0.8762107029595234, 0.8762107257814344, 0.5, 1.2] {
             n.set(0);
             let (t, s, co) = newton_sin_cos(f, lo, hi, (start, None));

@@ -1104,7 +1104,7 @@ fn radii(law: &Law) -> impl Iterator<Item = (f64, f64)> + '_ {
 
 /// An angle of a trial with its sine and cosine and its derivative in the amplitude: the
 /// next trial's angle solve starts at the angle moved along that derivative, its sine and
-/// cosine carried by [`contact::sin_cos_step`].
+/// cosine carried by [`contact::sin_cos_rotated`].
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct AngleCarry {
     /// The angle [rad].
@@ -1116,13 +1116,12 @@ pub(crate) struct AngleCarry {
 }
 
 impl AngleCarry {
-    /// Largest angle step [rad] the sine and cosine are carried over (error < 5e-18).
-    const MAX_STEP: f64 = 1e-4;
-
-    /// The start of the same angle's solve at amplitude `w`, the carry made at `from`.
+    /// The start of the same angle's solve at amplitude `w`, the carry made at `from`, where
+    /// [`contact::rotation_carries`] allows the step.
     pub(crate) fn start_at(&self, from: f64, w: f64) -> Option<contact::AngleStart> {
         let step = self.per_w * (w - from);
-        (step.abs() <= Self::MAX_STEP).then(|| (self.rad + step, Some(contact::sin_cos_step(self.sin_cos, step))))
+        contact::rotation_carries(self.sin_cos.0, step)
+            .then(|| (self.rad + step, Some(contact::sin_cos_rotated(self.sin_cos, step))))
     }
 }
 

@@ -203,7 +203,8 @@ mod tests {
         use crate::quantities::QUANTITIES;
         use crate::solve::{solve, Status};
         let mut seen = std::collections::HashSet::new();
-        // (amplitude evaluations of the sweep and of the cold solves, ok and stall points)
+        // (amplitude evaluations of the sweep and of the cold solves, ok and stall points of
+        // the stators a sweep warm-starts)
         let (mut warm_evals, mut cold_evals) = (0u64, 0u64);
         // The presets, and trum60a with a softening stator (several amplitude branches; no
         // warm amplitude there, see solve::solve_in_sweep).
@@ -230,7 +231,7 @@ mod tests {
                     let c = solve(&m, op);
                     seen.insert(c.status);
                     assert_eq!(s.status, c.status, "{name} {op:?}");
-                    if matches!(c.status, Status::Ok | Status::Stall) {
+                    if matches!(c.status, Status::Ok | Status::Stall) && !name.ends_with("softening") {
                         warm_evals += u64::from(s.iterations);
                         cold_evals += u64::from(c.iterations);
                     }
@@ -249,9 +250,10 @@ mod tests {
         }
         assert!([Status::Ok, Status::Stall, Status::Clamped].iter().all(|s| seen.contains(s)), "{seen:?}");
         // the torque-ordered warm start is taken (solve::solve_in_sweep): fewer amplitude
-        // evaluations than cold, not the same answer by never leaving the cold path (0.604
-        // of the cold count on these coarse grids)
-        assert!(warm_evals * 100 < cold_evals * 62, "sweep {warm_evals} vs cold {cold_evals} amplitude evaluations");
+        // evaluations than cold, not the same answer by never leaving the cold path (0.514
+        // of the cold count on these coarse grids; the softening stator, which a sweep
+        // does not warm-start, left out)
+        assert!(warm_evals * 100 < cold_evals * 53, "sweep {warm_evals} vs cold {cold_evals} amplitude evaluations");
     }
 
     /// Stators (softening or stiffening) whose cold descent lands on another branch than

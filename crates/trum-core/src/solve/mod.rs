@@ -7,8 +7,9 @@
 //! equivalent damping gives a new amplitude W' = Θ·V/|Z(W)| ([`crate::stator`]). The
 //! steady state is the fixed point W = W'. Because W' is bounded by Θ·V/(ω·c) and grows
 //! with W, iterating from that bound descends monotonically onto the largest fixed point
-//! (the running branch); secant/regula-falsi steps inside the bracket make it converge
-//! in a handful of evaluations.
+//! (the running branch); Newton steps on W·|Z(W)| − Θ·V where the trial has an exact
+//! slope, secants elsewhere, and regula falsi inside a bracket make it converge in a
+//! handful of evaluations.
 //!
 //! Where the parts live:
 //! - this file: the entry points [`solve`] and [`solve_prepared`] (the public types

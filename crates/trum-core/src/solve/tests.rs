@@ -751,6 +751,21 @@ fn multi_branch_stators_report_the_largest_fixed_point() {
     assert!(all.is_empty(), "{} points:\n{}", all.len(), all.join("\n"));
 }
 
+/// The effect-free stators too, whose cold descent takes Newton steps on the trial's
+/// exact slope of r = W − G(W) from the top down (`first_step`, `unbracketed_step`):
+/// random drives from far below to far above the resonance reach points with several
+/// fixed points (W = 0, a middle and the running one) and clamped ones, and every
+/// reported amplitude is the largest fixed point of the dense scan.
+#[test]
+fn effect_free_stators_report_the_largest_fixed_point() {
+    let configs: Vec<(&str, &str, bool)> =
+        ["trum60a", "generic60", "trum60-qut"].iter().map(|&name| (name, "none", false)).collect();
+    let (wrong, checked, multi, clamped, mean) = largest_fixed_point_check(&configs, 3000, 31);
+    println!("effect-free: {} wrong of {checked}, {multi} multi, {clamped} clamped, {mean:.2} evals", wrong.len());
+    assert!(multi >= 20 && clamped >= 1, "{multi} multi-branch, {clamped} clamped of {checked}");
+    assert!(wrong.is_empty(), "{} points:\n{}", wrong.len(), wrong.join("\n"));
+}
+
 /// Every motor parameter over many decades (each alone, ×10^-6 to ×10^6 where the motor
 /// stays valid), at running, loaded and low-drive points: a point reported `clamped` is
 /// clamped for real — an amplitude of a thousandth of the static deflection Θ·V/k (no
