@@ -163,6 +163,24 @@ pub(super) fn settle(
 /// 0.075 N·m, 194 V, 41.56 kHz). Below the ratio the band is under 1e-10 of W.
 const MAX_WARM_ELASTICITY: f64 = 1e3;
 
+/// The ratio of relative amplitude change to relative electrode-voltage change between two
+/// states (W [m], V [V]) under the same temperature rise: 1/r'(W) at their fixed point
+/// ([`MAX_WARM_ELASTICITY`]). NaN where the voltages are equal or an amplitude is not finite.
+fn amplitude_elasticity((w0, v0): (f64, f64), (w1, v1): (f64, f64)) -> f64 {
+    ((w1 - w0) / w0) / ((v1 - v0) / v0)
+}
+
+/// The amplitude [m] at electrode voltage `v` [V] extrapolated from the state at `v_prev`
+/// (amplitude `w_prev` [m]) along the `elasticity` measured between the two states before
+/// it: a first trial for the warm descent, kept only strictly between zero and `w_prev`
+/// (the proven bound where the voltage falls). Late passes move V by 1e-5 to 1e-9 of
+/// itself, where the extrapolation is within the descent's tolerance or one Newton step of
+/// it: one trial a pass fewer than a descent from the bound.
+fn predicted_amplitude(w_prev: f64, elasticity: f64, (v_prev, v): (f64, f64)) -> Option<f64> {
+    let w = w_prev * (1.0 + elasticity * (v - v_prev) / v_prev);
+    (w > 0.0 && w < w_prev).then_some(w)
+}
+
 /// A pass's state solve `state(d, rise, guess, top)` ([`settle_with`]).
 type WarmState<'a> = dyn Fn(&Drive, f64, Option<&Solution>, Option<WarmTop>) -> Solution + 'a;
 
@@ -175,10 +193,16 @@ type WarmState<'a> = dyn Fn(&Drive, f64, Option<&Solution>, Option<WarmTop>) -> 
 /// alone (the temperature rise fixed) at V₂ ≤ V₁ has G₂ = (V₂/V₁)·G₁ ≤ G₁ at every W, and
 /// the previous pass's amplitude W₁, the largest fixed point of G₁ (G₁(W) < W above it),
 /// bounds the largest fixed point of G₂ from above. Late passes move V by a hair, so the
-/// descent from W₁ needs 1-3 trials instead of a descent from the cold bound (about six).
-/// Where V rises, the previous state is not a solved amplitude (clamped, unconverged), or
-/// the amplitude is ill-conditioned ([`MAX_WARM_ELASTICITY`]; the first pass, without two
-/// states to tell), the pass descends from the cold bound.
+/// descent from W₁, first trying the amplitude extrapolated along the passes' elasticity
+/// ([`predicted_amplitude`]), needs 1-3 trials instead of a descent from the cold bound
+/// (about five). Where V rises, the previous state is not a solved amplitude (clamped,
+/// unconverged), or the amplitude is ill-conditioned ([`MAX_WARM_ELASTICITY`]), the pass
+/// descends from the cold bound; the first pass after the set voltage's, without two
+/// states to tell the conditioning before it, is judged after its warm descent and solved
+/// again from the cold bound where it is ill-conditioned.
+///
+/// The passes end at the first state that is its own fixed point to the tolerances (1e-10
+/// of the temperature rise, 1e-12 of the set voltage), which is returned.
 fn settle_with(
     p: &Prepared,
     op: &OperatingPoint,
@@ -211,7 +235,13 @@ fn settle_with(
         if sag {
             new_v = sagged_voltage_v(p, op, &s);
         }
-        let done = (new_rise - rise).abs() <= 1e-10 * (1.0 + rise.abs()) && (new_v - d.v).abs() <= 1e-12 * op.voltage_v;
+        if (new_rise - rise).abs() <= 1e-10 * (1.0 + rise.abs()) && (new_v - d.v).abs() <= 1e-12 * op.voltage_v {
+            // `s` is its own fixed point to the tolerances: the state it was solved at is
+            // the answer (another solve at the pass's next iterate would move it by less
+            // than the tolerance, at the cost of an amplitude solve)
+            settled = true;
+            break;
+        }
         let mut next = (
             bracketed_secant(rise, new_rise, last_pass.map(|l| l.0)),
             bracketed_secant(d.v, new_v, last_pass.map(|l| l.1)),
@@ -220,7 +250,7 @@ fn settle_with(
             next.1 = monotone_secant(d.v, new_v, last_pass.map(|l| l.1)).unwrap_or(next.1);
         }
         last_pass = Some(((rise, new_rise), (d.v, new_v)));
-        if thermal != sag && !done {
+        if thermal != sag {
             let (x, gx) = if thermal { (rise, new_rise) } else { (d.v, new_v) };
             bracket.record(x, x - gx, pass >= BRACKET_AFTER);
             if pass >= BRACKET_AFTER {
@@ -259,24 +289,36 @@ fn settle_with(
         // (W, V) of the state before `prev`: their ratio of relative changes is
         // 1/r'(W) at the fixed point (W = V·Θ/|Z(W)|), how far the descent's tolerance
         // on r leaves W uncertain
-        let well_conditioned = older.is_some_and(|(w0, v0): (f64, f64)| {
-            let elasticity = ((prev.amplitude_m - w0) / w0) / ((v_prev - v0) / v0);
-            elasticity.abs() <= MAX_WARM_ELASTICITY
-        });
+        let elasticity = older.map(|(w0, v0): (f64, f64)| amplitude_elasticity((w0, v0), (prev.amplitude_m, v_prev)));
+        let well_conditioned = elasticity.is_some_and(|e| e.abs() <= MAX_WARM_ELASTICITY);
+        // Without two states yet (the first pass after the set voltage's), the pass is
+        // tried from the previous amplitude all the same and its conditioning judged
+        // afterwards, from the two states it then has: the same ratio, measured one pass
+        // later.
+        let judged_after = older.is_none();
         let warm = sag
             && !thermal
-            && well_conditioned
+            && (well_conditioned || judged_after)
             && d.v <= v_prev
             && matches!(prev.status, Status::Ok | Status::Stall)
             && prev.amplitude_m > 0.0
             && prev.amplitude_m.is_finite();
-        let top =
-            warm.then_some(WarmTop { bound: prev.amplitude_m, predicted: None, contact_rad: None, stick_rad: None });
+        let top = warm.then(|| WarmTop {
+            bound: prev.amplitude_m,
+            predicted: elasticity.and_then(|e| predicted_amplitude(prev.amplitude_m, e, (v_prev, d.v))),
+            contact_rad: None,
+            stick_rad: None,
+        });
         older = Some((prev.amplitude_m, v_prev));
-        s = state(&d, rise, Some(&prev).filter(|g| g.status.is_valid()), top);
-        if done && !work.exhausted() {
-            settled = true;
-            break;
+        let guess = Some(&prev).filter(|g| g.status.is_valid());
+        s = state(&d, rise, guess, top);
+        if warm && judged_after {
+            // (false for a NaN too)
+            let conditioned =
+                amplitude_elasticity((prev.amplitude_m, v_prev), (s.amplitude_m, d.v)).abs() <= MAX_WARM_ELASTICITY;
+            if !conditioned {
+                s = state(&d, rise, guess, None);
+            }
         }
         if !s.status.is_valid() || work.exhausted() {
             break;
