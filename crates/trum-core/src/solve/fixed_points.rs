@@ -172,13 +172,44 @@ fn amplitude_elasticity((w0, v0): (f64, f64), (w1, v1): (f64, f64)) -> f64 {
 
 /// The amplitude [m] at electrode voltage `v` [V] extrapolated from the state at `v_prev`
 /// (amplitude `w_prev` [m]) along the `elasticity` measured between the two states before
-/// it: a first trial for the warm descent, kept only strictly between zero and `w_prev`
-/// (the proven bound where the voltage falls). Late passes move V by 1e-5 to 1e-9 of
+/// it: a first trial for the warm descent, kept only strictly between zero and `bound`
+/// [m], the proven upper bound it starts from. Late passes move V by 1e-5 to 1e-9 of
 /// itself, where the extrapolation is within the descent's tolerance or one Newton step of
 /// it: one trial a pass fewer than a descent from the bound.
-fn predicted_amplitude(w_prev: f64, elasticity: f64, (v_prev, v): (f64, f64)) -> Option<f64> {
+fn predicted_amplitude(w_prev: f64, elasticity: f64, (v_prev, v): (f64, f64), bound: f64) -> Option<f64> {
     let w = w_prev * (1.0 + elasticity * (v - v_prev) / v_prev);
-    (w > 0.0 && w < w_prev).then_some(w)
+    (w > 0.0 && w < bound).then_some(w)
+}
+
+/// States the electrode voltage's passes solved (at one temperature rise) kept as upper
+/// bounds of the largest fixed point at other voltages: the amplitude W₁ solved at V₁
+/// bounds the largest fixed point at any V ≤ V₁ ([`settle_with`]). A pass whose voltage
+/// rises over the previous one's (the passes alternate about the fixed point) is bounded
+/// by an earlier state at a voltage above it. The latest [`AmplitudeBounds::KEPT`] states.
+#[derive(Default)]
+struct AmplitudeBounds {
+    /// (V [V], W [m]) of the states, the latest at `next - 1` (modulo the length).
+    kept: [Option<(f64, f64)>; AmplitudeBounds::KEPT],
+    next: usize,
+}
+
+impl AmplitudeBounds {
+    const KEPT: usize = 4;
+
+    /// Keeps state `s` solved at electrode voltage `v` [V] where its amplitude is a
+    /// solved one (running or stalled, positive and finite).
+    fn record(&mut self, v: f64, s: &Solution) {
+        if matches!(s.status, Status::Ok | Status::Stall) && s.amplitude_m > 0.0 && s.amplitude_m.is_finite() {
+            self.kept[self.next % Self::KEPT] = Some((v, s.amplitude_m));
+            self.next += 1;
+        }
+    }
+
+    /// The least kept amplitude [m] solved at a voltage at or above `v` [V]: a proven upper
+    /// bound of the largest fixed point at `v`; `None` where every kept state is below it.
+    fn at(&self, v: f64) -> Option<f64> {
+        self.kept.iter().flatten().filter(|&&(vk, _)| vk >= v).map(|&(_, w)| w).reduce(f64::min)
+    }
 }
 
 /// A pass's state solve `state(d, rise, guess, top)` ([`settle_with`]).
@@ -195,9 +226,11 @@ type WarmState<'a> = dyn Fn(&Drive, f64, Option<&Solution>, Option<WarmTop>) -> 
 /// bounds the largest fixed point of G₂ from above. Late passes move V by a hair, so the
 /// descent from W₁, first trying the amplitude extrapolated along the passes' elasticity
 /// ([`predicted_amplitude`]), needs 1-3 trials instead of a descent from the cold bound
-/// (about five). Where V rises, the previous state is not a solved amplitude (clamped,
-/// unconverged), or the amplitude is ill-conditioned ([`MAX_WARM_ELASTICITY`]), the pass
-/// descends from the cold bound; the first pass after the set voltage's, without two
+/// (about five). Where V rises over the previous pass's, the least amplitude of the
+/// latest states solved at a voltage at or above it bounds it instead
+/// ([`AmplitudeBounds`]). Where no such state is a solved amplitude (clamped, unconverged)
+/// or the amplitude is ill-conditioned ([`MAX_WARM_ELASTICITY`]), the pass descends from
+/// the cold bound; the first pass after the set voltage's, without two
 /// states to tell the conditioning before it, is judged after its warm descent and solved
 /// again from the cold bound where it is ill-conditioned.
 ///
@@ -219,6 +252,7 @@ fn settle_with(
     }
     let mut s = state(&d, rise, guess, None);
     let mut older: Option<(f64, f64)> = None;
+    let mut bounds = AmplitudeBounds::default();
     let mut settled = false;
     // (x, G(x)) of the previous pass, for the temperature rise and the electrode voltage
     let mut last_pass: Option<((f64, f64), (f64, f64))> = None;
@@ -296,16 +330,12 @@ fn settle_with(
         // afterwards, from the two states it then has: the same ratio, measured one pass
         // later.
         let judged_after = older.is_none();
-        let warm = sag
-            && !thermal
-            && (well_conditioned || judged_after)
-            && d.v <= v_prev
-            && matches!(prev.status, Status::Ok | Status::Stall)
-            && prev.amplitude_m > 0.0
-            && prev.amplitude_m.is_finite();
-        let top = warm.then(|| WarmTop {
-            bound: prev.amplitude_m,
-            predicted: elasticity.and_then(|e| predicted_amplitude(prev.amplitude_m, e, (v_prev, d.v))),
+        bounds.record(v_prev, &prev);
+        let bound = (sag && !thermal && (well_conditioned || judged_after)).then(|| bounds.at(d.v)).flatten();
+        let warm = bound.is_some();
+        let top = bound.map(|bound| WarmTop {
+            bound,
+            predicted: elasticity.and_then(|e| predicted_amplitude(prev.amplitude_m, e, (v_prev, d.v), bound)),
             contact_rad: None,
             stick_rad: None,
         });
