@@ -56,8 +56,9 @@ fn solve_effects_with(
         return drive(&Drive::at(p, op), guess, None);
     }
     let direct_warm = |d: &Drive, _: f64, g: Option<&Solution>, top: Option<WarmTop>| drive(d, g, top);
-    let direct_cold = |d: &Drive, _: f64, g: Option<&Solution>, _: Option<WarmTop>| drive(d, g, None);
-    let (mut s, mut rise, mut settled) = settle_with(p, op, guess, (thermal, sag), 0.0, work, &direct_warm);
+    let direct_cold = |d: &Drive, _: f64, g: Option<&Solution>| drive(d, g, None);
+    let (mut s, mut rise, mut settled) =
+        settle_with(p, op, guess, (thermal, sag), 0.0, work, PassState::Warm(&direct_warm));
     if branches && sag && !thermal && !settled {
         if let Some(stalled) =
             settle_lower_branch(p, op, &s, 0.0, work).or_else(|| settle_on_amplitude(p, op, 0.0, work))
@@ -97,7 +98,7 @@ fn solve_effects_with(
             // end 1.2e-9 off its own set voltage, beyond the 1e-9 a fixed point keeps;
             // tests/solver_convergence.rs `stress_self_consistent_effects`)
             let inner = |_: &Drive, r: f64, g: Option<&Solution>| {
-                let (mut s, _, mut ok) = settle_with(p, op, g, (false, true), r, work, &direct_cold);
+                let (mut s, _, mut ok) = settle(p, op, g, (false, true), r, work, &direct_cold);
                 if lower && !ok {
                     if let Some(l) =
                         settle_lower_branch(p, op, &s, r, work).or_else(|| settle_on_amplitude(p, op, r, work))
@@ -152,7 +153,7 @@ pub(super) fn settle(
     work: &Work,
     state: &dyn Fn(&Drive, f64, Option<&Solution>) -> Solution,
 ) -> (Solution, f64, bool) {
-    settle_with(p, op, guess, flags, rise0, work, &|d, r, g, _| state(d, r, g))
+    settle_with(p, op, guess, flags, rise0, work, PassState::Cold(state))
 }
 
 /// Largest ratio of relative amplitude change to relative electrode-voltage change between
@@ -215,7 +216,25 @@ impl AmplitudeBounds {
 /// A pass's state solve `state(d, rise, guess, top)` ([`settle_with`]).
 type WarmState<'a> = dyn Fn(&Drive, f64, Option<&Solution>, Option<WarmTop>) -> Solution + 'a;
 
-/// [`settle`] whose state solve (`state(d, rise, guess, top)`) may start its amplitude
+/// The state solve of [`settle_with`]'s passes: one that may start its amplitude descent
+/// from a warm top, or one that always starts cold (`state(d, rise, guess)`; the passes
+/// then neither look for a top nor judge one).
+#[derive(Clone, Copy)]
+enum PassState<'a> {
+    Warm(&'a WarmState<'a>),
+    Cold(&'a dyn Fn(&Drive, f64, Option<&Solution>) -> Solution),
+}
+
+impl PassState<'_> {
+    fn solve(&self, d: &Drive, rise: f64, guess: Option<&Solution>, top: Option<WarmTop>) -> Solution {
+        match self {
+            PassState::Warm(f) => f(d, rise, guess, top),
+            PassState::Cold(f) => f(d, rise, guess),
+        }
+    }
+}
+
+/// [`settle`] whose state solve (`state`, [`PassState::Warm`]) may start its amplitude
 /// descent from `top`, a proven upper bound of the largest fixed point under `d`, instead
 /// of the cold bound Θ·V/(ω·c).
 ///
@@ -243,14 +262,14 @@ fn settle_with(
     (thermal, sag): (bool, bool),
     rise0: f64,
     work: &Work,
-    state: &WarmState,
+    state: PassState,
 ) -> (Solution, f64, bool) {
     let mut d = Drive::at(p, op);
     let mut rise = rise0;
     if rise != 0.0 {
         d.warm(p, rise);
     }
-    let mut s = state(&d, rise, guess, None);
+    let mut s = state.solve(&d, rise, guess, None);
     let mut older: Option<(f64, f64)> = None;
     let mut bounds = AmplitudeBounds::default();
     let mut settled = false;
@@ -330,8 +349,11 @@ fn settle_with(
         // afterwards, from the two states it then has: the same ratio, measured one pass
         // later.
         let judged_after = older.is_none();
-        bounds.record(v_prev, &prev);
-        let bound = (sag && !thermal && (well_conditioned || judged_after)).then(|| bounds.at(d.v)).flatten();
+        let warm_tops = matches!(state, PassState::Warm(_)) && sag && !thermal;
+        if warm_tops {
+            bounds.record(v_prev, &prev);
+        }
+        let bound = (warm_tops && (well_conditioned || judged_after)).then(|| bounds.at(d.v)).flatten();
         let warm = bound.is_some();
         let top = bound.map(|bound| WarmTop {
             bound,
@@ -341,13 +363,13 @@ fn settle_with(
         });
         older = Some((prev.amplitude_m, v_prev));
         let guess = Some(&prev).filter(|g| g.status.is_valid());
-        s = state(&d, rise, guess, top);
+        s = state.solve(&d, rise, guess, top);
         if warm && judged_after {
             // (false for a NaN too)
             let conditioned =
                 amplitude_elasticity((prev.amplitude_m, v_prev), (s.amplitude_m, d.v)).abs() <= MAX_WARM_ELASTICITY;
             if !conditioned {
-                s = state(&d, rise, guess, None);
+                s = state.solve(&d, rise, guess, None);
             }
         }
         if !s.status.is_valid() || work.exhausted() {
