@@ -56,8 +56,9 @@ fn solve_effects_with(
         return drive(&Drive::at(p, op), guess, None);
     }
     let direct_warm = |d: &Drive, _: f64, g: Option<&Solution>, top: Option<WarmTop>| drive(d, g, top);
-    let direct_cold = |d: &Drive, _: f64, g: Option<&Solution>, _: Option<WarmTop>| drive(d, g, None);
-    let (mut s, mut rise, mut settled) = settle_with(p, op, guess, (thermal, sag), 0.0, work, &direct_warm);
+    let direct_cold = |d: &Drive, _: f64, g: Option<&Solution>| drive(d, g, None);
+    let (mut s, mut rise, mut settled) =
+        settle_with(p, op, guess, (thermal, sag), 0.0, work, PassState::Warm(&direct_warm));
     if branches && sag && !thermal && !settled {
         if let Some(stalled) =
             settle_lower_branch(p, op, &s, 0.0, work).or_else(|| settle_on_amplitude(p, op, 0.0, work))
@@ -97,7 +98,7 @@ fn solve_effects_with(
             // end 1.2e-9 off its own set voltage, beyond the 1e-9 a fixed point keeps;
             // tests/solver_convergence.rs `stress_self_consistent_effects`)
             let inner = |_: &Drive, r: f64, g: Option<&Solution>| {
-                let (mut s, _, mut ok) = settle_with(p, op, g, (false, true), r, work, &direct_cold);
+                let (mut s, _, mut ok) = settle(p, op, g, (false, true), r, work, &direct_cold);
                 if lower && !ok {
                     if let Some(l) =
                         settle_lower_branch(p, op, &s, r, work).or_else(|| settle_on_amplitude(p, op, r, work))
@@ -152,7 +153,7 @@ pub(super) fn settle(
     work: &Work,
     state: &dyn Fn(&Drive, f64, Option<&Solution>) -> Solution,
 ) -> (Solution, f64, bool) {
-    settle_with(p, op, guess, flags, rise0, work, &|d, r, g, _| state(d, r, g))
+    settle_with(p, op, guess, flags, rise0, work, PassState::Cold(state))
 }
 
 /// Largest ratio of relative amplitude change to relative electrode-voltage change between
@@ -163,10 +164,77 @@ pub(super) fn settle(
 /// 0.075 N·m, 194 V, 41.56 kHz). Below the ratio the band is under 1e-10 of W.
 const MAX_WARM_ELASTICITY: f64 = 1e3;
 
+/// The ratio of relative amplitude change to relative electrode-voltage change between two
+/// states (W [m], V [V]) under the same temperature rise: 1/r'(W) at their fixed point
+/// ([`MAX_WARM_ELASTICITY`]). NaN where the voltages are equal or an amplitude is not finite.
+fn amplitude_elasticity((w0, v0): (f64, f64), (w1, v1): (f64, f64)) -> f64 {
+    ((w1 - w0) / w0) / ((v1 - v0) / v0)
+}
+
+/// The amplitude [m] at electrode voltage `v` [V] extrapolated from the state at `v_prev`
+/// (amplitude `w_prev` [m]) along the `elasticity` measured between the two states before
+/// it: a first trial for the warm descent, kept only strictly between zero and `bound`
+/// [m], the proven upper bound it starts from. Late passes move V by 1e-5 to 1e-9 of
+/// itself, where the extrapolation is within the descent's tolerance or one Newton step of
+/// it: one trial a pass fewer than a descent from the bound.
+fn predicted_amplitude(w_prev: f64, elasticity: f64, (v_prev, v): (f64, f64), bound: f64) -> Option<f64> {
+    let w = w_prev * (1.0 + elasticity * (v - v_prev) / v_prev);
+    (w > 0.0 && w < bound).then_some(w)
+}
+
+/// States the electrode voltage's passes solved (at one temperature rise) kept as upper
+/// bounds of the largest fixed point at other voltages: the amplitude W₁ solved at V₁
+/// bounds the largest fixed point at any V ≤ V₁ ([`settle_with`]). A pass whose voltage
+/// rises over the previous one's (the passes alternate about the fixed point) is bounded
+/// by an earlier state at a voltage above it. The latest [`AmplitudeBounds::KEPT`] states.
+#[derive(Default)]
+struct AmplitudeBounds {
+    /// (V [V], W [m]) of the states, the latest at `next - 1` (modulo the length).
+    kept: [Option<(f64, f64)>; AmplitudeBounds::KEPT],
+    next: usize,
+}
+
+impl AmplitudeBounds {
+    const KEPT: usize = 4;
+
+    /// Keeps state `s` solved at electrode voltage `v` [V] where its amplitude is a
+    /// solved one (running or stalled, positive and finite).
+    fn record(&mut self, v: f64, s: &Solution) {
+        if matches!(s.status, Status::Ok | Status::Stall) && s.amplitude_m > 0.0 && s.amplitude_m.is_finite() {
+            self.kept[self.next % Self::KEPT] = Some((v, s.amplitude_m));
+            self.next += 1;
+        }
+    }
+
+    /// The least kept amplitude [m] solved at a voltage at or above `v` [V]: a proven upper
+    /// bound of the largest fixed point at `v`; `None` where every kept state is below it.
+    fn at(&self, v: f64) -> Option<f64> {
+        self.kept.iter().flatten().filter(|&&(vk, _)| vk >= v).map(|&(_, w)| w).reduce(f64::min)
+    }
+}
+
 /// A pass's state solve `state(d, rise, guess, top)` ([`settle_with`]).
 type WarmState<'a> = dyn Fn(&Drive, f64, Option<&Solution>, Option<WarmTop>) -> Solution + 'a;
 
-/// [`settle`] whose state solve (`state(d, rise, guess, top)`) may start its amplitude
+/// The state solve of [`settle_with`]'s passes: one that may start its amplitude descent
+/// from a warm top, or one that always starts cold (`state(d, rise, guess)`; the passes
+/// then neither look for a top nor judge one).
+#[derive(Clone, Copy)]
+enum PassState<'a> {
+    Warm(&'a WarmState<'a>),
+    Cold(&'a dyn Fn(&Drive, f64, Option<&Solution>) -> Solution),
+}
+
+impl PassState<'_> {
+    fn solve(&self, d: &Drive, rise: f64, guess: Option<&Solution>, top: Option<WarmTop>) -> Solution {
+        match self {
+            PassState::Warm(f) => f(d, rise, guess, top),
+            PassState::Cold(f) => f(d, rise, guess),
+        }
+    }
+}
+
+/// [`settle`] whose state solve (`state`, [`PassState::Warm`]) may start its amplitude
 /// descent from `top`, a proven upper bound of the largest fixed point under `d`, instead
 /// of the cold bound Θ·V/(ω·c).
 ///
@@ -175,10 +243,18 @@ type WarmState<'a> = dyn Fn(&Drive, f64, Option<&Solution>, Option<WarmTop>) -> 
 /// alone (the temperature rise fixed) at V₂ ≤ V₁ has G₂ = (V₂/V₁)·G₁ ≤ G₁ at every W, and
 /// the previous pass's amplitude W₁, the largest fixed point of G₁ (G₁(W) < W above it),
 /// bounds the largest fixed point of G₂ from above. Late passes move V by a hair, so the
-/// descent from W₁ needs 1-3 trials instead of a descent from the cold bound (about six).
-/// Where V rises, the previous state is not a solved amplitude (clamped, unconverged), or
-/// the amplitude is ill-conditioned ([`MAX_WARM_ELASTICITY`]; the first pass, without two
-/// states to tell), the pass descends from the cold bound.
+/// descent from W₁, first trying the amplitude extrapolated along the passes' elasticity
+/// ([`predicted_amplitude`]), needs 1-3 trials instead of a descent from the cold bound
+/// (about five). Where V rises over the previous pass's, the least amplitude of the
+/// latest states solved at a voltage at or above it bounds it instead
+/// ([`AmplitudeBounds`]). Where no such state is a solved amplitude (clamped, unconverged)
+/// or the amplitude is ill-conditioned ([`MAX_WARM_ELASTICITY`]), the pass descends from
+/// the cold bound; the first pass after the set voltage's, without two
+/// states to tell the conditioning before it, is judged after its warm descent and solved
+/// again from the cold bound where it is ill-conditioned.
+///
+/// The passes end at the first state that is its own fixed point to the tolerances (1e-10
+/// of the temperature rise, 1e-12 of the set voltage), which is returned.
 fn settle_with(
     p: &Prepared,
     op: &OperatingPoint,
@@ -186,15 +262,16 @@ fn settle_with(
     (thermal, sag): (bool, bool),
     rise0: f64,
     work: &Work,
-    state: &WarmState,
+    state: PassState,
 ) -> (Solution, f64, bool) {
     let mut d = Drive::at(p, op);
     let mut rise = rise0;
     if rise != 0.0 {
         d.warm(p, rise);
     }
-    let mut s = state(&d, rise, guess, None);
+    let mut s = state.solve(&d, rise, guess, None);
     let mut older: Option<(f64, f64)> = None;
+    let mut bounds = AmplitudeBounds::default();
     let mut settled = false;
     // (x, G(x)) of the previous pass, for the temperature rise and the electrode voltage
     let mut last_pass: Option<((f64, f64), (f64, f64))> = None;
@@ -211,7 +288,13 @@ fn settle_with(
         if sag {
             new_v = sagged_voltage_v(p, op, &s);
         }
-        let done = (new_rise - rise).abs() <= 1e-10 * (1.0 + rise.abs()) && (new_v - d.v).abs() <= 1e-12 * op.voltage_v;
+        if (new_rise - rise).abs() <= 1e-10 * (1.0 + rise.abs()) && (new_v - d.v).abs() <= 1e-12 * op.voltage_v {
+            // `s` is its own fixed point to the tolerances: the state it was solved at is
+            // the answer (another solve at the pass's next iterate would move it by less
+            // than the tolerance, at the cost of an amplitude solve)
+            settled = true;
+            break;
+        }
         let mut next = (
             bracketed_secant(rise, new_rise, last_pass.map(|l| l.0)),
             bracketed_secant(d.v, new_v, last_pass.map(|l| l.1)),
@@ -220,7 +303,7 @@ fn settle_with(
             next.1 = monotone_secant(d.v, new_v, last_pass.map(|l| l.1)).unwrap_or(next.1);
         }
         last_pass = Some(((rise, new_rise), (d.v, new_v)));
-        if thermal != sag && !done {
+        if thermal != sag {
             let (x, gx) = if thermal { (rise, new_rise) } else { (d.v, new_v) };
             bracket.record(x, x - gx, pass >= BRACKET_AFTER);
             if pass >= BRACKET_AFTER {
@@ -259,24 +342,35 @@ fn settle_with(
         // (W, V) of the state before `prev`: their ratio of relative changes is
         // 1/r'(W) at the fixed point (W = V·Θ/|Z(W)|), how far the descent's tolerance
         // on r leaves W uncertain
-        let well_conditioned = older.is_some_and(|(w0, v0): (f64, f64)| {
-            let elasticity = ((prev.amplitude_m - w0) / w0) / ((v_prev - v0) / v0);
-            elasticity.abs() <= MAX_WARM_ELASTICITY
+        let elasticity = older.map(|(w0, v0): (f64, f64)| amplitude_elasticity((w0, v0), (prev.amplitude_m, v_prev)));
+        let well_conditioned = elasticity.is_some_and(|e| e.abs() <= MAX_WARM_ELASTICITY);
+        // Without two states yet (the first pass after the set voltage's), the pass is
+        // tried from the previous amplitude all the same and its conditioning judged
+        // afterwards, from the two states it then has: the same ratio, measured one pass
+        // later.
+        let judged_after = older.is_none();
+        let warm_tops = matches!(state, PassState::Warm(_)) && sag && !thermal;
+        if warm_tops {
+            bounds.record(v_prev, &prev);
+        }
+        let bound = (warm_tops && (well_conditioned || judged_after)).then(|| bounds.at(d.v)).flatten();
+        let warm = bound.is_some();
+        let top = bound.map(|bound| WarmTop {
+            bound,
+            predicted: elasticity.and_then(|e| predicted_amplitude(prev.amplitude_m, e, (v_prev, d.v), bound)),
+            contact_rad: None,
+            stick_rad: None,
         });
-        let warm = sag
-            && !thermal
-            && well_conditioned
-            && d.v <= v_prev
-            && matches!(prev.status, Status::Ok | Status::Stall)
-            && prev.amplitude_m > 0.0
-            && prev.amplitude_m.is_finite();
-        let top =
-            warm.then_some(WarmTop { bound: prev.amplitude_m, predicted: None, contact_rad: None, stick_rad: None });
         older = Some((prev.amplitude_m, v_prev));
-        s = state(&d, rise, Some(&prev).filter(|g| g.status.is_valid()), top);
-        if done && !work.exhausted() {
-            settled = true;
-            break;
+        let guess = Some(&prev).filter(|g| g.status.is_valid());
+        s = state.solve(&d, rise, guess, top);
+        if warm && judged_after {
+            // (false for a NaN too)
+            let conditioned =
+                amplitude_elasticity((prev.amplitude_m, v_prev), (s.amplitude_m, d.v)).abs() <= MAX_WARM_ELASTICITY;
+            if !conditioned {
+                s = state.solve(&d, rise, guess, None);
+            }
         }
         if !s.status.is_valid() || work.exhausted() {
             break;
