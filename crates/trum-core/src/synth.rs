@@ -33,6 +33,17 @@ impl Campaign {
     /// Names accepted on the command line.
     pub const NAMES: [&'static str; 5] = ["preload-torque", "frequency-sweep", "warm-up", "stability", "combined"];
 
+    /// The campaign's name, as `trum synth --campaign` takes it (one of [`Campaign::NAMES`]).
+    pub fn name(self) -> &'static str {
+        match self {
+            Campaign::PreloadTorque => Campaign::NAMES[0],
+            Campaign::FrequencySweep => Campaign::NAMES[1],
+            Campaign::WarmUp => Campaign::NAMES[2],
+            Campaign::Stability => Campaign::NAMES[3],
+            Campaign::Combined => Campaign::NAMES[4],
+        }
+    }
+
     /// Parses a campaign name; the error lists the valid names.
     pub fn from_name(s: &str) -> Result<Campaign, TrumError> {
         Ok(match s {
