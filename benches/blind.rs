@@ -13,7 +13,8 @@
 //! tables in docs/DIAGNOSIS.md (between the `blind-dev:` and `blind-heldout:` markers) and
 //! the per-case tables docs/data/blind_{dev,heldout}.csv. Options (these print only):
 //! `--half dev|heldout` one half; `--seed-offset K` every seed moved by K (another draw);
-//! `--slice` the test suite's slices; `--plain` the earlier single-form design without
+//! `--slice` the test suite's slices; `--pairs` every pair of two effects alone, in the
+//! half's forms and artefacts, on the combined campaign; `--plain` the earlier single-form design without
 //! artefacts; `--only NAME` the cases whose injected set contains NAME; `--bare` every
 //! case's file without `run_id` and with its rows shuffled; `--workers N`; `--no-write`. Each case's CSV and JSON stay in target/blind/.
 
@@ -133,6 +134,7 @@ fn main() {
         && !flag("--bare")
         && !flag("--slice")
         && !flag("--plain")
+        && !flag("--pairs")
         && seed_offset == 0
         && arg(&args, "--only").is_none();
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/blind");
@@ -143,6 +145,7 @@ fn main() {
             (Half::Plain, true) => blind::slice_cases(),
             (Half::Plain, false) => blind::full_cases_at(seed_offset),
             (h, true) => blind::half_slice_cases(h),
+            (h, false) if flag("--pairs") => blind::pair_cases(h, seed_offset),
             (h, false) => blind::half_cases(h, seed_offset),
         };
         if let Some(only) = arg(&args, "--only") {

@@ -494,6 +494,23 @@ pub fn half_cases(half: Half, seed_offset: u64) -> Vec<Case> {
     out
 }
 
+/// Every pair of two different effects, each at typical strength in the half's truth
+/// forms with its artefacts, on the combined campaign (21 cases), seeds from 3200 (the
+/// development half) or 5200 (the held-out half) moved by `seed_offset`: a design of
+/// two-effect cases alone, beside the halves' two pairs each.
+pub fn pair_cases(half: Half, seed_offset: u64) -> Vec<Case> {
+    let names = effect_names();
+    let mut seed = seed_offset + if half == Half::HeldOut { 5200 } else { 3200 };
+    let mut out = Vec::new();
+    for (i, a) in names.iter().enumerate() {
+        for b in &names[i + 1..] {
+            seed += 1;
+            out.push(Case { effects: vec![*a, *b], factor: 1.0, campaign: "combined", noise: 1.0, seed, half });
+        }
+    }
+    out
+}
+
 /// The fast slice of the two-half benchmark in the test suite: for each half, four single
 /// effects on the preload-torque campaign (typical strength) and two null cases (one on a
 /// campaign without load torque). Seeds differ from the full run's.

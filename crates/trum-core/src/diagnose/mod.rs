@@ -404,10 +404,9 @@ pub fn diagnose(
                 pairs::rounded(base.noise_best)
             ));
         }
-        let mut best_pair = None;
+        let mut pairs = Vec::new();
         if ctx.opts.try_pairs && ranking.len() >= 2 && single_at_noise.is_none() {
-            (best_pair, screened_note) =
-                pairs::fit_pairs(&scorer, &mut fits, &mut ranking, &best_single, single_closes);
+            (pairs, screened_note) = pairs::fit_pairs(&scorer, &mut fits, &mut ranking, &best_single, single_closes);
         }
         decided = verdict::decide(
             &ctx,
@@ -416,7 +415,7 @@ pub fn diagnose(
             &fits.cv_preds,
             best_single,
             single_closes,
-            best_pair,
+            &pairs,
             &probes.base_sigs,
         );
         notes.append(&mut decided.notes);

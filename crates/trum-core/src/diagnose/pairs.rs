@@ -19,15 +19,15 @@ pub(super) const PAIR_GAIN: f64 = 1.0 / 3.0;
 /// the candidate with the most evidence) joined with every other testable candidate worth
 /// a pair fit, and when no single closes the gap (`single_closes`) the candidate with the
 /// most evidence leading too, plus pairs of the three strongest. The pairs are scored and
-/// added to `ranking` (re-sorted) and `fits`. Returns the best pair and the note on the
-/// pairs screened out.
+/// added to `ranking` (re-sorted) and `fits`. Returns the pairs' entries, best evidence
+/// first, and the note on the pairs screened out.
 pub(super) fn fit_pairs(
     scorer: &Scorer,
     fits: &mut Fits,
     ranking: &mut Vec<RankEntry>,
     best_single: &Option<RankEntry>,
     single_closes: bool,
-) -> (Option<RankEntry>, Option<String>) {
+) -> (Vec<RankEntry>, Option<String>) {
     let ctx = scorer.ctx;
     let (rows, sc, n_read, noise_weights) = (&ctx.rows[..], &ctx.sc, ctx.n_read, ctx.noise_weights);
     let untestable = &scorer.probes.untestable;
@@ -168,10 +168,9 @@ pub(super) fn fit_pairs(
     let scored: Vec<Scored> = pairs.par_iter().zip(&nested).map(|(p, n)| scorer.score(p, from(p), n)).collect();
     let mut pr: Vec<RankEntry> = fits.absorb(scored);
     sort_ranking(&mut pr);
-    let best_pair = pr.first().cloned();
-    ranking.extend(pr);
+    ranking.extend(pr.iter().cloned());
     sort_ranking(ranking);
-    (best_pair, screened)
+    (pr, screened)
 }
 
 /// The excess beyond the noise of a held-out χ² per reading `x` over `n` readings of a
