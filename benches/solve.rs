@@ -34,25 +34,31 @@ fn one_point(c: &mut Criterion) {
 }
 
 fn sweep(c: &mut Criterion) {
-    let m = preset("trum60a").expect("preset");
-    let p = Prepared::new(&m);
+    let shipped = preset("trum60a").expect("preset");
+    // the effect-free motor (the baseline's warm sweep) and the preset as shipped, whose
+    // multi-branch stator a sweep cannot warm-start (docs/PERFORMANCE.md)
+    let mut bare = shipped.clone();
+    bare.effects.parse_assignment("none").expect("effect");
     let mut g = c.benchmark_group("sweep");
-    for n in [1_000u64, 10_000] {
-        let side = (n as f64).sqrt() as usize;
-        let grid = Grid {
-            preload_n: Axis::linspace(100.0, 500.0, side),
-            voltage_v: Axis::fixed(200.0),
-            frequency_hz: Axis::fixed(43e3),
-            torque_nm: Axis::linspace(0.0, 1.2, side),
-        };
-        g.throughput(Throughput::Elements(grid.len()));
-        g.bench_with_input(BenchmarkId::new("preload_x_torque", grid.len()), &grid, |b, grid| {
-            b.iter(|| {
-                let mut acc = 0.0;
-                solve_range(&m, &p, grid, 0..grid.len(), |_, _, s| acc += s.speed_rpm);
-                black_box(acc)
-            })
-        });
+    for (name, m) in [("preload_x_torque-no-effects", &bare), ("preload_x_torque", &shipped)] {
+        let p = Prepared::new(m);
+        for n in [1_000u64, 10_000] {
+            let side = (n as f64).sqrt() as usize;
+            let grid = Grid {
+                preload_n: Axis::linspace(100.0, 500.0, side),
+                voltage_v: Axis::fixed(200.0),
+                frequency_hz: Axis::fixed(43e3),
+                torque_nm: Axis::linspace(0.0, 1.2, side),
+            };
+            g.throughput(Throughput::Elements(grid.len()));
+            g.bench_with_input(BenchmarkId::new(name, grid.len()), &grid, |b, grid| {
+                b.iter(|| {
+                    let mut acc = 0.0;
+                    solve_range(m, &p, grid, 0..grid.len(), |_, _, s| acc += s.speed_rpm);
+                    black_box(acc)
+                })
+            });
+        }
     }
     g.finish();
 }
