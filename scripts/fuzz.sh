@@ -22,7 +22,7 @@
 # cargo-fuzz`). Corpora grow in fuzz/coverage/corpus/<target>/ (git-ignored, seeded from
 # the committed fuzz/corpus/ where a target reads the same format); crashes go to
 # fuzz/coverage/artifacts/<target>/. Prints executions, rate, coverage, corpus size and
-# peak RSS per target.
+# peak RSS per target, also for a run stopped by hand with SIGINT to the target binary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SANITIZER=address
@@ -35,7 +35,7 @@ while [ $# -gt 0 ]; do
     --timeout) TIMEOUT=${2:?--timeout needs seconds}; shift 2 ;;
     --timeout=*) TIMEOUT=${1#*=}; shift ;;
     --no-trace-compares) TRACE_CMP=no; shift ;;
-    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,25p' "$0"; exit 0 ;;
     -*) echo "fuzz.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
     *) break ;;
   esac
@@ -100,18 +100,27 @@ for a in "${ARGS[@]}"; do
   log=$(mktemp)
   start=$(date +%s)
   # -rss_limit_mb bounds memory; -timeout reports a slow input as a hang
+  rc=0
   # shellcheck disable=SC2086
-  if ! /usr/bin/time -f "wall %e s, max RSS %M kB" "$BIN_DIR/$t" "$corpus" $seeds \
+  /usr/bin/time -f "wall %e s, max RSS %M kB" "$BIN_DIR/$t" "$corpus" $seeds \
       -artifact_prefix="fuzz/coverage/artifacts/$t/" \
       -seed="$SEED" "$(budget_args "$b")" -rss_limit_mb=4096 -timeout="$TIMEOUT" \
       -max_len="$max_len" -len_control=0 \
-      -print_final_stats=1 >"$log" 2>&1; then
+      -print_final_stats=1 >"$log" 2>&1 || rc=$?
+  # a run stopped by hand (SIGINT to the target: libFuzzer prints its figures and exits
+  # 72) is not a failure; its figures are of the executions so far
+  interrupted=no
+  if [ "$rc" -eq 72 ] && grep -q "libFuzzer: run interrupted" "$log"; then
+    interrupted=yes
+  fi
+  if [ "$rc" -ne 0 ] && [ "$interrupted" = no ]; then
     tail -40 "$log"
     echo "FAILED: $t (seed $SEED; the input is in fuzz/coverage/artifacts/$t/)"
     rm -f "$log"
     exit 1
   fi
   secs=$(( $(date +%s) - start ))
+  [ "$interrupted" = yes ] && echo "interrupted by hand: the figures below are of the run so far"
   grep -E "^#[0-9]+.*(DONE|cov:)" "$log" | tail -1
   grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|stat::peak_rss_mb|^wall" "$log" || true
   echo "corpus: $(find "$corpus" -type f | wc -l) files, $(du -sh "$corpus" | cut -f1); ${secs} s"

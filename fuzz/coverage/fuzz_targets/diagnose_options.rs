@@ -2,17 +2,18 @@
 //! configuration the input chooses (its byte `data[1]`, which the rows do not read): one
 //! or two candidate effects of the seven, or none (bits 0-2 and 3-5: an effect's index, 7
 //! for none; the same effect twice is one), pairs tried or not (bit 6), 0 or 2 bootstrap
-//! draws (bit 7), two folds. Every other option is the default's, and every stage of the
+//! draws (bit 7), two folds. Every other option is the default's, so each stage of the
 //! diagnosis runs as `trum diagnose` runs it: the baseline and its cross-validation, the
-//! candidates' fits and scores, the pair fits, the verdict, where the gap lies.
+//! candidates' fits and scores, the pair fits (where two candidates and bit 6 ask for
+//! them), the verdict, where the gap lies.
 //! Properties: those of the `diagnose` target (no panic; the JSON's headline figures
 //! finite, the verdict a known word), and the ranking and the verdict name only the
 //! candidates asked for.
 //!
 //! Why a configuration: the `diagnose` target, with all seven candidates, four folds and
-//! 20 bootstrap draws, takes 0.3-1 s an input, so it is run for a time budget, not for
-//! 10⁶ executions; the fits of a diagnosis are each candidate's and each fold's, so one or
-//! two candidates on two folds reach the same code for a small part of the cost.
+//! 20 bootstrap draws, takes 0.3-1 s an input; the fits of a diagnosis are each
+//! candidate's and each fold's, so one or two candidates on two folds reach the same code
+//! for about a tenth of the cost (docs/RELIABILITY.md, "Where 10^6 is out of reach").
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 use trum_core::bench::observations;
