@@ -1028,7 +1028,7 @@ fn remaining_gain(j: &DMatrix<f64>, r: &DVector<f64>, u: &DVector<f64>) -> f64 {
 fn gain_below(j: &DMatrix<f64>, r: &DVector<f64>, u: &DVector<f64>, tol: f64) -> bool {
     let (edge, free) = edge_gain(j, r, u);
     // (a non-finite edge, or one at tol already, fails the test whatever the decrement)
-    if !(edge < tol) {
+    if edge.is_nan() || edge >= tol {
         return false;
     }
     if decrement_lower_bound(&free, r) >= 2.0 * (tol - edge) {
