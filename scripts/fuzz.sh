@@ -11,24 +11,31 @@
 #                              only adds checks inside unsafe code of its dependencies
 #                              (docs/RELIABILITY.md, "Coverage-guided fuzzing")
 #   --timeout S                an input slower than S seconds is a hang (default 10)
+#   --no-trace-compares        build without libFuzzer's comparison tracing (its own
+#                              target directory, fuzz/coverage/target-no-cmp): for the
+#                              numeric targets, whose bytes become floats, where the
+#                              tracing is most of the time and guides little
+#                              (docs/RELIABILITY.md, "Which build")
 # Debug assertions and overflow checks are on in every build (-a).
 # Every target is built before the first one runs, so the figures are of one source state.
 # Needs a nightly toolchain (`rustup toolchain list`) and cargo-fuzz (`cargo install
 # cargo-fuzz`). Corpora grow in fuzz/coverage/corpus/<target>/ (git-ignored, seeded from
 # the committed fuzz/corpus/ where a target reads the same format); crashes go to
 # fuzz/coverage/artifacts/<target>/. Prints executions, rate, coverage, corpus size and
-# peak RSS per target.
+# peak RSS per target, also for a run stopped by hand with SIGINT to the target binary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SANITIZER=address
 TIMEOUT=10
+TRACE_CMP=yes
 while [ $# -gt 0 ]; do
   case $1 in
     --sanitizer) SANITIZER=${2:?--sanitizer needs none or address}; shift 2 ;;
     --sanitizer=*) SANITIZER=${1#*=}; shift ;;
     --timeout) TIMEOUT=${2:?--timeout needs seconds}; shift 2 ;;
     --timeout=*) TIMEOUT=${1#*=}; shift ;;
-    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
+    --no-trace-compares) TRACE_CMP=no; shift ;;
+    -h|--help) sed -n '2,25p' "$0"; exit 0 ;;
     -*) echo "fuzz.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
     *) break ;;
   esac
@@ -53,7 +60,7 @@ budget_args() {
 budget_args "$BUDGET" >/dev/null
 ARGS=("$@")
 if [ ${#ARGS[@]} -eq 0 ]; then
-  ARGS=(motor_reader measurement_reader solver writers_round_trip calibrate diagnose)
+  ARGS=(motor_reader measurement_reader solver writers_round_trip calibrate diagnose diagnose_options)
 fi
 TARGETS=()
 for a in "${ARGS[@]}"; do
@@ -62,12 +69,18 @@ for a in "${ARGS[@]}"; do
 done
 SEED=${TRUM_FUZZ_SEED:-$(( $(date +%s) % 1000000007 ))}
 BUILD=(cargo +nightly fuzz build --fuzz-dir fuzz/coverage -O -a -s "$SANITIZER")
-echo "fuzz seed: $SEED, budget $BUDGET per target (x: executions, else seconds), sanitizer $SANITIZER, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
-echo "replay a crash: cargo +nightly fuzz run --fuzz-dir fuzz/coverage -O -a -s $SANITIZER TARGET ARTIFACT"
+TARGET_DIR=fuzz/coverage/target
+if [ "$TRACE_CMP" = no ]; then
+  # (other flags, so a directory of their own: the two builds do not rebuild each other)
+  TARGET_DIR=fuzz/coverage/target-no-cmp
+  BUILD+=(--no-trace-compares --target-dir "$TARGET_DIR")
+fi
+echo "fuzz seed: $SEED, budget $BUDGET per target (x: executions, else seconds), sanitizer $SANITIZER, comparison tracing $TRACE_CMP, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "replay a crash: ${BUILD[*]/build/run} TARGET ARTIFACT"
 for t in "${TARGETS[@]}"; do
   "${BUILD[@]}" "$t"
 done
-BIN_DIR=fuzz/coverage/target/$(rustc +nightly -vV | sed -n 's/^host: //p')/release
+BIN_DIR=$TARGET_DIR/$(rustc +nightly -vV | sed -n 's/^host: //p')/release
 for a in "${ARGS[@]}"; do
   t=${a%%:*}
   b=$BUDGET
@@ -80,25 +93,34 @@ for a in "${ARGS[@]}"; do
     measurement_reader) seeds=fuzz/corpus/csv; max_len=8192 ;;
     solver) seeds=; max_len=128 ;;
     writers_round_trip) seeds=; max_len=512 ;;
-    calibrate|diagnose) seeds=; max_len=64 ;;
+    calibrate|diagnose|diagnose_options) seeds=; max_len=64 ;;
     *) seeds=; max_len=4096 ;;
   esac
   echo "== $t, budget $b (load $(cut -d' ' -f1-3 /proc/loadavg))"
   log=$(mktemp)
   start=$(date +%s)
   # -rss_limit_mb bounds memory; -timeout reports a slow input as a hang
+  rc=0
   # shellcheck disable=SC2086
-  if ! /usr/bin/time -f "wall %e s, max RSS %M kB" "$BIN_DIR/$t" "$corpus" $seeds \
+  /usr/bin/time -f "wall %e s, max RSS %M kB" "$BIN_DIR/$t" "$corpus" $seeds \
       -artifact_prefix="fuzz/coverage/artifacts/$t/" \
       -seed="$SEED" "$(budget_args "$b")" -rss_limit_mb=4096 -timeout="$TIMEOUT" \
       -max_len="$max_len" -len_control=0 \
-      -print_final_stats=1 >"$log" 2>&1; then
+      -print_final_stats=1 >"$log" 2>&1 || rc=$?
+  # a run stopped by hand (SIGINT to the target: libFuzzer prints its figures and exits
+  # 72) is not a failure; its figures are of the executions so far
+  interrupted=no
+  if [ "$rc" -eq 72 ] && grep -q "libFuzzer: run interrupted" "$log"; then
+    interrupted=yes
+  fi
+  if [ "$rc" -ne 0 ] && [ "$interrupted" = no ]; then
     tail -40 "$log"
     echo "FAILED: $t (seed $SEED; the input is in fuzz/coverage/artifacts/$t/)"
     rm -f "$log"
     exit 1
   fi
   secs=$(( $(date +%s) - start ))
+  [ "$interrupted" = yes ] && echo "interrupted by hand: the figures below are of the run so far"
   grep -E "^#[0-9]+.*(DONE|cov:)" "$log" | tail -1
   grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|stat::peak_rss_mb|^wall" "$log" || true
   echo "corpus: $(find "$corpus" -type f | wc -l) files, $(du -sh "$corpus" | cut -f1); ${secs} s"
