@@ -17,11 +17,12 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 use trum_core::bench::observations;
-use trum_core::diagnose::json::{to_json, Provenance};
 use trum_core::diagnose::{diagnose, DiagnoseOptions};
 use trum_core::effects::ALL;
 use trum_core::presets;
 
+#[path = "../common/diagnosis.rs"]
+mod diagnosis;
 #[path = "../common/rows.rs"]
 mod rows;
 
@@ -46,14 +47,8 @@ fuzz_target!(|data: &[u8]| {
         ..DiagnoseOptions::default()
     };
     if let Ok(d) = diagnose(&motor, &bench.rows, &bench.groups, &opts) {
-        let src = Provenance { motor_name: &motor.name, motor_source: "generic60", data: "fuzz", lines: &bench.lines };
-        let doc = to_json(&d, &src);
-        let finite = |v: &serde_json::Value| v.as_f64().is_some_and(f64::is_finite);
-        assert!(finite(&doc["gap"]["baseline_heldout_nrmse"]) && finite(&doc["gap"]["noise_nrmse"]), "{doc}");
+        let doc = diagnosis::checked_json(&motor, &bench, &d);
         for r in doc["ranking"].as_array().expect("ranking") {
-            for k in ["evidence", "heldout_nrmse_after", "shrink"] {
-                assert!(finite(&r[k]), "{k}: {doc}");
-            }
             let name = r["effect"].as_str().expect("effect");
             assert!(
                 name.split('+').all(|e| candidates.iter().any(|c| c.name() == e)),
