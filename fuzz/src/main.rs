@@ -30,8 +30,8 @@
 //! status, effect set) join the in-memory corpus: cheap feedback without coverage.
 //!
 //! ```text
-//! cargo run --release --manifest-path fuzz/Cargo.toml -- --seconds 20 --target all
-//! cargo run --release --manifest-path fuzz/Cargo.toml -- --target toml --replay fuzz/artifacts/toml-panic-0.bin
+//! cargo run --profile test --example trum-fuzz -- --seconds 20 --target all
+//! cargo run --profile test --example trum-fuzz -- --target toml --replay fuzz/artifacts/toml-panic-0.bin
 //! ```
 //! Exit code 0 when no property failed, 1 when one did, 2 on a usage error, 3 on a hang.
 
@@ -93,7 +93,7 @@ fn usage() -> ! {
 }
 
 fn parse_opts() -> Opts {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fuzz");
     let mut o = Opts {
         seconds: 20.0,
         targets: Target::ALL.to_vec(),
