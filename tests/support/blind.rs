@@ -322,6 +322,34 @@ fn strip_runs_and_shuffle(path: &std::path::Path, seed: u64) {
     std::fs::write(path, format!("{}\n{}\n", head.join(","), rows.join("\n"))).expect("rewrite case CSV");
 }
 
+/// What `separating_campaigns` holds, on every diagnosis the benchmark makes: entries from
+/// the lead (the single-effect verdict, or `partial` with `unexplained`) to each effect in
+/// `confounded_with`, then at most one `close_in_evidence` rival, a supported single effect
+/// less than 3 behind the lead in evidence (docs/DIAGNOSIS_JSON.md).
+fn check_separations(v: &serde_json::Value, verdict: &str, confounded: &[String]) {
+    let seps = v["separating_campaigns"].as_array().expect("separating_campaigns");
+    let lead = if verdict == "unexplained" { v["partial"].as_str().unwrap_or(verdict) } else { verdict };
+    let evidence = |e: &str| {
+        v["ranking"].as_array().expect("ranking").iter().find(|r| r["effect"] == e).and_then(|r| r["evidence"].as_f64())
+    };
+    let mut close = 0;
+    for s in seps {
+        assert_eq!(s["effects"][0], lead, "{s}");
+        let rival = s["effects"][1].as_str().expect("rival");
+        match s["rival"].as_str().expect("rival kind") {
+            "confounded" => assert!(confounded.iter().any(|c| c == rival), "{s}"),
+            "close_in_evidence" => {
+                close += 1;
+                let (l, r) = (evidence(lead).expect("lead ranked"), evidence(rival).expect("rival ranked"));
+                assert!(!confounded.iter().any(|c| c == rival) && !rival.contains('+'), "{s}");
+                assert!(r > 0.0 && l - r < 3.0, "lead {l}, rival {r}: {s}");
+            }
+            other => panic!("rival kind {other}: {s}"),
+        }
+    }
+    assert!(close <= 1, "{seps:?}");
+}
+
 /// Synthesises the case's data and diagnoses it blind.
 pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
     let tag = format!(
@@ -365,7 +393,7 @@ pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
     let text = std::fs::read_to_string(&json).expect("diagnosis JSON");
     let v: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
     let verdict = v["verdict"].as_str().expect("verdict").to_string();
-    let confounded = v["confounded_with"]
+    let confounded: Vec<String> = v["confounded_with"]
         .as_array()
         .expect("confounded_with")
         .iter()
@@ -373,6 +401,7 @@ pub fn run_case(case: &Case, dir: &std::path::Path) -> Outcome {
         .map(String::from)
         .collect();
     let ranking = v["ranking"].as_array().expect("ranking");
+    check_separations(&v, &verdict, &confounded);
     let shrink_of = |name: &str| {
         ranking
             .iter()

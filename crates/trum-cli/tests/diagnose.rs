@@ -490,6 +490,7 @@ fn a_confounded_verdict_names_the_campaign_that_separates_it() {
     assert_eq!(j["confounded_with"], serde_json::json!(["preload_stiffening"]), "{out}");
     let s = &j["separating_campaigns"][0];
     assert_eq!(s["effects"], serde_json::json!(["hertz_softening", "preload_stiffening"]), "{s}");
+    assert_eq!(s["rival"], "confounded", "{s}");
     assert_eq!(s["best"], "frequency-sweep", "{s}");
     let chi2 = |c: &str| {
         s["campaigns"].as_array().expect("campaigns").iter().find(|x| x["campaign"] == c).expect(c)["chi2"]

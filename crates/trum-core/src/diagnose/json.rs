@@ -146,6 +146,7 @@ pub fn to_json(d: &Diagnosis, src: &Provenance<'_>) -> Value {
         })).collect::<Vec<_>>(),
         "separating_campaigns": d.separating_campaigns.iter().map(|s| json!({
             "effects": [s.effects.0, s.effects.1],
+            "rival": s.rival.name(),
             "chi2_on_the_data": num(s.chi2_on_the_data),
             "campaigns": s.chi2.iter().map(|(c, x)| json!({"campaign": c, "chi2": num(*x)})).collect::<Vec<_>>(),
             "best": s.best().map(|b| b.0),

@@ -443,7 +443,8 @@ pub fn diagnose(
     }
     let Verdict { verdict, complete, confounded, partial, .. } = decided;
     notes.extend(screened_note);
-    let separating_campaigns = separating_campaigns(&ctx.rows, &fits.fits, &verdict, &confounded);
+    let lead = partial.as_deref().filter(|_| verdict == "unexplained").unwrap_or(&verdict);
+    let separating_campaigns = separating_campaigns(&ctx.rows, &fits.fits, &ranking, lead, &confounded);
     notes.extend(separating_campaigns.iter().filter_map(separation_note));
     notes.extend(scorer.into_notes());
     notes.extend(folds::in_sample_note(base.cv.in_sample, &ranking, ctx.k));
@@ -489,31 +490,40 @@ pub fn diagnose(
     }))
 }
 
-/// The separation of the single-effect `verdict` from each effect it is `confounded` with,
-/// between their full-data fits (`fits`), at the drive of `rows`.
+/// The separation of the lead effect from each of its rivals ([`separation::rivals`]),
+/// between their full-data fits (`fits`), at the drive of `rows`. The lead is a
+/// single-effect verdict, or with `unexplained` the effect that explains part of the gap
+/// (`partial`): in both a user asks what would confirm it against the next explanation.
 fn separating_campaigns(
     rows: &[ObservedRow],
     fits: &BTreeMap<String, crate::calibrate::Calibration>,
-    verdict: &str,
+    ranking: &[RankEntry],
+    lead: &str,
     confounded: &[String],
 ) -> Vec<separation::Separation> {
-    let (Some(lead), Some((voltage_v, frequency_hz))) = (fits.get(verdict), separation::drive_of(rows)) else {
+    let (Some(lead_fit), Some((voltage_v, frequency_hz))) = (fits.get(lead), separation::drive_of(rows)) else {
         return Vec::new();
     };
-    confounded
+    separation::rivals(ranking, lead, confounded)
         .par_iter()
-        .filter_map(|e| {
+        .filter_map(|(e, why)| {
             let other = fits.get(e)?;
-            Some(separation::separation((verdict, e), &lead.motor, &other.motor, rows, voltage_v, frequency_hz))
+            Some(separation::separation((lead, e), *why, &lead_fit.motor, &other.motor, rows, voltage_v, frequency_hz))
         })
         .collect()
 }
 
-/// The note that says what would separate two confounded effects, where a campaign does.
+/// The note that says what would separate the lead from a rival, where a campaign does.
 fn separation_note(s: &separation::Separation) -> Option<String> {
     let (campaign, chi2) = s.best()?;
+    let relation = match s.rival {
+        separation::Rival::Confounded => "are not told apart by these data",
+        separation::Rival::CloseInEvidence => {
+            "are both supported and the data prefer the first only weakly (evidence less than 3 apart)"
+        }
+    };
     Some(format!(
-        "{} and {} are not told apart by these data (their fits differ by χ² {} over the data's readings at the nominal bench noise of docs/SYNTH.md); a {campaign} campaign at the data's drive would separate them by χ² {} (`trum synth --campaign {campaign}` shows its operating points)",
+        "{} and {} {relation} (their fits differ by χ² {} over the data's readings at the nominal bench noise of docs/SYNTH.md); a {campaign} campaign at the data's drive would separate them by χ² {} (`trum synth --campaign {campaign}` shows its operating points)",
         s.effects.0,
         s.effects.1,
         pairs::rounded(s.chi2_on_the_data),

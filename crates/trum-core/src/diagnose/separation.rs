@@ -17,11 +17,60 @@ use crate::synth::{reading_noise, synthesize, Campaign, SynthConfig};
 pub const CAMPAIGNS: [Campaign; 4] =
     [Campaign::PreloadTorque, Campaign::FrequencySweep, Campaign::WarmUp, Campaign::Stability];
 
+/// A log Bayes factor (evidence, ½·ΔBIC) below which the lead's preference over a rival
+/// is not strong: 2·ln B < 6 is at most "positive" evidence on the scale of Kass and
+/// Raftery 1995 ("Bayes factors", J. Am. Stat. Assoc. 90, 773-795), the scale the
+/// diagnosis JSON's `evidence_scale` states.
+pub const CLOSE_EVIDENCE: f64 = 3.0;
+
+/// Why the separation of a rival effect from the lead is reported.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rival {
+    /// In `confounded_with`: the data do not tell the two apart.
+    Confounded,
+    /// Not confounded, but the best other single effect, supported and behind the lead by
+    /// less than [`CLOSE_EVIDENCE`]: the data prefer the lead, though not strongly.
+    CloseInEvidence,
+}
+
+impl Rival {
+    /// The name in the diagnosis JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Rival::Confounded => "confounded",
+            Rival::CloseInEvidence => "close_in_evidence",
+        }
+    }
+}
+
+/// The rivals of the single effect `lead` whose separation from it is reported: every
+/// effect in `confounded`, then the other single effect of `ranking` with the most
+/// evidence where it is supported (evidence > 0) and within [`CLOSE_EVIDENCE`]
+/// of the lead's evidence. Pairs are never rivals: a separation compares two fits of
+/// one effect each. Empty where `lead` is not in `ranking`.
+pub fn rivals(ranking: &[super::RankEntry], lead: &str, confounded: &[String]) -> Vec<(String, Rival)> {
+    let Some(lead_evidence) = ranking.iter().find(|r| r.effect == lead).map(|r| r.evidence) else {
+        return Vec::new();
+    };
+    let mut out: Vec<(String, Rival)> = confounded.iter().map(|e| (e.clone(), Rival::Confounded)).collect();
+    let runner_up = ranking
+        .iter()
+        .filter(|r| r.effect != lead && !r.effect.contains('+') && !confounded.contains(&r.effect))
+        .filter(|r| r.evidence.is_finite())
+        .max_by(|a, b| a.evidence.total_cmp(&b.evidence));
+    if let Some(r) = runner_up.filter(|r| r.evidence > 0.0 && lead_evidence - r.evidence < CLOSE_EVIDENCE) {
+        out.push((r.effect.clone(), Rival::CloseInEvidence));
+    }
+    out
+}
+
 /// How well each campaign would separate two fitted models.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Separation {
     /// The two effects (the verdict's first).
     pub effects: (String, String),
+    /// Why this pair is reported.
+    pub rival: Rival,
     /// Per campaign kind (its `trum synth` name): Σ over its readings of the squared
     /// difference of the two models' predictions in units of the nominal bench noise
     /// (docs/SYNTH.md, noise level 1). 0 where the two models agree on every reading.
@@ -61,6 +110,7 @@ pub fn drive_of(rows: &[ObservedRow]) -> Option<(f64, f64)> {
 /// noise levels the diagnosis gave them. Units: χ² [-], the drive in V and Hz.
 pub fn separation(
     names: (&str, &str),
+    rival: Rival,
     a: &Motor,
     b: &Motor,
     rows: &[ObservedRow],
@@ -97,7 +147,12 @@ pub fn separation(
         })
         .collect();
     let chi2_on_the_data: f64 = rows.iter().map(|r| difference(r, &expected(a, &pa, r), &expected(b, &pb, r))).sum();
-    Separation { effects: (names.0.to_string(), names.1.to_string()), chi2, chi2_on_the_data: finite(chi2_on_the_data) }
+    Separation {
+        effects: (names.0.to_string(), names.1.to_string()),
+        rival,
+        chi2,
+        chi2_on_the_data: finite(chi2_on_the_data),
+    }
 }
 
 /// The readings `motor` predicts for `row`, through its bench instruments (NaN where it has
@@ -166,7 +221,7 @@ mod tests {
     #[test]
     fn a_model_is_not_separated_from_itself() {
         let m = with("radial_friction=1");
-        let s = separation(("a", "b"), &m, &m, &[], 200.0, 43e3);
+        let s = separation(("a", "b"), Rival::Confounded, &m, &m, &[], 200.0, 43e3);
         assert!(s.chi2.iter().all(|&(_, c)| c == 0.0), "{s:?}");
         assert_eq!(s.best(), None);
         assert_eq!(s.chi2.len(), CAMPAIGNS.len());
@@ -182,7 +237,7 @@ mod tests {
     #[test]
     fn only_a_warm_up_separates_a_thermal_drift() {
         let (a, b) = (generic(), with("thermal_drift=-4e-4"));
-        let s = separation(("none", "thermal_drift"), &a, &b, &[], 200.0, 43e3);
+        let s = separation(("none", "thermal_drift"), Rival::Confounded, &a, &b, &[], 200.0, 43e3);
         let get = |n: &str| s.chi2.iter().find(|(c, _)| *c == n).expect("campaign").1;
         assert!(get("warm-up") > 25.0, "{s:?}");
         for c in ["preload-torque", "frequency-sweep", "stability"] {

@@ -925,3 +925,31 @@ fn stated_sensor_noise_texts_are_read_or_refused_with_the_reason() {
     assert!(err(&["speed_rpm=1", "speed_rpm=2"]).contains("stated twice"));
     assert!(t(&[]).expect("none").is_empty());
 }
+
+/// The rivals whose separation from the lead is reported: every confounded effect, then
+/// the supported single effect with the most evidence after the lead's where it is
+/// within CLOSE_EVIDENCE of it; pairs, unsupported and distant effects never.
+#[test]
+fn a_rival_is_confounded_or_the_next_supported_single_close_in_evidence() {
+    use separation::{rivals, Rival, CLOSE_EVIDENCE};
+    let with = |e: &str, evidence: f64| RankEntry { evidence, ..ranked(e, 1.0, 0.1) };
+    let ranking = vec![
+        with("voltage_sag+eccentricity", 60.0),
+        with("voltage_sag", 50.0),
+        with("thermal_drift", 47.5),
+        with("radial_friction", 48.0),
+        with("eccentricity", 49.9),
+    ];
+    assert_eq!(
+        rivals(&ranking, "voltage_sag", &["eccentricity".to_string()]),
+        vec![("eccentricity".to_string(), Rival::Confounded), ("radial_friction".to_string(), Rival::CloseInEvidence)]
+    );
+    let pair = |behind: f64| vec![with("voltage_sag", 50.0), with("radial_friction", 50.0 - behind)];
+    assert_eq!(rivals(&pair(CLOSE_EVIDENCE - 0.01), "voltage_sag", &[]).len(), 1);
+    assert!(rivals(&pair(CLOSE_EVIDENCE), "voltage_sag", &[]).is_empty());
+    // not supported, however close
+    let weak = vec![with("voltage_sag", 1.0), with("radial_friction", -0.5)];
+    assert!(rivals(&weak, "voltage_sag", &[]).is_empty());
+    // a lead the ranking does not hold has no rivals
+    assert!(rivals(&ranking, "hertz_softening", &["eccentricity".to_string()]).is_empty());
+}
