@@ -47,11 +47,14 @@ impl Rival {
 /// effect in `confounded`, then the other single effect of `ranking` with the most
 /// evidence where it is supported (evidence > 0) and within [`CLOSE_EVIDENCE`]
 /// of the lead's evidence. Pairs are never rivals: a separation compares two fits of
-/// one effect each. Empty where `lead` is not in `ranking`.
+/// one effect each. Empty where `lead` is a pair or not in `ranking`.
 pub fn rivals(ranking: &[super::RankEntry], lead: &str, confounded: &[String]) -> Vec<(String, Rival)> {
     let Some(lead_evidence) = ranking.iter().find(|r| r.effect == lead).map(|r| r.evidence) else {
         return Vec::new();
     };
+    if lead.contains('+') {
+        return Vec::new();
+    }
     let mut out: Vec<(String, Rival)> = confounded.iter().map(|e| (e.clone(), Rival::Confounded)).collect();
     let runner_up = ranking
         .iter()

@@ -950,6 +950,8 @@ fn a_rival_is_confounded_or_the_next_supported_single_close_in_evidence() {
     // not supported, however close
     let weak = vec![with("voltage_sag", 1.0), with("radial_friction", -0.5)];
     assert!(rivals(&weak, "voltage_sag", &[]).is_empty());
+    // a pair verdict has none either, whatever trails it
+    assert!(rivals(&ranking, "voltage_sag+eccentricity", &[]).is_empty());
     // a lead the ranking does not hold has no rivals
     assert!(rivals(&ranking, "hertz_softening", &["eccentricity".to_string()]).is_empty());
 }
