@@ -16,19 +16,14 @@
 //! for about a tenth of the cost (docs/RELIABILITY.md, "Where 10^6 is out of reach").
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use trum_core::bench::observations;
 use trum_core::diagnose::{diagnose, DiagnoseOptions};
 use trum_core::effects::ALL;
-use trum_core::presets;
 
 #[path = "../common/diagnosis.rs"]
 mod diagnosis;
-#[path = "../common/rows.rs"]
-mod rows;
 
 fuzz_target!(|data: &[u8]| {
-    let motor = presets::find("generic60").expect("preset").motor();
-    let Some(m) = rows::small_rows(&motor, data) else { return };
+    let Some((motor, bench)) = diagnosis::small_case(data) else { return };
     let config = data[1];
     let mut candidates = Vec::new();
     for i in [config & 7, (config >> 3) & 7] {
@@ -38,7 +33,6 @@ fuzz_target!(|data: &[u8]| {
             }
         }
     }
-    let bench = observations(&m, &motor);
     let opts = DiagnoseOptions {
         folds: 2,
         candidates: candidates.clone(),
@@ -55,7 +49,7 @@ fuzz_target!(|data: &[u8]| {
                 "{name} not among {candidates:?}"
             );
         }
-        let v = doc["verdict"].as_str().expect("verdict");
+        let v = d.verdict.as_str();
         assert!(
             v == "none" || v == "unexplained" || v.split('+').all(|e| candidates.iter().any(|c| c.name() == e)),
             "{v} not among {candidates:?}"
