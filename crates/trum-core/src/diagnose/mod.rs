@@ -517,10 +517,11 @@ fn separating_campaigns(
 fn separation_note(s: &separation::Separation) -> Option<String> {
     let (campaign, chi2) = s.best()?;
     let relation = match s.rival {
-        separation::Rival::Confounded => "are not told apart by these data",
-        separation::Rival::CloseInEvidence => {
-            "are both supported and the data prefer the first only weakly (evidence less than 3 apart)"
-        }
+        separation::Rival::Confounded => String::from("are not told apart by these data"),
+        separation::Rival::CloseInEvidence => format!(
+            "are both supported and the data prefer the first only weakly (evidence less than {} apart)",
+            separation::CLOSE_EVIDENCE
+        ),
     };
     Some(format!(
         "{} and {} {relation} (their fits differ by χ² {} over the data's readings at the nominal bench noise of docs/SYNTH.md); a {campaign} campaign at the data's drive would separate them by χ² {} (`trum synth --campaign {campaign}` shows its operating points)",
