@@ -3,6 +3,7 @@
 //! fits themselves, and the gains a pair must show over the single it extends.
 
 use super::candidates::{sort_ranking, Fits, Nested, Scored, Scorer};
+use super::verdict::GapTests;
 use super::{signature, RankEntry};
 use crate::calibrate::Calibration;
 use crate::effects::Effect;
@@ -27,6 +28,7 @@ pub(super) fn fit_pairs(
     ranking: &mut Vec<RankEntry>,
     best_single: &Option<RankEntry>,
     single_closes: bool,
+    tests: &GapTests,
 ) -> (Vec<RankEntry>, Option<String>) {
     let ctx = scorer.ctx;
     let (rows, sc, n_read, noise_weights) = (&ctx.rows[..], &ctx.sc, ctx.n_read, ctx.noise_weights);
@@ -65,8 +67,9 @@ pub(super) fn fit_pairs(
     // A lead that closes the gap is beaten only by a pair that also removes PAIR_GAIN
     // of what it leaves beyond the noise on held-out data, in held-out χ² or in NRMSE
     // (`pair_beats_single`): Σ over readings of at least 1 − (1 − PAIR_GAIN)² of the
-    // excess. A second effect whose first-order in-sample gain at the lead's fit is
-    // below a quarter of that in both measures is not worth a pair fit either. The
+    // excess, and only in the measure the lead leaves a gap in where that is one
+    // ([`pair_need`]). A second effect whose first-order in-sample gain at the lead's fit
+    // is below a quarter of that in both measures is not worth a pair fit either. The
     // bound is empirical: held-out gains are in-sample gains less what the fit
     // overfits, where the held-out excess is of the in-sample one's order (here 39
     // against 29 per reading); the quarter allows for that and the first-order
@@ -81,7 +84,7 @@ pub(super) fn fit_pairs(
         best_single
             .as_ref()
             .filter(|b| single_closes && b.effect == lead.name())
-            .map(|b| held_out_need(b, n_read, noise_weights))
+            .map(|b| pair_need(tests, b, n_read, noise_weights))
     };
     let mut lead_starts: Vec<(Effect, Motor)> = Vec::new();
     let mut skipped_notes: Vec<String> = Vec::new();
@@ -215,6 +218,19 @@ pub(super) fn held_out_need(b: &RankEntry, n_read: usize, noise_nrmse: f64) -> (
     )
 }
 
+/// What a pair must remove on held-out data to beat the single `b` that closes the gap, as
+/// `verdict::decide` tests it: where `b` leaves part of the gap in one held-out measure
+/// only ([`GapTests::gap_in_one_measure`]), the [`held_out_need`] of that measure (the
+/// NRMSE's excess over the gap tests' noise) and nothing of the other; else both.
+pub(super) fn pair_need(tests: &GapTests, b: &RankEntry, n_read: usize, noise_nrmse: f64) -> (f64, f64) {
+    let (chi2, e2) = held_out_need(b, n_read, noise_nrmse);
+    match tests.gap_in_one_measure(b) {
+        Some(true) => (0.0, held_out_need(b, n_read, tests.gap_noise).1),
+        Some(false) => (chi2, 0.0),
+        None => (chi2, e2),
+    }
+}
+
 /// `x` to about three significant digits, for notes.
 pub(super) fn rounded(x: f64) -> String {
     match x.abs() {
@@ -249,13 +265,14 @@ pub(super) fn worth_pair_fit(
         Some((chi2, e2)) => {
             let (d_chi2, d_e2) = first_order_gains(c, rows, &s, sc);
             let worth = (chi2 > 0.0 && d_chi2 >= 0.25 * chi2) || (e2 > 0.0 && d_e2 >= 0.25 * e2);
-            let why = format!(
-                "Σz² {} < {} and Σe² {} < {}",
-                rounded(d_chi2),
-                rounded(0.25 * chi2),
-                rounded(d_e2),
-                rounded(0.25 * e2)
-            );
+            // Only the measures with a need are named: where the lead leaves one at the
+            // noise, a pair is not asked to gain in it (`pair_need`).
+            let why = [("Σz²", d_chi2, chi2), ("Σe²", d_e2, e2)]
+                .iter()
+                .filter(|(_, _, need)| *need > 0.0)
+                .map(|(name, gain, need)| format!("{name} {} < {}", rounded(*gain), rounded(0.25 * need)))
+                .collect::<Vec<_>>()
+                .join(" and ");
             (worth, if worth { String::new() } else { why })
         }
         None => (true, String::new()),

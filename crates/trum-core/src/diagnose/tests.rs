@@ -226,6 +226,10 @@ fn first_order_gains_are_what_the_refit_removes() {
     let (worth_it, why) =
         worth_pair_fit(Some(&base), &rows, Effect::RadialFriction, 10.0, Some((4.1 * d_chi2, 4.1 * d_e2)), &sc);
     assert!(!worth_it && why.starts_with("Σz² ") && why.contains(" and Σe² "), "{why}");
+    // a measure without a need is not named
+    let (worth_it, why) =
+        worth_pair_fit(Some(&base), &rows, Effect::RadialFriction, 10.0, Some((0.0, 4.1 * d_e2)), &sc);
+    assert!(!worth_it && why.starts_with("Σe² ") && !why.contains("Σz²"), "{why}");
 
     // the screen of pairs that lead nothing, with the baseline as the first effect's fit
     // (evidence 0): the pair must remove 2·best + ln n + 10 to beat a best single of
