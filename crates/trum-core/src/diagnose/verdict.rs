@@ -458,6 +458,37 @@ mod tests {
         BTreeMap::new()
     }
 
+    /// Held-out predictions k(σ/scale)·σ off each reading (σ its noise, scale its
+    /// quantity's), alternating in sign from reading to reading and row to row.
+    fn predictions_off(ctx: &Context, rows: &[ObservedRow], k: &dyn Fn(f64) -> f64) -> Vec<Vec<f64>> {
+        let sign = |i: usize| if i.is_multiple_of(2) { 1.0 } else { -1.0 };
+        let row = |(i, r): (usize, &ObservedRow)| {
+            r.readings.iter().enumerate().map(|(j, &(o, v, s))| v + sign(i + j) * k(s / ctx.sc[&o]) * s).collect()
+        };
+        rows.iter().enumerate().map(row).collect()
+    }
+
+    /// The entry of `effect` whose held-out predictions are `preds`, against a baseline
+    /// held-out NRMSE `base_nrmse`, with bootstrap intervals about its shrink.
+    fn entry_predicting(
+        ctx: &Context,
+        rows: &[ObservedRow],
+        preds: &[Vec<f64>],
+        effect: &str,
+        evidence: f64,
+        base_nrmse: f64,
+    ) -> RankEntry {
+        let (nrmse, z2, _, _) = errors(rows, preds, &ctx.sc);
+        let shrink = 1.0 - nrmse / base_nrmse;
+        RankEntry {
+            evidence,
+            shrink,
+            shrink_interval: (0.5 * shrink, 1.5 * shrink),
+            z2_shrink_interval: (0.5 * shrink, 1.5 * shrink),
+            ..ranked(effect, z2, nrmse)
+        }
+    }
+
     /// Two pairs extend a single that closes part of the gap: the one with the most
     /// evidence predicts the held-out data worse than the single, the other closes the gap
     /// there. The verdict is the second pair, complete.
@@ -467,29 +498,16 @@ mod tests {
         let (rows, groups) = data(&motor, 1.0, 3);
         let ctx = Context::new(&motor, &rows, &groups, &quick(false)).unwrap();
         // held-out predictions k σ off every reading, alternating in sign
-        let off = |k: f64| -> Vec<Vec<f64>> {
-            let sign = |i: usize| if i.is_multiple_of(2) { 1.0 } else { -1.0 };
-            let row = |(i, r): (usize, &ObservedRow)| {
-                r.readings.iter().enumerate().map(|(j, &(_, v, s))| v + sign(i + j) * k * s).collect()
-            };
-            rows.iter().enumerate().map(row).collect()
-        };
+        let off = |k: f64| predictions_off(&ctx, &rows, &|_| k);
         let (base_nrmse, base_z2, _, _) = errors(&rows, &off(4.0), &ctx.sc);
         let tests =
             GapTests { base_nrmse, gap_noise: errors(&rows, &off(1.0), &ctx.sc).0, base_z2, n_read: ctx.n_read };
         let mut cv_preds = BTreeMap::new();
         let mut fitted = |effect: &str, evidence: f64, k: f64| {
             let preds = off(k);
-            let (nrmse, z2, _, _) = errors(&rows, &preds, &ctx.sc);
+            let entry = entry_predicting(&ctx, &rows, &preds, effect, evidence, base_nrmse);
             cv_preds.insert(effect.to_string(), preds);
-            let shrink = 1.0 - nrmse / base_nrmse;
-            RankEntry {
-                evidence,
-                shrink,
-                shrink_interval: (0.5 * shrink, 1.5 * shrink),
-                z2_shrink_interval: (0.5 * shrink, 1.5 * shrink),
-                ..ranked(effect, z2, nrmse)
-            }
+            entry
         };
         let single = fitted("voltage_sag", 100.0, 2.5);
         let worse = fitted("voltage_sag+eccentricity", 300.0, 3.0);
@@ -523,13 +541,7 @@ mod tests {
         let (rows, groups) = data(&motor, 1.0, 3);
         let ctx = Context::new(&motor, &rows, &groups, &quick(false)).unwrap();
         // held-out predictions k(σ/scale)·σ off each reading, alternating in sign
-        let off = |k: &dyn Fn(f64) -> f64| -> Vec<Vec<f64>> {
-            let sign = |i: usize| if i.is_multiple_of(2) { 1.0 } else { -1.0 };
-            let row = |(i, r): (usize, &ObservedRow)| {
-                r.readings.iter().enumerate().map(|(j, &(o, v, s))| v + sign(i + j) * k(s / ctx.sc[&o]) * s).collect()
-            };
-            rows.iter().enumerate().map(row).collect()
-        };
+        let off = |k: &dyn Fn(f64) -> f64| predictions_off(&ctx, &rows, k);
         let mut ratios: Vec<f64> =
             rows.iter().flat_map(|r| r.readings.iter().map(|&(o, _, s)| s / ctx.sc[&o])).collect();
         ratios.sort_by(f64::total_cmp);
@@ -540,16 +552,9 @@ mod tests {
         let mut cv_preds = BTreeMap::new();
         let mut fitted = |effect: &str, evidence: f64, k: &dyn Fn(f64) -> f64| {
             let preds = off(k);
-            let (nrmse, z2, _, _) = errors(&rows, &preds, &ctx.sc);
+            let entry = entry_predicting(&ctx, &rows, &preds, effect, evidence, base_nrmse);
             cv_preds.insert(effect.to_string(), preds);
-            let shrink = 1.0 - nrmse / base_nrmse;
-            RankEntry {
-                evidence,
-                shrink,
-                shrink_interval: (0.5 * shrink, 1.5 * shrink),
-                z2_shrink_interval: (0.5 * shrink, 1.5 * shrink),
-                ..ranked(effect, z2, nrmse)
-            }
+            entry
         };
         let single = fitted("hertz_softening", 100.0, &|_| 1.3);
         // the readings whose noise is small against their quantity's scale weigh most in σ
