@@ -58,14 +58,20 @@ impl GapTests {
         (x * x - self.gap_noise * self.gap_noise).max(0.0).sqrt()
     }
 
-    /// The fraction of the held-out gap beyond the noise an entry closes.
-    pub(super) fn excess_shrink(&self, r: &RankEntry) -> f64 {
-        let before = self.beyond(self.base_nrmse);
+    /// The fraction of a held-out NRMSE's part beyond the noise that going from `before` to
+    /// `after` removes (0 where `before` is at the noise).
+    fn removed_beyond(&self, before: f64, after: f64) -> f64 {
+        let before = self.beyond(before);
         if before > 0.0 {
-            1.0 - self.beyond(r.heldout_nrmse_after) / before
+            1.0 - self.beyond(after) / before
         } else {
             0.0
         }
+    }
+
+    /// The fraction of the held-out gap beyond the noise an entry closes.
+    pub(super) fn excess_shrink(&self, r: &RankEntry) -> f64 {
+        self.removed_beyond(self.base_nrmse, r.heldout_nrmse_after)
     }
 
     /// Where a single effect that closes the gap leaves part of it in one held-out measure
@@ -81,12 +87,7 @@ impl GapTests {
     /// The fraction of what `single` leaves of the held-out NRMSE beyond the noise that
     /// `pair` removes (0 where the single leaves nothing beyond it).
     pub(super) fn excess_gain(&self, single: &RankEntry, pair: &RankEntry) -> f64 {
-        let before = self.beyond(single.heldout_nrmse_after);
-        if before > 0.0 {
-            1.0 - self.beyond(pair.heldout_nrmse_after) / before
-        } else {
-            0.0
-        }
+        self.removed_beyond(single.heldout_nrmse_after, pair.heldout_nrmse_after)
     }
 
     /// The fraction of the held-out mean z²'s excess over the noise an entry closes, on the
