@@ -60,7 +60,7 @@ budget_args() {
 budget_args "$BUDGET" >/dev/null
 ARGS=("$@")
 if [ ${#ARGS[@]} -eq 0 ]; then
-  ARGS=(motor_reader measurement_reader solver writers_round_trip calibrate diagnose diagnose_options)
+  ARGS=(motor_reader measurement_reader solver writers_round_trip calibrate diagnose diagnose_options diagnose_decision)
 fi
 TARGETS=()
 for a in "${ARGS[@]}"; do

@@ -30,6 +30,9 @@ mod bench;
 mod candidates;
 mod context;
 mod folds;
+// (built for the fuzz targets, and for its own test so it cannot drift from `diagnose`)
+#[cfg(any(fuzzing, test))]
+pub mod fuzzing;
 pub mod json;
 mod pairs;
 mod scan;
@@ -364,85 +367,25 @@ pub fn diagnose(
     notes.extend(probes.at_rest_note.clone());
 
     let tests = GapTests { base_nrmse: base.nrmse, gap_noise: base.noise_best, base_z2: base.z2, n_read: ctx.n_read };
-    // The gap is real when the baseline misses held-out data beyond twice the noise
-    // variance, with the noise levels at the upper end of their estimates (a level
-    // estimated low by chance raises every z²), or when some effect shows it
-    // ([`verdict::GapTests::shows_gap`]: closes a material part of a small, consistent gap).
-    let gap = base.z2_upper_noise > 2.0 || ranking.iter().any(|r| tests.shows_gap(r));
-    let mut decided = Verdict {
-        verdict: String::from("none"),
-        complete: true,
-        confounded: Vec::new(),
-        partial: None,
-        notes: Vec::new(),
-    };
-    let mut screened_note = None;
-    if gap {
-        let best_single = ranking.iter().find(|r| GapTests::supported(r)).cloned();
-        let single_closes = best_single.as_ref().is_some_and(|b| tests.closes(b));
-        // Pairs are tried when no single effect closes the gap, and also when one closes it
-        // but leaves part of it in one held-out measure or both (a mean z² > 2, or an NRMSE
-        // above what noise alone gives): another effect's signature in one quantity or
-        // corner of the data, and that second effect need not be supported on its own (the
-        // first one's gap dominates its single fit). Which second effects are worth a pair
-        // fit is screened by their score test at the lead's fit (`pairs`). A single that
-        // leaves the held-out data at the noise in both measures needs no partner: a
-        // verdict names two effects when both are needed to close the gap, and a second
-        // effect fitted there polishes the first one's form, which on a bench differs from
-        // every candidate's (with enough readings any form error is significant, so no test
-        // of the pair's gain can tell the two apart). Where the single leaves a gap in one
-        // measure only, the pair must close a third of it in that measure
-        // (`verdict::decide`): a gain in the measure already at the noise is such polish.
-        let single_at_noise = best_single
-            .as_ref()
-            .filter(|b| single_closes && (b.heldout_chi2_after <= 2.0 && b.heldout_nrmse_after <= base.noise_best));
-        if let Some(b) = single_at_noise {
-            notes.push(format!(
-                "no pair of effects tried: {} alone leaves the held-out data at the noise (mean squared normalised residual {:.2}, NRMSE {} against {} from noise alone), so a second effect is not needed",
-                b.effect,
-                b.heldout_chi2_after,
-                pairs::rounded(b.heldout_nrmse_after),
-                pairs::rounded(base.noise_best)
-            ));
-        }
-        let mut pairs = Vec::new();
-        if ctx.opts.try_pairs && ranking.len() >= 2 && single_at_noise.is_none() {
-            (pairs, screened_note) =
-                pairs::fit_pairs(&scorer, &mut fits, &mut ranking, &best_single, single_closes, &tests);
-        }
-        decided = verdict::decide(
-            &ctx,
-            &tests,
-            &mut ranking,
-            &fits.cv_preds,
-            best_single,
-            single_closes,
-            &pairs,
-            &probes.base_sigs,
-        );
-        notes.append(&mut decided.notes);
-        // (a single-effect verdict: the effects the whole data do not separate from it)
-        if Effect::from_name(&decided.verdict).is_ok() {
-            let z2: BTreeMap<String, Vec<f64>> = fits
-                .fits
+    let (mut decided, screened_note) = verdict::after_fits(
+        &ctx,
+        &tests,
+        base.z2_upper_noise,
+        &mut ranking,
+        &mut fits,
+        |fits, ranking, best_single, single_closes| {
+            pairs::fit_pairs(&scorer, fits, ranking, best_single, single_closes, &tests)
+        },
+        &probes.base_sigs,
+        |fits| {
+            fits.fits
                 .par_iter()
                 .filter(|(name, _)| Effect::from_name(name).is_ok())
                 .map(|(name, c)| (name.clone(), residuals(&c.motor, &ctx.rows).iter().map(|z| z * z).collect()))
-                .collect();
-            let one_frequency = span_of(&ctx.rows, |r| r.op.frequency_hz) < verdict::ONE_FREQUENCY_SPAN;
-            let alike = one_frequency.then(|| verdict::alike_at_one_frequency(&ranking, &decided.verdict)).flatten();
-            for e in verdict::inseparable(&ranking, &decided.verdict, &z2).into_iter().chain(alike) {
-                if !decided.confounded.contains(&e) {
-                    decided.confounded.push(e);
-                }
-            }
-        }
-    } else {
-        notes.push(format!(
-            "the calibrated baseline predicts the held-out regions at the noise level (mean squared normalised residual {:.2}; {:.2} with each quantity's noise level at the upper end of its estimate's 90 % interval) and no candidate effect is supported; no effect is needed",
-            base.z2, base.z2_upper_noise
-        ));
-    }
+                .collect()
+        },
+    );
+    notes.append(&mut decided.notes);
     let Verdict { verdict, complete, confounded, partial, .. } = decided;
     notes.extend(screened_note);
     let lead = partial.as_deref().filter(|_| verdict == "unexplained").unwrap_or(&verdict);
