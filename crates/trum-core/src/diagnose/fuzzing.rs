@@ -13,8 +13,8 @@ use super::candidates::{sort_ranking, Fits};
 use super::context::Context;
 use super::signature::Signature;
 use super::verdict::{self, GapTests};
-use super::{bench, DiagnoseOptions, RankEntry};
-use crate::effects::Effect;
+use super::{bench, same_set, DiagnoseOptions, RankEntry};
+use crate::effects::{Effect, ALL};
 use crate::error::TrumError;
 use crate::observable::ObservedRow;
 use crate::params::Motor;
@@ -120,6 +120,192 @@ pub fn decide(
     })
 }
 
+/// The bytes of a fuzz input after its rows, read one at a time (zeros once they run out).
+struct Bytes<'a>(std::slice::Iter<'a, u8>);
+
+impl Bytes<'_> {
+    fn byte(&mut self) -> u8 {
+        self.0.next().copied().unwrap_or(0)
+    }
+    fn unit(&mut self) -> f64 {
+        f64::from(self.byte()) / 255.0
+    }
+    /// 10^(lo + (hi − lo)·u): a positive figure over decades.
+    fn decades(&mut self, lo: f64, hi: f64) -> f64 {
+        10f64.powf(lo + (hi - lo) * self.unit())
+    }
+    /// A signed evidence, near the thresholds at 0 and 5 as often as far from them.
+    fn evidence(&mut self) -> f64 {
+        let b = self.byte();
+        let magnitude = if b & 1 == 0 { 10.0 * self.unit() } else { self.decades(0.0, 4.0) };
+        if b & 2 == 0 {
+            magnitude
+        } else {
+            -magnitude
+        }
+    }
+    /// A bootstrap interval around `x`.
+    fn interval(&mut self, x: f64) -> (f64, f64) {
+        let (lo, hi) = (0.5 * self.unit(), 0.5 * self.unit());
+        (x - lo, x + hi)
+    }
+    /// An entry named `effect` whose held-out figures follow from the baseline's
+    /// (`base_nrmse`, `base_z2`) as a fit's do: each shrink from its own figure.
+    fn entry(&mut self, effect: String, base_nrmse: f64, base_z2: f64) -> RankEntry {
+        let heldout_nrmse_after = base_nrmse * self.decades(-2.0, 0.3);
+        let heldout_chi2_after = base_z2 * self.decades(-2.0, 0.3);
+        let shrink = 1.0 - heldout_nrmse_after / base_nrmse;
+        let z2_shrink = 1.0 - (heldout_chi2_after / base_z2).sqrt();
+        RankEntry {
+            effect,
+            evidence: self.evidence(),
+            heldout_nrmse_after,
+            heldout_chi2_after,
+            shrink,
+            shrink_interval: self.interval(shrink),
+            z2_shrink_interval: self.interval(z2_shrink),
+            params: Vec::new(),
+            signature_match: None,
+            linear_chi2_drop: None,
+            signature_overlap: None,
+            heldout_in_sample_folds: 0,
+        }
+    }
+}
+
+/// The figures and options that `bytes` encode for `rows`: a configuration byte (bits 0-2
+/// the number of single effects drawn, 0-7, a repeat drawn once; bits 3-4 of pairs, 0-3;
+/// bits 5-6 the bootstrap draws, 0-12; bit 7 pairs tried), the baseline's gap (held-out
+/// NRMSE 1e-4-10, the noise 0-2 × it, mean z² 0.1-1000 and its upper value 1-4 × it), each
+/// entry's figures, held-out predictions within ±20 % of each reading (a pair's from its
+/// lead's, below), full-data z² of
+/// 0-16 a reading, and signatures in [−1, 1]. A pair whose first effect is among the
+/// singles has that single's evidence added to its own draw.
+pub fn case_from_bytes(rows: &[ObservedRow], bytes: &[u8]) -> (FittedFigures, DiagnoseOptions) {
+    let readings: Vec<Vec<f64>> = rows.iter().map(|r| r.readings.iter().map(|x| x.1).collect()).collect();
+    let n_read: usize = readings.iter().map(Vec::len).sum();
+    let mut b = Bytes(bytes.iter());
+    let config = b.byte();
+    let base_nrmse = b.decades(-4.0, 1.0);
+    let gap_noise = base_nrmse * 2.0 * b.unit();
+    let base_z2 = b.decades(-1.0, 3.0);
+    let z2_upper_noise = base_z2 * (1.0 + 3.0 * b.unit());
+    let mut f = FittedFigures { base_nrmse, gap_noise, base_z2, z2_upper_noise, ..FittedFigures::default() };
+    for _ in 0..config % 8 {
+        let e = ALL[usize::from(b.byte()) % ALL.len()];
+        if !f.singles.iter().any(|r| r.effect == e.name()) {
+            let r = b.entry(e.name().to_string(), base_nrmse, base_z2);
+            f.singles.push(r);
+        }
+    }
+    for _ in 0..(config >> 3) % 4 {
+        let (i, j) = (usize::from(b.byte()) % ALL.len(), usize::from(b.byte()) % ALL.len());
+        let name = format!("{}+{}", ALL[i].name(), ALL[j].name());
+        if i != j && !f.pairs.iter().any(|p| same_set(&p.effect, &name)) {
+            let mut r = b.entry(name, base_nrmse, base_z2);
+            // a pair nests its lead: its evidence is the lead's and what the second adds
+            if let Some(lead) = f.singles.iter().find(|s| s.effect == ALL[i].name()) {
+                r.evidence += lead.evidence;
+            }
+            f.pairs.push(r);
+        }
+    }
+    let names: Vec<String> = f.singles.iter().map(|r| r.effect.clone()).collect();
+    for name in names {
+        let preds =
+            readings.iter().map(|row| row.iter().map(|v| v * (1.0 + 0.4 * (b.unit() - 0.5))).collect()).collect();
+        f.cv_preds.insert(name, preds);
+    }
+    // a pair's predictions: its lead's moved towards the readings or away from them (a
+    // factor 0-1.5 of the lead's errors), or of its own where its lead is not drawn
+    let pairs: Vec<String> = f.pairs.iter().map(|r| r.effect.clone()).collect();
+    for name in pairs {
+        let lead = name.split('+').next().and_then(|l| f.cv_preds.get(l)).cloned();
+        let preds = match lead {
+            Some(lead) => {
+                let t = 1.5 * b.unit();
+                let row = |(m, p): (&Vec<f64>, &Vec<f64>)| m.iter().zip(p).map(|(v, y)| v + t * (y - v)).collect();
+                readings.iter().zip(&lead).map(row).collect()
+            }
+            None => {
+                readings.iter().map(|row| row.iter().map(|v| v * (1.0 + 0.4 * (b.unit() - 0.5))).collect()).collect()
+            }
+        };
+        f.cv_preds.insert(name, preds);
+    }
+    let singles: Vec<String> = f.singles.iter().map(|r| r.effect.clone()).collect();
+    for name in singles {
+        f.z2.insert(name.clone(), (0..n_read).map(|_| (4.0 * b.unit()).powi(2)).collect());
+        if let Ok(e) = Effect::from_name(&name) {
+            f.signatures.insert(e, (0..n_read).map(|_| 2.0 * b.unit() - 1.0).collect());
+        }
+    }
+    let opts = DiagnoseOptions {
+        bootstrap: usize::from((config >> 5) & 3) * 4,
+        try_pairs: config & 128 != 0,
+        ..DiagnoseOptions::default()
+    };
+    (f, opts)
+}
+
+/// Asserts what a decision `d` from the figures `f` must hold, whatever the figures: `none`
+/// only without a gap (the upper mean z² at most 2), with nothing confounded or partial and
+/// no pairs tried; `unexplained` incomplete, with the best supported single as `partial`;
+/// a single verdict a supported single given; a pair verdict one of the pairs given,
+/// supported, more than 5 ahead of the best supported single in evidence and no worse on
+/// held-out data, its stronger effect first, nothing confounded or partial; confounded
+/// effects singles given with evidence above 5, never the verdict, none twice; the ranking
+/// the singles plus the pairs where pairs were tried. Panics with the decision otherwise.
+pub fn assert_properties(f: &FittedFigures, d: &Decision) {
+    let mut sorted = f.singles.clone();
+    sort_ranking(&mut sorted);
+    let best_single = sorted.into_iter().find(GapTests::supported);
+    let single = |n: &str| f.singles.iter().find(|r| r.effect == n);
+    let v = d.verdict.as_str();
+    match v {
+        "none" => {
+            assert!(f.z2_upper_noise <= 2.0, "none with a gap: {d:?}");
+            assert!(d.complete && d.confounded_with.is_empty() && d.partial.is_none(), "{d:?}");
+            assert!(!d.pairs_tried, "pairs tried without a gap: {d:?}");
+        }
+        "unexplained" => {
+            assert!(!d.complete, "{d:?}");
+            assert_eq!(d.partial, best_single.as_ref().map(|b| b.effect.clone()), "{d:?}");
+        }
+        _ if !v.contains('+') => {
+            let r = single(v).unwrap_or_else(|| panic!("{v} not a single given: {d:?}"));
+            assert!(GapTests::supported(r), "{v} not supported: {d:?}");
+            assert!(d.partial.is_none(), "{d:?}");
+        }
+        _ => {
+            assert!(d.pairs_tried, "{d:?}");
+            let p = f.pairs.iter().find(|p| same_set(&p.effect, v));
+            let p = p.unwrap_or_else(|| panic!("{v} not a pair given: {d:?}"));
+            assert!(GapTests::supported(p), "{v} not supported: {d:?}");
+            if let Some(s) = &best_single {
+                assert!(p.evidence > s.evidence + 5.0, "{v} not ahead of {}: {d:?}", s.effect);
+                assert!(p.heldout_nrmse_after <= s.heldout_nrmse_after, "{v} worse than {}: {d:?}", s.effect);
+                assert!(p.heldout_chi2_after <= s.heldout_chi2_after, "{v} worse than {}: {d:?}", s.effect);
+            }
+            let ev = |n: &str| single(n).map_or(f64::NEG_INFINITY, |r| r.evidence);
+            let names: Vec<&str> = v.split('+').collect();
+            assert!(ev(names[0]) >= ev(names[1]), "{v}: the weaker effect first: {d:?}");
+            assert!(d.confounded_with.is_empty() && d.partial.is_none(), "{d:?}");
+        }
+    }
+    for c in &d.confounded_with {
+        assert!(c != v && !c.contains('+'), "{c} confounded with {v}");
+        let r = single(c).unwrap_or_else(|| panic!("{c} not a single given: {d:?}"));
+        assert!(r.evidence > 5.0, "{c} confounded with {v} without support: {d:?}");
+    }
+    let mut seen = d.confounded_with.clone();
+    seen.sort();
+    seen.dedup();
+    assert_eq!(seen.len(), d.confounded_with.len(), "a confounded effect twice: {d:?}");
+    let expected = f.singles.len() + if d.pairs_tried { f.pairs.len() } else { 0 };
+    assert_eq!(d.ranking.len(), expected, "{d:?}");
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
@@ -151,5 +337,27 @@ mod tests {
         assert_eq!((d.verdict.as_str(), d.complete, d.pairs_tried, d.ranking.len()), ("voltage_sag", true, true, 3));
         assert_eq!(d.ranking[0].effect, "voltage_sag", "sorted by evidence");
         assert!(d.confounded_with.is_empty(), "eccentricity is 80 behind in evidence: {:?}", d.confounded_with);
+    }
+
+    /// The properties of the decision stage on figures drawn as the fuzz target draws them
+    /// (`case_from_bytes`), on stable Rust in every test run; the coverage-guided target
+    /// searches the same space at 10^6 executions.
+    #[test]
+    fn decisions_on_any_figures_keep_their_rules() {
+        let motor = crate::calibrate::tests::reference_motor();
+        let (rows, groups) = data(&motor, 1.0, 3);
+        let cfg = proptest::test_runner::Config { cases: 4096, ..Default::default() };
+        // (half the cases with pairs tried and three given, where random bytes seldom reach
+        // a pair verdict: the rules a pair must pass are most of the stage)
+        let bytes = proptest::collection::vec(proptest::num::u8::ANY, 0..600);
+        proptest::proptest!(cfg, |(mut bytes in bytes, with_pairs in proptest::bool::ANY)| {
+            if let (Some(c), true) = (bytes.first_mut(), with_pairs) {
+                *c |= 0b1001_1000;
+            }
+            let (figures, opts) = case_from_bytes(&rows, &bytes);
+            let d = decide(&motor, &rows, &groups, &opts, figures.clone()).unwrap();
+            assert_properties(&figures, &d);
+            assert_eq!(decide(&motor, &rows, &groups, &opts, figures.clone()).unwrap(), d, "not deterministic");
+        });
     }
 }
