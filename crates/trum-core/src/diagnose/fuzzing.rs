@@ -1,5 +1,6 @@
-//! The diagnosis' decision stage on its own, for coverage-guided fuzzing (built only with
-//! `--cfg fuzzing`, which cargo-fuzz sets; never part of the public interface).
+//! The diagnosis' decision stage on its own, for coverage-guided fuzzing (built with
+//! `--cfg fuzzing`, which cargo-fuzz sets, and for the crate's tests; never part of the
+//! public interface).
 //!
 //! A whole diagnosis of a few rows costs 0.05-1 s, almost all of it in the fits, so a
 //! fuzzer reaches the rules that turn fitted figures into a verdict only a few times a
