@@ -319,7 +319,7 @@ fn settle_with(
                     // |G'| ≥ JUMP_RESIDUAL / JUMP_WIDTH there: G jumps (as below), unsettled.
                     break;
                 }
-                if bracket.width().is_some_and(|w| w <= 1e-12 * scale.max(x.abs())) {
+                if bracket.width().is_some_and(|w| w <= 1e-12 * tol) {
                     // The sign change has shrunk to a point without the residual vanishing
                     // to the tolerance. Where the residual is still large, G jumps there
                     // (the stator clamps or the rotor stalls on one side and moves on the
@@ -333,7 +333,7 @@ fn settle_with(
                     // with a 150 Ω sag at 640 N, 0.075 N·m, 194 V, 41.56 kHz), and where
                     // G is steep (|G'| ~ 1e4) the tolerance is below x's own rounding.
                     // Settled.
-                    settled = (x - gx).abs() <= 1e-9 * scale.max(x.abs());
+                    settled = (x - gx).abs() <= 1e-9 * tol;
                     break;
                 }
                 if let Some(x) = bracket.regula_falsi() {
@@ -695,8 +695,8 @@ const BRACKET_AFTER: usize = 30;
 /// Swings of the passes between a clamped and a moving stator after which they switch to
 /// regula falsi before [`BRACKET_AFTER`]: passes that swing so are crossing a jump of G (the
 /// stator clamps on one side of it), around which the secant steps cycle without closing
-/// in (a 1074 Ω sag at 263 N, 0.06 N·m, 200 V cycled 133.2 → 125.2 → 105.2 → 118.9 →
-/// 133.2 V for 30 passes). Four swings are two such cycles; where a fixed point lies
+/// in (a calibrated ring motor with a 1074 Ω sag at 263 N, 0.06 N·m, 200 V: 133.2 → 125.2 →
+/// 105.2 → 118.9 → 133.2 V, again and again). Four swings are two such cycles; where a fixed point lies
 /// between the two states after all, regula falsi inside the sign change finds it too.
 const JUMP_SWINGS: usize = 4;
 
