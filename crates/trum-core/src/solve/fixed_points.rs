@@ -276,16 +276,18 @@ fn settle_with(
     // (x, G(x)) of the previous pass, for the temperature rise and the electrode voltage
     let mut last_pass: Option<((f64, f64), (f64, f64))> = None;
     // With one of the two effects on, the residual x − G(x) of its scalar is watched for a
-    // sign change; passes that have not settled after BRACKET_AFTER, or that have swung
-    // between a clamped and a moving stator JUMP_SWINGS times, switch to regula falsi
+    // sign change; passes that have not settled after BRACKET_AFTER, or whose state has
+    // changed kind (clamped, stalled, running) JUMP_SWINGS times, switch to regula falsi
     // inside the latest sign change.
     let mut bracket = SignBracket::default();
+    // (the status of the state and its unhalved |x − G(x)| at the latest point on either
+    // side of the sign change: below zero, above it)
+    let mut ends: [Option<(Status, f64)>; 2] = [None, None];
     let scale = if thermal { 1.0 } else { op.voltage_v };
-    let (mut swings, mut was_clamped) = (0usize, s.status == Status::Clamped);
+    let (mut swings, mut was) = (0usize, s.status);
     for pass in 0..100 {
-        let clamped = s.status == Status::Clamped;
-        swings += usize::from(clamped != was_clamped);
-        was_clamped = clamped;
+        swings += usize::from(s.status != was);
+        was = s.status;
         let (mut new_rise, mut new_v) = (rise, d.v);
         if thermal {
             new_rise = temperature_rise_for_drift(p, s.total_loss_w(), op.elapsed_s);
@@ -312,11 +314,26 @@ fn settle_with(
             let (x, gx) = if thermal { (rise, new_rise) } else { (d.v, new_v) };
             let bracketing = pass >= BRACKET_AFTER || swings >= JUMP_SWINGS;
             bracket.record(x, x - gx, bracketing);
+            if x.is_finite() && (x - gx).is_finite() && x != gx {
+                ends[usize::from(x > gx)] = Some((s.status, (x - gx).abs()));
+            }
             if bracketing {
                 let tol = scale.max(x.abs());
                 if bracket.width().is_some_and(|w| w <= JUMP_WIDTH * tol) && (x - gx).abs() >= JUMP_RESIDUAL * tol {
                     // A residual this large at one end of so narrow a sign change needs
                     // |G'| ≥ JUMP_RESIDUAL / JUMP_WIDTH there: G jumps (as below), unsettled.
+                    break;
+                }
+                // States of different kinds (clamped, stalled, running) at the two ends of
+                // the sign change, each with a large residual: the branch changes inside it,
+                // where G jumps unless it is steep across the change. Bisection locates a
+                // jump at a step a pass (regula falsi, its ends' residuals never shrinking,
+                // takes about one and a half), and a jump is proven at a coarser width.
+                let across = match ends {
+                    [Some((a, ra)), Some((b, rb))] => a != b && ra.min(rb) >= JUMP_RESIDUAL * tol,
+                    _ => false,
+                };
+                if across && bracket.width().is_some_and(|w| w <= KIND_JUMP_WIDTH * tol) {
                     break;
                 }
                 if bracket.width().is_some_and(|w| w <= 1e-12 * tol) {
@@ -336,7 +353,11 @@ fn settle_with(
                     settled = (x - gx).abs() <= 1e-9 * tol;
                     break;
                 }
-                if let Some(x) = bracket.regula_falsi() {
+                let step = match (across, bracket.neg, bracket.pos) {
+                    (true, Some((a, _)), Some((b, _))) => Some(0.5 * (a + b)),
+                    _ => bracket.regula_falsi(),
+                };
+                if let Some(x) = step {
                     if thermal {
                         next.0 = x;
                     } else {
@@ -692,10 +713,10 @@ pub(crate) fn state_map(
 /// change of x − G(x). Normal points settle within ~15 passes and never reach it.
 const BRACKET_AFTER: usize = 30;
 
-/// Swings of the passes between a clamped and a moving stator after which they switch to
-/// regula falsi before [`BRACKET_AFTER`]: passes that swing so are crossing a jump of G (the
-/// stator clamps on one side of it), around which the secant steps cycle without closing
-/// in (a calibrated ring motor with a 1074 Ω sag at 263 N, 0.06 N·m, 200 V: 133.2 → 125.2 →
+/// Swings of the passes between states of different kinds (a clamped stator, a stalled
+/// rotor, a running one) after which they switch to regula falsi before [`BRACKET_AFTER`]:
+/// passes that swing so are crossing a jump of G (the stator clamps or the rotor stalls on
+/// one side of it), around which the secant steps cycle without closing in (a calibrated ring motor with a 1074 Ω sag at 263 N, 0.06 N·m, 200 V: 133.2 → 125.2 →
 /// 105.2 → 118.9 → 133.2 V, again and again). Four swings are two such cycles; where a fixed point lies
 /// between the two states after all, regula falsi inside the sign change finds it too.
 const JUMP_SWINGS: usize = 4;
@@ -706,6 +727,12 @@ const JUMP_SWINGS: usize = 4;
 /// passes otherwise narrow to (the residual left there, up to |G'|·1e-12, above the 1e-9
 /// that settles), about seven passes later.
 const JUMP_WIDTH: f64 = 1e-7;
+
+/// Width of a sign change of x − G(x), relative to the scalar's scale, below which states
+/// of different kinds at its two ends (clamped, stalled, running), each with a residual of
+/// at least [`JUMP_RESIDUAL`], show a jump of G: a continuous G would fall there with a
+/// slope below −19 while the branch changes.
+const KIND_JUMP_WIDTH: f64 = 1e-4;
 
 /// Residual |x − G(x)|, relative to the scalar's scale, that [`JUMP_WIDTH`] judges.
 const JUMP_RESIDUAL: f64 = 1e-3;
