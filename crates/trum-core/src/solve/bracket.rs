@@ -40,10 +40,19 @@ impl SignBracket {
         Some((self.pos?.0 - self.neg?.0).abs())
     }
 
+    /// The middle of the sign change; `None` before it has two ends.
+    pub(crate) fn midpoint(&self) -> Option<f64> {
+        Some(0.5 * (self.neg?.0 + self.pos?.0))
+    }
+
     pub(crate) fn regula_falsi(&self) -> Option<f64> {
         let ((a, ha), (b, hb)) = (self.neg?, self.pos?);
         let x = a - ha * (b - a) / (hb - ha);
-        Some(if x.is_finite() && (x - a) * (x - b) < 0.0 { x } else { 0.5 * (a + b) })
+        if x.is_finite() && (x - a) * (x - b) < 0.0 {
+            Some(x)
+        } else {
+            self.midpoint()
+        }
     }
 }
 

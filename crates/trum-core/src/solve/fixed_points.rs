@@ -278,7 +278,7 @@ fn settle_with(
     // With one of the two effects on, the residual x − G(x) of its scalar is watched for a
     // sign change; passes that have not settled after BRACKET_AFTER, or whose state has
     // changed kind (clamped, stalled, running) JUMP_SWINGS times, switch to regula falsi
-    // inside the latest sign change.
+    // (or bisection, below) inside the latest sign change.
     let mut bracket = SignBracket::default();
     // (the status of the state and its unhalved |x − G(x)| at the latest point on either
     // side of the sign change: below zero, above it)
@@ -326,9 +326,10 @@ fn settle_with(
                 }
                 // States of different kinds (clamped, stalled, running) at the two ends of
                 // the sign change, each with a large residual: the branch changes inside it,
-                // where G jumps unless it is steep across the change. Bisection locates a
-                // jump at a step a pass (regula falsi, its ends' residuals never shrinking,
-                // takes about one and a half), and a jump is proven at a coarser width.
+                // where G jumps unless it is steep across the change. Bisection halves the
+                // sign change every pass, where regula falsi, whose ends' residuals do not
+                // shrink at a jump, narrows it more slowly, and a jump is proven at a
+                // coarser width.
                 let across = match ends {
                     [Some((a, ra)), Some((b, rb))] => a != b && ra.min(rb) >= JUMP_RESIDUAL * tol,
                     _ => false,
@@ -353,10 +354,7 @@ fn settle_with(
                     settled = (x - gx).abs() <= 1e-9 * tol;
                     break;
                 }
-                let step = match (across, bracket.neg, bracket.pos) {
-                    (true, Some((a, _)), Some((b, _))) => Some(0.5 * (a + b)),
-                    _ => bracket.regula_falsi(),
-                };
+                let step = if across { bracket.midpoint() } else { bracket.regula_falsi() };
                 if let Some(x) = step {
                     if thermal {
                         next.0 = x;
@@ -716,8 +714,9 @@ const BRACKET_AFTER: usize = 30;
 /// Swings of the passes between states of different kinds (a clamped stator, a stalled
 /// rotor, a running one) after which they switch to regula falsi before [`BRACKET_AFTER`]:
 /// passes that swing so are crossing a jump of G (the stator clamps or the rotor stalls on
-/// one side of it), around which the secant steps cycle without closing in (a calibrated ring motor with a 1074 Ω sag at 263 N, 0.06 N·m, 200 V: 133.2 → 125.2 →
-/// 105.2 → 118.9 → 133.2 V, again and again). Four swings are two such cycles; where a fixed point lies
+/// one side of it), around which the secant steps cycle without closing in (a calibrated
+/// ring motor with a 1074 Ω sag at 263 N, 0.06 N·m, 200 V: 133.2 → 125.2 → 105.2 → 118.9
+/// → 133.2 V, again and again). Four swings are two such cycles; where a fixed point lies
 /// between the two states after all, regula falsi inside the sign change finds it too.
 const JUMP_SWINGS: usize = 4;
 
