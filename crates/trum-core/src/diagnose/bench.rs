@@ -247,11 +247,10 @@ fn quantum(v: &[f64]) -> Option<f64> {
     None
 }
 
-/// Rows whose reading noise levels include the rounding error of quantised columns
-/// (σ² + q²/12), and a note naming them (`None` when no column is quantised more
-/// coarsely than its noise).
-pub fn account_for_quantisation(rows: &[ObservedRow]) -> (Vec<ObservedRow>, Option<String>) {
-    let mut out = rows.to_vec();
+/// `rows` with the noise level of every reading of a quantised column raised by the
+/// rounding error (σ² + q²/12), in place (a large file's rows are held once), and a note
+/// naming those columns (`None` when no column is quantised more coarsely than its noise).
+pub fn account_for_quantisation(mut rows: Vec<ObservedRow>) -> (Vec<ObservedRow>, Option<String>) {
     let mut seen = Vec::new();
     for o in Observable::ALL {
         let v: Vec<f64> = rows.iter().flat_map(|r| &r.readings).filter(|x| x.0 == o).map(|x| x.1).collect();
@@ -262,7 +261,7 @@ pub fn account_for_quantisation(rows: &[ObservedRow]) -> (Vec<ObservedRow>, Opti
         if q * q / 12.0 < 0.01 * mean_sigma * mean_sigma {
             continue;
         }
-        for r in out.iter_mut() {
+        for r in rows.iter_mut() {
             for x in r.readings.iter_mut().filter(|x| x.0 == o) {
                 x.2 = (x.2 * x.2 + q * q / 12.0).sqrt();
             }
@@ -272,7 +271,7 @@ pub fn account_for_quantisation(rows: &[ObservedRow]) -> (Vec<ObservedRow>, Opti
     let note = (!seen.is_empty()).then(|| {
         format!("quantised readings: their rounding error (step²/12) is added to the noise levels: {}", seen.join(", "))
     });
-    (out, note)
+    (rows, note)
 }
 
 #[cfg(test)]
@@ -463,7 +462,7 @@ mod tests {
                 r
             })
             .collect();
-        let (out, note) = account_for_quantisation(&rows);
+        let (out, note) = account_for_quantisation(rows);
         assert!(note.expect("note").contains("speed_rpm (step 1)"));
         let s = out[0].readings[0].2;
         assert!((s - (0.09f64 + 1.0 / 12.0).sqrt()).abs() < 1e-12, "σ {s}");
@@ -475,6 +474,6 @@ mod tests {
                 r
             })
             .collect();
-        assert!(account_for_quantisation(&fine).1.is_none());
+        assert!(account_for_quantisation(fine).1.is_none());
     }
 }

@@ -64,6 +64,8 @@ impl<'a> Context<'a> {
         // The bench model first: set points read back with noise are taken at their run's
         // mean, quantised readings carry their rounding error (`bench`).
         let (unscaled, mut bench_notes) = bench_model(&stated, groups);
+        // (a large file's rows are held by the caller and once here, not once per stage)
+        drop(stated);
         // Noise levels from the data, so that χ² and the evidence are on the scale of the
         // actual noise; clamped to [1/4, 4] × the default levels. A level the user states
         // is kept as stated: the estimate is reported beside it.
@@ -290,7 +292,7 @@ pub(super) fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
 /// the notes saying what was done.
 pub(super) fn bench_model(rows: &[ObservedRow], groups: &[String]) -> (Vec<ObservedRow>, Vec<String>) {
     let (snapped, snap_note) = bench::snap_set_points(rows, groups);
-    let (out, quantum_note) = bench::account_for_quantisation(&snapped);
+    let (out, quantum_note) = bench::account_for_quantisation(snapped);
     (out, snap_note.into_iter().chain(quantum_note).collect())
 }
 
@@ -298,10 +300,10 @@ pub(super) fn bench_model(rows: &[ObservedRow], groups: &[String]) -> (Vec<Obser
 /// `absolute + relative · |reading|`. Errors on a part that is negative or not finite, and
 /// on an absolute part of zero (a reading of zero would have no noise and weigh
 /// infinitely).
-fn with_stated_noise(
-    rows: &[ObservedRow],
+fn with_stated_noise<'r>(
+    rows: &'r [ObservedRow],
     stated: &BTreeMap<Observable, (f64, f64)>,
-) -> Result<Vec<ObservedRow>, TrumError> {
+) -> Result<std::borrow::Cow<'r, [ObservedRow]>, TrumError> {
     for (o, &(a, r)) in stated {
         let ok = a.is_finite() && r.is_finite() && a > 0.0 && r >= 0.0;
         if !ok {
@@ -310,6 +312,9 @@ fn with_stated_noise(
                 o.column()
             )));
         }
+    }
+    if stated.is_empty() {
+        return Ok(std::borrow::Cow::Borrowed(rows));
     }
     Ok(rows
         .iter()
