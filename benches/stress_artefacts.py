@@ -7,7 +7,7 @@ every parameter perturbed as in the blind benchmark) that this script then alter
 bench would: gains of the speed, torque, power, feedback, current or voltage readings, a
 zero offset of the preload reading, read-back noise of the preload or the frequency, a quantised torque, an offset or a lag of the temperature sensor,
 heavy-tailed speed noise, cells left empty, noise three times the nominal, noise that is
-all absolute or all relative. Null cases
+all absolute or all relative, noise correlated within runs. Null cases
 must come out `none`; effect cases (each effect at about twice its typical strength in
 its first truth form, with two artefacts drawn at random and the development half's own)
 should name the effect. The cases are a development set: the diagnosis was changed after
@@ -140,6 +140,35 @@ def noise_shape(levels):
     return apply
 
 
+def correlated_noise(phi):
+    """Gaussian noise of the simulator's default levels (an absolute floor plus a relative
+    part, `DEFAULT_LEVELS`) that is serially correlated within each run, in row order: a
+    first-order autoregression with coefficient `phi` and the same marginal standard
+    deviation (at 0.95 mostly a random offset per run, as where a run's mounting or layer
+    state differs from the next one's). Applied to readings synthesised without noise."""
+
+    def apply(rows, rng):
+        runs = {}
+        for row in rows:
+            runs.setdefault(row.get("run_id", ""), []).append(row)
+        for column, (a, r) in DEFAULT_LEVELS.items():
+            top = 1.0 if column == "efficiency" else math.inf
+            for run in runs.values():
+                e = rng.gauss(0.0, 1.0)
+                for row in run:
+                    if row.get(column, "") == "":
+                        continue
+                    v = float(row[column])
+                    e = phi * e + math.sqrt(1.0 - phi * phi) * rng.gauss(0.0, 1.0)
+                    row[column] = repr(min(top, max(0.0, v + (a + r * abs(v)) * e)))
+
+    return apply
+
+
+# the diagnosis' default noise levels (docs/DIAGNOSIS.md, "Noise levels from the data")
+DEFAULT_LEVELS = {"speed_rpm": (0.5, 0.01), "input_power_w": (0.05, 0.02), "current_a": (0.002, 0.015),
+                  "efficiency": (0.005, 0.03), "feedback_v": (0.2, 0.01)}
+
 # every reading's noise absolute (a bench whose instruments have a fixed resolution), or
 # relative (gains of the instruments' ranges), where the simulator and the diagnosis's
 # default levels have both parts
@@ -152,7 +181,8 @@ RELATIVE = {"speed_rpm": (0.0, 0.012), "input_power_w": (0.0, 0.015), "current_a
 
 # artefacts of their own cases only (the effect cases of every effect draw theirs from
 # ARTEFACTS)
-NULL_ONLY = {"temp_lag": sensor_lag(30.0), "abs_noise": noise_shape(ABSOLUTE), "rel_noise": noise_shape(RELATIVE)}
+NULL_ONLY = {"temp_lag": sensor_lag(30.0), "abs_noise": noise_shape(ABSOLUTE), "rel_noise": noise_shape(RELATIVE),
+             "ar_0.8": correlated_noise(0.8), "ar_0.95": correlated_noise(0.95)}
 
 EFFECTS = {
     "radial_friction": "radial_friction=2",
@@ -202,6 +232,13 @@ def cases():
             seed += 1
             out.append((f"{effect}_{art}_{campaign}", effect, [art], campaign, seed, EFFECTS[effect], 1,
                         ["--artefacts", DEV_ARTEFACTS]))
+    # noise correlated within runs, on readings synthesised without noise (kept apart, with
+    # seeds of their own, so the other cases keep their draws)
+    seed = 7400
+    for art in ("ar_0.8", "ar_0.95"):
+        for campaign in ("preload-torque", "combined"):
+            seed += 1
+            out.append((f"null_{art}_{campaign}", "none", [art], campaign, seed, None, 0, []))
     rng = random.Random(11)
     seed = 8100
     for effect, arg in EFFECTS.items():
