@@ -140,12 +140,13 @@ def noise_shape(levels):
     return apply
 
 
-def correlated_noise(phi):
+def correlated_noise(phi, scale=1.0):
     """Gaussian noise of the simulator's default levels (an absolute floor plus a relative
     part, `DEFAULT_LEVELS`) that is serially correlated within each run, in row order: a
     first-order autoregression with coefficient `phi` and the same marginal standard
     deviation (at 0.95 mostly a random offset per run, as where a run's mounting or layer
-    state differs from the next one's). Applied to readings synthesised without noise."""
+    state differs from the next one's), times `scale`. Applied to readings synthesised
+    without noise."""
 
     def apply(rows, rng):
         runs = {}
@@ -160,7 +161,7 @@ def correlated_noise(phi):
                         continue
                     v = float(row[column])
                     e = phi * e + math.sqrt(1.0 - phi * phi) * rng.gauss(0.0, 1.0)
-                    row[column] = repr(min(top, max(0.0, v + (a + r * abs(v)) * e)))
+                    row[column] = repr(min(top, max(0.0, v + scale * (a + r * abs(v)) * e)))
 
     return apply
 
@@ -182,7 +183,8 @@ RELATIVE = {"speed_rpm": (0.0, 0.012), "input_power_w": (0.0, 0.015), "current_a
 # artefacts of their own cases only (the effect cases of every effect draw theirs from
 # ARTEFACTS)
 NULL_ONLY = {"temp_lag": sensor_lag(30.0), "abs_noise": noise_shape(ABSOLUTE), "rel_noise": noise_shape(RELATIVE),
-             "ar_0.8": correlated_noise(0.8), "ar_0.95": correlated_noise(0.95)}
+             "ar_0.8": correlated_noise(0.8), "ar_0.95": correlated_noise(0.95),
+             "ar_0.95_low": correlated_noise(0.95, 0.6)}
 
 EFFECTS = {
     "radial_friction": "radial_friction=2",
@@ -239,6 +241,10 @@ def cases():
         for campaign in ("preload-torque", "combined"):
             seed += 1
             out.append((f"null_{art}_{campaign}", "none", [art], campaign, seed, None, 0, []))
+    for campaign in ("preload-torque", "combined"):
+        for _ in range(3):
+            seed += 1
+            out.append((f"null_ar_0.95_low_{campaign}_{seed}", "none", ["ar_0.95_low"], campaign, seed, None, 0, []))
     rng = random.Random(11)
     seed = 8100
     for effect, arg in EFFECTS.items():
