@@ -972,7 +972,7 @@ fn noise_correlated_along_runs_is_scatter_of_the_runs_not_a_gap() {
     let m = crate::calibrate::tests::reference_motor();
     let (clean, groups) = data(&m, 0.0, 5);
     let noisy = |phi: f64| -> Vec<ObservedRow> {
-        let mut state = 2024u64;
+        let mut state = rand::SeedableRng::seed_from_u64(2024);
         let mut rows = clean.clone();
         let mut e: BTreeMap<(String, Observable), f64> = BTreeMap::new();
         for (r, g) in rows.iter_mut().zip(&groups) {
