@@ -463,10 +463,14 @@ fn compliance_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64, weight: f64) 
 /// slip nearly vanishes at the crest, u → 1), it grades the panels towards it
 /// ([`nearest_singularity`], [`graded_ends`]). The candidate's tanh saturation without
 /// radial slip takes the Coulomb closed forms plus the saturation's difference from them
-/// on a window about θs ([`compliance_factors`]).
+/// on a window about θs ([`compliance_factors`]), and so do its sharper stick-then-slip
+/// forms ([`stick_slip_window_factors`]).
 pub fn factors(ct: &Contact, u: f64, law: &Law) -> Factors {
     let uc = u.clamp(-1.0, 1.0);
     if law.sharpness != 1.0 && law.slip_scale > 0.0 && !law.truth {
+        if law.radial_ratio == 0.0 {
+            return stick_slip_window_factors(ct, uc, u, law);
+        }
         return stick_slip_factors(ct, uc, u, law);
     }
     factors_about(ct, u, law, nearest_singularity(law, uc, ct.half_angle_rad))
@@ -589,25 +593,41 @@ const REACH: f64 = 19.5;
 /// singularity. Within 1e-12 of the graded rule over the whole contact
 /// (`quadrature_factors`, test below).
 fn compliance_factors(ct: &Contact, uc: f64, u: f64, law: &Law, z: Option<(f64, f64)>) -> Factors {
-    let (phi0, c, sigma) = (ct.half_angle_rad, ct.offset, law.slip_scale);
-    let reach = REACH * sigma;
-    // a window over the whole contact saves nothing: the plain rule's one pass is cheaper
-    if u + reach >= 1.0 && u - reach <= c.max(-1.0) {
+    let sigma = law.slip_scale;
+    let Some((mut f, plain, np)) = coulomb_part_and_window(ct, uc, u, REACH * sigma) else {
+        // a window over the whole contact saves nothing: the plain rule's one pass is cheaper
         return quadrature_factors_about(ct, u, law, z);
+    };
+    if np == 0 {
+        return f;
+    }
+    let (ends, n) = z.and_then(|z| graded_ends_in(&plain[..np], z)).unwrap_or_else(|| plain_ends(&plain[..np]));
+    for_panel_pairs(&ends[..n], |nodes| f.add(&compliance_window_sums(nodes, ct.offset, u, sigma)));
+    f
+}
+
+/// The Coulomb law's closed forms (torque 2χ(θs) − χ(φ0), power 2E(θs) − E(φ0), Sun et
+/// al. 2021 eq. 10-11; no derivatives in u: a saturating law's come from its window alone)
+/// and the window |cos θ − u| ≤ `reach` about the stick point θs within the contact, as
+/// one or two panels split at θs (none where the window misses the contact). `None` where
+/// the window covers the whole contact. `uc` is `u` clamped to [−1, 1].
+fn coulomb_part_and_window(ct: &Contact, uc: f64, u: f64, reach: f64) -> Option<(Factors, WindowPanels, usize)> {
+    let (phi0, c) = (ct.half_angle_rad, ct.offset);
+    if u + reach >= 1.0 && u - reach <= c.max(-1.0) {
+        return None;
     }
     let ts = uc.acos();
     let (s0, c0) = phi0.sin_cos();
-    // the Coulomb part, sign(cos θ − u) = +1 on [0, θs) and −1 beyond
+    // sign(cos θ − u) = +1 on [0, θs) and −1 beyond
     let te = ts.min(phi0);
     let (se, ce) = if ts < phi0 { (((1.0 - uc) * (1.0 + uc)).sqrt(), uc) } else { (s0, c0) };
     let chi = |t: f64, s: f64| s - t * c;
     let e_int = |t: f64, s: f64, co: f64| 0.5 * t + 0.5 * s * co - c * s;
-    let mut f = Factors {
+    let f = Factors {
         torque: 2.0 * chi(te, se) - chi(phi0, s0),
         power: 2.0 * e_int(te, se, ce) - e_int(phi0, s0, c0),
         ..Factors::default()
     };
-    // the window, split at θs
     let lo = if u + reach >= 1.0 { 0.0 } else { (u + reach).acos() };
     let hi = if u - reach <= -1.0 { phi0 } else { (u - reach).acos().min(phi0) };
     let mut plain = [(0.0, 0.0); 2];
@@ -620,29 +640,37 @@ fn compliance_factors(ct: &Contact, uc: f64, u: f64, law: &Law, z: Option<(f64, 
         plain[np] = (ts, hi);
         np += 1;
     }
-    if np == 0 {
-        return f;
+    Some((f, plain, np))
+}
+
+/// The window's panels about θs: the first `n` of two, ascending.
+type WindowPanels = [(f64, f64); 2];
+
+/// The ends of the contiguous panels `plain` (at least one), ungraded.
+fn plain_ends(plain: &[(f64, f64)]) -> ([f64; MAX_PANELS + 1], usize) {
+    let mut e = [0.0; MAX_PANELS + 1];
+    e[0] = plain[0].0;
+    for (k, &(_, b)) in plain.iter().enumerate() {
+        e[k + 1] = b;
     }
-    let graded = z.and_then(|z| graded_ends_in(&plain[..np], z));
-    let (ends, n) = graded.unwrap_or_else(|| {
-        let mut e = [0.0; MAX_PANELS + 1];
-        e[0] = plain[0].0;
-        for (k, &(_, b)) in plain[..np].iter().enumerate() {
-            e[k + 1] = b;
-        }
-        (e, np + 1)
-    });
+    (e, plain.len() + 1)
+}
+
+/// Calls `sum` with the nodes of the panels between `ends`, two panels at a time (one node
+/// array of the plain rule's size, rather than one for all panels: zeroing 11.5 kB a call
+/// had cost 1-14 % of a graded call, most at few panels).
+#[inline(always)]
+fn for_panel_pairs(ends: &[f64], mut sum: impl FnMut(&Nodes)) {
     let panel = |a: f64, b: f64| (a, b, (0.5 * (a + b)).sin_cos());
-    for k in (0..n - 1).step_by(2) {
+    for k in (0..ends.len() - 1).step_by(2) {
         let mut nodes = Nodes::new();
-        if k + 2 < n {
+        if k + 2 < ends.len() {
             nodes.panels(&[panel(ends[k], ends[k + 1]), panel(ends[k + 1], ends[k + 2])]);
         } else {
             nodes.panels(&[panel(ends[k], ends[k + 1])]);
         }
-        f.add(&compliance_window_sums(&nodes, c, u, sigma));
+        sum(&nodes);
     }
-    f
 }
 
 /// The node sums of [`compliance_factors`]: q·(tanh x − sign x) and q·∂tanh(x)/∂u with
@@ -690,25 +718,15 @@ fn compliance_window_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64) -> Fac
     }
 }
 
-/// [`factors`] on the graded panels between `ends`, two panels at a time (one node array
-/// of the plain rule's size, rather than one for all panels: zeroing 11.5 kB a call had cost
-/// 1-14 % of a graded call, most at few panels). Kept out of `factors` (never inlined), so that the node sums
-/// are not compiled into it twice. (The panels' centres by angle addition from θs and the
-/// series of their offsets saved another 4 %, but their 2-ulp rounding moved the torque
-/// at the crest, u = 1, where cos θ − u cancels, by 2e-14 of 0.05.)
+/// [`factors`] on the graded panels between `ends` ([`for_panel_pairs`]). Kept out of
+/// `factors` (never inlined), so that the node sums are not compiled into it twice. (The
+/// panels' centres by angle addition from θs and the series of their offsets saved another
+/// 4 %, but their 2-ulp rounding moved the torque at the crest, u = 1, where cos θ − u
+/// cancels, by 2e-14 of 0.05.)
 #[inline(never)]
 fn graded_factors(ends: &[f64], c: f64, u: f64, law: &Law) -> Factors {
-    let panel = |a: f64, b: f64| (a, b, (0.5 * (a + b)).sin_cos());
     let mut f = Factors::default();
-    for k in (0..ends.len() - 1).step_by(2) {
-        let mut nodes = Nodes::new();
-        if k + 2 < ends.len() {
-            nodes.panels(&[panel(ends[k], ends[k + 1]), panel(ends[k + 1], ends[k + 2])]);
-        } else {
-            nodes.panels(&[panel(ends[k], ends[k + 1])]);
-        }
-        f.add(&node_sums(&nodes, c, u, law));
-    }
+    for_panel_pairs(ends, |nodes| f.add(&node_sums(nodes, c, u, law)));
     f
 }
 
@@ -865,6 +883,72 @@ fn stick_slip_factors(ct: &Contact, uc: f64, u: f64, law: &Law) -> Factors {
     ends.sort_by(f64::total_cmp);
     ends.dedup();
     graded_factors(&ends, ct.offset, u, law)
+}
+
+/// [`factors`] of the stick-then-slip saturations without radial slip (ρ = 0, n ≠ 1): as
+/// [`compliance_factors`] for tanh, the Coulomb closed forms plus the saturation's
+/// difference from them, q·(S(|x|) − 1)·sign x and q·∂/∂u = −q·S'(|x|)/σ with
+/// x = (cos θ − u)/σ, on the window |x| ≤ REACH^(1/n) alone (beyond it tanh(xⁿ) rounds to
+/// 1, S' is 0 and S is 1 within a few ulp), graded towards the law's singularities on both
+/// sides of θs ([`stick_slip_singularities`]). The whole-contact rule
+/// ([`stick_slip_factors`]) grades its panels across the contact and evaluates the general
+/// integrand, with its square root and three divisions, at every node; the window is a
+/// fraction of the contact where σ is small. No second derivative in u (NaN), as on the
+/// whole-contact route. Within 1e-12 of that route (test below).
+fn stick_slip_window_factors(ct: &Contact, uc: f64, u: f64, law: &Law) -> Factors {
+    let (sigma, n) = (law.slip_scale, law.sharpness);
+    let Some((mut f, plain, np)) = coulomb_part_and_window(ct, uc, u, sigma * REACH.powf(1.0 / n)) else {
+        return stick_slip_factors(ct, uc, u, law);
+    };
+    f.torque_uu = f64::NAN;
+    if np == 0 {
+        return f;
+    }
+    let mut ends = [0.0; 2 * (MAX_PANELS + 1)];
+    let mut len = 0;
+    for z in stick_slip_singularities(law, uc, ct.half_angle_rad).into_iter().flatten() {
+        if let Some((e, k)) = graded_ends_in(&plain[..np], z) {
+            ends[len..len + k].copy_from_slice(&e[..k]);
+            len += k;
+        }
+    }
+    if len == 0 {
+        let (e, k) = plain_ends(&plain[..np]);
+        ends[..k].copy_from_slice(&e[..k]);
+        len = k;
+    }
+    let ends = &mut ends[..len];
+    ends.sort_unstable_by(f64::total_cmp);
+    let mut distinct = 1;
+    for k in 1..ends.len() {
+        if ends[k] != ends[distinct - 1] {
+            ends[distinct] = ends[k];
+            distinct += 1;
+        }
+    }
+    for_panel_pairs(&ends[..distinct], |nodes| f.add(&stick_slip_window_sums(nodes, ct.offset, u, sigma, n)));
+    f
+}
+
+/// The node sums of [`stick_slip_window_factors`]. A node with x = +0 (cos θ rounded onto
+/// u) counts as beyond θs, where the Coulomb part takes the sign −1.
+fn stick_slip_window_sums(nodes: &Nodes, c: f64, u: f64, slip_scale: f64, sharpness: f64) -> Factors {
+    let inv_s = 1.0 / slip_scale;
+    let (mut t, mut t_u, mut p, mut p_u) = (0.0, 0.0, 0.0, 0.0);
+    count_evaluations(nodes.len);
+    for k in 0..nodes.len {
+        let (co, w) = (nodes.cos[k], nodes.weight[k]);
+        let wq = w * (co - c).max(0.0);
+        let x = (co - u) * inv_s;
+        let (sv, ds) = stick_slip_saturation(x.abs(), sharpness);
+        let d = if x > 0.0 { sv - 1.0 } else { 1.0 - sv };
+        let dg = -ds * inv_s;
+        t += wq * d;
+        t_u += wq * dg;
+        p += wq * d * co;
+        p_u += wq * dg * co;
+    }
+    Factors { torque: t, power: p, radial: 0.0, torque_du: t_u, power_du: p_u, radial_du: 0.0, torque_uu: f64::NAN }
 }
 
 /// The singularities of the stick-then-slip law S(D/σ)/D with S(x) = tanh(xⁿ)^(1/n)
@@ -1912,18 +1996,22 @@ mod tests {
         assert!(graded > 100_000, "{graded}");
     }
 
-    /// The saturating law by its Coulomb closed forms plus the windowed difference
-    /// (`compliance_factors`) against the graded rule over the whole contact
+    /// The saturating laws by their Coulomb closed forms plus the windowed difference
+    /// (`compliance_factors` for tanh, `stick_slip_window_factors` for the sharper
+    /// stick-then-slip forms) against the graded rule over the whole contact
     /// (`quadrature_factors`, an independent route: no closed form, the saturation itself at
     /// every node), over slip scales from 1e-7 (a step at θs) to 3 (the window is the whole
-    /// contact), contacts from narrow to full and rotor speeds from rest past the crest:
-    /// torque and power within 1e-12 of their scale, the derivatives within 1e-12 of that
-    /// over σ.
+    /// contact), sharpness from tanh's 1 to 4, contacts from narrow to full and rotor speeds
+    /// from rest past the crest: torque and power within 1e-12 of their scale, the
+    /// derivatives within 1e-12 of that over σ.
     #[test]
-    fn windowed_compliance_factors_agree_with_the_whole_contact_rule() {
+    fn windowed_saturating_factors_agree_with_the_whole_contact_rule() {
         let mut worst: f64 = 0.0;
-        for &sigma in &[1e-7, 1e-5, 3e-4, 0.003, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 3.0] {
-            let law = Law { radial_ratio: 0.0, slip_scale: sigma, truth: false, truth_radial: false, sharpness: 1.0 };
+        let laws = [1e-7, 1e-5, 3e-4, 0.003, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 3.0]
+            .into_iter()
+            .flat_map(|sigma| [1.0, 1.5, 2.0, 3.0, 4.0].map(|n| (sigma, n)));
+        for (sigma, n) in laws {
+            let law = Law { radial_ratio: 0.0, slip_scale: sigma, truth: false, truth_radial: false, sharpness: n };
             for &y in &[0.02, 0.3, 0.7, 1.0, 1.5, 2.0, 3.0, 3.2, 4.0, 6.0] {
                 let ct = contact_from_ratio(y);
                 for &u in &[
@@ -1953,7 +2041,7 @@ mod tests {
                         let sc = if k < 2 { scale } else { scale / sigma };
                         let err = (x - z).abs() / sc;
                         worst = worst.max(err);
-                        assert!(err <= 1e-12, "σ={sigma} y={y} u={u} [{k}]: windowed {x} vs whole contact {z}");
+                        assert!(err <= 1e-12, "σ={sigma} n={n} y={y} u={u} [{k}]: windowed {x} vs whole contact {z}");
                     }
                     assert_eq!((a.radial, a.radial_du), (0.0, 0.0));
                 }
@@ -2115,9 +2203,7 @@ mod tests {
                         let sc = if k == 2 { scale / l.slip_scale } else { scale };
                         let err = (got - want).abs() / sc;
                         worst = worst.max(err);
-                        if err > 1e-9 {
-                            eprintln!("{l:?} y={y} u={u} [{k}]: {err:.1e}");
-                        }
+                        assert!(err <= 2e-12, "{l:?} y={y} u={u} [{k}]: rule {got} vs adaptive {want} ({err:.1e})");
                     }
                 }
             }
