@@ -868,21 +868,43 @@ fn nearest_singularity(law: &Law, u: f64, phi0: f64) -> Option<(f64, f64)> {
 /// gradings. `uc` is `u` clamped to [−1, 1].
 fn stick_slip_factors(ct: &Contact, uc: f64, u: f64, law: &Law) -> Factors {
     let (phi0, ts) = (ct.half_angle_rad, uc.acos());
-    let mut ends: Vec<f64> = Vec::with_capacity(2 * MAX_PANELS + 2);
-    for z in stick_slip_singularities(law, uc, phi0).into_iter().flatten() {
-        if let Some((e, n)) = graded_ends(ts, phi0, z) {
-            ends.extend_from_slice(&e[..n]);
+    let split = ts > 0.0 && ts < phi0;
+    let plain: &[(f64, f64)] = if split { &[(0.0, ts), (ts, phi0)] } else { &[(0.0, phi0)] };
+    let mut ends = [0.0; 2 * (MAX_PANELS + 1)];
+    let len = union_of_gradings(plain, stick_slip_singularities(law, uc, phi0), &mut ends);
+    graded_factors(&ends[..len], ct.offset, u, law)
+}
+
+/// The panel ends of the contiguous panels `plain` graded towards each singularity of
+/// `singularities` ([`graded_ends_in`]), merged: sorted and distinct, in `out`, with their
+/// count returned. Where neither grades (none is near enough) they are `plain`'s own ends.
+fn union_of_gradings(
+    plain: &[(f64, f64)],
+    singularities: [Option<(f64, f64)>; 2],
+    out: &mut [f64; 2 * (MAX_PANELS + 1)],
+) -> usize {
+    let mut len = 0;
+    for z in singularities.into_iter().flatten() {
+        if let Some((e, k)) = graded_ends_in(plain, z) {
+            out[len..len + k].copy_from_slice(&e[..k]);
+            len += k;
         }
     }
-    if ends.is_empty() {
-        ends.extend([0.0, phi0]);
-        if ts > 0.0 && ts < phi0 {
-            ends.push(ts);
+    if len == 0 {
+        let (e, k) = plain_ends(plain);
+        out[..k].copy_from_slice(&e[..k]);
+        len = k;
+    }
+    let ends = &mut out[..len];
+    ends.sort_unstable_by(f64::total_cmp);
+    let mut distinct = 1;
+    for k in 1..ends.len() {
+        if ends[k] != ends[distinct - 1] {
+            ends[distinct] = ends[k];
+            distinct += 1;
         }
     }
-    ends.sort_by(f64::total_cmp);
-    ends.dedup();
-    graded_factors(&ends, ct.offset, u, law)
+    distinct
 }
 
 /// [`factors`] of the stick-then-slip saturations without radial slip (ρ = 0, n ≠ 1): as
@@ -905,28 +927,8 @@ fn stick_slip_window_factors(ct: &Contact, uc: f64, u: f64, law: &Law) -> Factor
         return f;
     }
     let mut ends = [0.0; 2 * (MAX_PANELS + 1)];
-    let mut len = 0;
-    for z in stick_slip_singularities(law, uc, ct.half_angle_rad).into_iter().flatten() {
-        if let Some((e, k)) = graded_ends_in(&plain[..np], z) {
-            ends[len..len + k].copy_from_slice(&e[..k]);
-            len += k;
-        }
-    }
-    if len == 0 {
-        let (e, k) = plain_ends(&plain[..np]);
-        ends[..k].copy_from_slice(&e[..k]);
-        len = k;
-    }
-    let ends = &mut ends[..len];
-    ends.sort_unstable_by(f64::total_cmp);
-    let mut distinct = 1;
-    for k in 1..ends.len() {
-        if ends[k] != ends[distinct - 1] {
-            ends[distinct] = ends[k];
-            distinct += 1;
-        }
-    }
-    for_panel_pairs(&ends[..distinct], |nodes| f.add(&stick_slip_window_sums(nodes, ct.offset, u, sigma, n)));
+    let len = union_of_gradings(&plain[..np], stick_slip_singularities(law, uc, ct.half_angle_rad), &mut ends);
+    for_panel_pairs(&ends[..len], |nodes| f.add(&stick_slip_window_sums(nodes, ct.offset, u, sigma, n)));
     f
 }
 
