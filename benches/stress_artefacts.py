@@ -9,8 +9,8 @@ zero offset of the preload reading, read-back noise of the preload or the freque
 heavy-tailed speed noise, cells left empty, noise three times the nominal, noise that is
 all absolute or all relative, noise correlated within runs. Null cases
 must come out `none`; effect cases (each effect at about twice its typical strength in
-its first truth form, with two artefacts drawn at random and the development half's own)
-should name the effect. The cases are a development set: the diagnosis was changed after
+its first truth form, with two artefacts drawn at random and the development half's own,
+or under noise correlated within runs) should name the effect. The cases are a development set: the diagnosis was changed after
 they were first run.
 
     cargo build --release -p trum-cli
@@ -245,6 +245,14 @@ def cases():
         for _ in range(3):
             seed += 1
             out.append((f"null_ar_0.95_low_{campaign}_{seed}", "none", ["ar_0.95_low"], campaign, seed, None, 0, []))
+    # every effect under noise correlated within runs (mostly an offset per run): a gap
+    # the runs' scatter could pass for, or hide
+    seed = 7500
+    for effect, arg in EFFECTS.items():
+        for campaign in ("combined", "preload-torque"):
+            seed += 1
+            truth = "none" if (effect, campaign) == ("thermal_drift", "preload-torque") else effect
+            out.append((f"{effect}_ar_0.95_{campaign}", truth, ["ar_0.95"], campaign, seed, arg, 0, []))
     rng = random.Random(11)
     seed = 8100
     for effect, arg in EFFECTS.items():

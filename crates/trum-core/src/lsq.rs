@@ -109,6 +109,11 @@ impl LeastSquares {
         &vs * vs.transpose()
     }
 
+    /// U (m × k): an orthonormal basis of the numerical range of J.
+    pub(crate) fn range_basis(&self) -> &DMatrix<f64> {
+        &self.u
+    }
+
     /// (I − U Uᵀ) S: the part of each column of `s` (m × p) orthogonal to the numerical
     /// range of J, i.e. the residual of its least-squares fit by J's columns. Computed as
     /// S − U (Uᵀ S), never with the m × m projector.

@@ -293,7 +293,18 @@ pub struct HeldOut {
 /// scatter: its held-out gain is chance over a handful of runs).
 fn run_scatter(ctx: &Context, base: &baseline::Baseline) -> Option<(bool, String)> {
     let z = residuals(&base.cal.motor, &ctx.rows);
-    let r = repeatability::across_runs(&ctx.rows, &z, &ctx.groups, ctx.opts.seed)?;
+    // the fit's Jacobian of the unweighted residuals (its rows carry the Huber weights;
+    // a reading the fit gave no weight constrains nothing)
+    let lin = &base.cal.lin;
+    let mut jz = lin.jacobian.clone();
+    for (mut row, &w) in jz.row_iter_mut().zip(&lin.weights) {
+        if w > 0.0 {
+            row /= w
+        } else {
+            row.fill(0.0)
+        }
+    }
+    let r = repeatability::across_runs(&ctx.rows, &z, &ctx.groups, Some(&jz), ctx.opts.seed)?;
     let test = format!(
         "agreement of each miss with those of other runs at the nearest operating points {:.2}; sign-flip test over the {} runs, p = {}",
         r.agreement,
