@@ -27,7 +27,7 @@
 //! block of runs bends towards the runs beside it, so held-out misses of neighbouring runs
 //! can disagree even where the model lacks something (a strong `voltage_sag` on a
 //! `trum60-qut` preload-torque campaign: agreement −0.39 held out, 1.00 on the full-data
-//! fit). A fit through runs that scatter independently leaves residuals that alternate
+//! residuals as they are, 0.64 with the fit's share taken again after each sign pattern). A fit through runs that scatter independently leaves residuals that alternate
 //! between neighbouring runs (agreement near −1, p near 1), not ones that agree.
 
 use super::folds::OUTLIER_Z2;
