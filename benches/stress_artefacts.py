@@ -7,7 +7,11 @@ every parameter perturbed as in the blind benchmark) that this script then alter
 bench would: gains of the speed, torque, power, feedback, current or voltage readings, a
 zero offset of the preload reading, read-back noise of the preload or the frequency, a quantised torque, an offset or a lag of the temperature sensor,
 heavy-tailed speed noise, cells left empty, noise three times the nominal, noise that is
-all absolute or all relative, noise correlated within runs. Null cases
+all absolute or all relative, noise correlated within runs; and the logging and slow
+changes of the instruments (`LOGGING`): every row logged twice, rows out of order,
+readings carried over from the previous row or lagging it, gains that drift over a run or
+switch range halfway, a power or frequency offset, a stator still warm at switch-on,
+speeds quantised to 2 rpm, efficiencies rounded to two decimals. Null cases
 must come out `none`; effect cases (each effect at about twice its typical strength in
 its first truth form, with two artefacts drawn at random and the development half's own,
 or under noise correlated within runs) should name the effect. The cases are a development set: the diagnosis was changed after
@@ -149,9 +153,7 @@ def correlated_noise(phi, scale=1.0):
     without noise."""
 
     def apply(rows, rng):
-        runs = {}
-        for row in rows:
-            runs.setdefault(row.get("run_id", ""), []).append(row)
+        runs = by_run(rows)
         for column, (a, r) in DEFAULT_LEVELS.items():
             top = 1.0 if column == "efficiency" else math.inf
             for run in runs.values():
@@ -185,6 +187,124 @@ RELATIVE = {"speed_rpm": (0.0, 0.012), "input_power_w": (0.0, 0.015), "current_a
 NULL_ONLY = {"temp_lag": sensor_lag(30.0), "abs_noise": noise_shape(ABSOLUTE), "rel_noise": noise_shape(RELATIVE),
              "ar_0.8": correlated_noise(0.8), "ar_0.95": correlated_noise(0.95),
              "ar_0.95_low": correlated_noise(0.95, 0.6)}
+
+
+def by_run(rows):
+    """The rows of each run (by `run_id`), in file order."""
+    runs = {}
+    for row in rows:
+        runs.setdefault(row.get("run_id", ""), []).append(row)
+    return runs
+
+
+# the reference motor's thermal time constant C/(h·A) [s] (tests/data/motors/ring60.toml)
+THERMAL_TAU_S = 150.0 / (10.0 * 0.02366)
+
+
+def warm_start(excess_k):
+    """A stator still `excess_k` warmer than ambient at switch-on (the previous run's heat),
+    decaying with the motor's thermal time constant: the readings of a motor that was not
+    left to cool."""
+
+    def apply(rows, rng):
+        for row in rows:
+            if row.get("temperature_c", "") != "" and row.get("elapsed_s", "") != "":
+                t = float(row["elapsed_s"])
+                row["temperature_c"] = repr(float(row["temperature_c"]) + excess_k * math.exp(-t / THERMAL_TAU_S))
+
+    return apply
+
+
+def drift(column, rel):
+    """A reading whose gain drifts linearly by `rel` over each run, in row order."""
+
+    def apply(rows, rng):
+        for run in by_run(rows).values():
+            n = max(1, len(run) - 1)
+            for i, row in enumerate(run):
+                if row.get(column, "") != "":
+                    row[column] = repr(float(row[column]) * (1.0 + rel * i / n))
+
+    return apply
+
+
+def lagged(column, share):
+    """A slow instrument: each reading carries `share` of the previous row's true value."""
+
+    def apply(rows, rng):
+        for run in by_run(rows).values():
+            prev = None
+            for row in run:
+                if row.get(column, "") == "":
+                    continue
+                v = float(row[column])
+                if prev is not None:
+                    row[column] = repr((1.0 - share) * v + share * prev)
+                prev = v
+
+    return apply
+
+
+def stale(column, share):
+    """An instrument polled faster than it updates: a `share` of rows carries the previous
+    row's reading of `column`."""
+
+    def apply(rows, rng):
+        for run in by_run(rows).values():
+            prev = None
+            for row in run:
+                if row.get(column, "") == "":
+                    continue
+                if prev is not None and rng.random() < share:
+                    row[column] = prev
+                prev = row[column]
+
+    return apply
+
+
+def range_switch(column, gain):
+    """An instrument that switches range halfway through each run, the second range's gain
+    off by `gain`."""
+
+    def apply(rows, rng):
+        for run in by_run(rows).values():
+            for i, row in enumerate(run):
+                if i >= len(run) // 2 and row.get(column, "") != "":
+                    row[column] = repr(float(row[column]) * gain)
+
+    return apply
+
+
+def logged_twice(rows, rng):
+    """Every row written twice by the logger."""
+    rows[:] = [copy for row in rows for copy in (row, dict(row))]
+
+
+def shuffled(rows, rng):
+    """Rows written in another order than they were measured."""
+    rng.shuffle(rows)
+
+
+# Artefacts of the logging and of slow changes of the instruments, added after every set
+# above and kept apart with seeds of their own; each is a null case on two campaigns, and
+# each effect case draws two of them. The rows logged twice led to dropping rows that repeat
+# an earlier row (crate::observations); the others changed nothing.
+LOGGING = {
+    "warm_start_5K": warm_start(5.0),
+    "voltage_drift": drift("voltage_v", 0.01),
+    "speed_gain_drift": drift("speed_rpm", 0.02),
+    "preload_drift": drift("preload_n", 0.03),
+    "torque_lag": lagged("torque_nm", 0.2),
+    "speed_quant_2rpm": lambda rows, rng: alter(rows, "speed_rpm", lambda v: round(v / 2.0) * 2.0),
+    "freq_offset": lambda rows, rng: alter(rows, "frequency_hz", lambda v: v + 100.0),
+    "logged_twice": logged_twice,
+    "shuffled_rows": shuffled,
+    "efficiency_2dp": lambda rows, rng: alter(rows, "efficiency", lambda v: round(v, 2)),
+    "current_range_switch": range_switch("current_a", 1.02),
+    "power_offset": lambda rows, rng: alter(rows, "input_power_w", lambda v: v + 0.3),
+    "stale_power": stale("input_power_w", 0.3),
+    "stale_speed": stale("speed_rpm", 0.2),
+}
 
 EFFECTS = {
     "radial_friction": "radial_friction=2",
@@ -253,6 +373,21 @@ def cases():
             seed += 1
             truth = "none" if (effect, campaign) == ("thermal_drift", "preload-torque") else effect
             out.append((f"{effect}_ar_0.95_{campaign}", truth, ["ar_0.95"], campaign, seed, arg, 0, []))
+    # logging and slow instrument changes (LOGGING), with the development half's artefacts
+    seed = 9100
+    for art in LOGGING:
+        for campaign in ("warm-up", "combined") if art == "warm_start_5K" else ("preload-torque", "combined"):
+            seed += 1
+            out.append((f"null_{art}_{campaign}", "none", [art], campaign, seed, None, 1, ["--artefacts", DEV_ARTEFACTS]))
+    draw = random.Random(5)
+    for effect, arg in EFFECTS.items():
+        for campaign in ("combined", "preload-torque"):
+            if (effect, campaign) == ("thermal_drift", "preload-torque"):
+                continue
+            seed += 1
+            arts = draw.sample(sorted(a for a in LOGGING if a != "warm_start_5K"), 2)
+            out.append((f"{effect}_logging_{campaign}", effect, arts, campaign, seed, arg, 1,
+                        ["--artefacts", DEV_ARTEFACTS]))
     rng = random.Random(11)
     seed = 8100
     for effect, arg in EFFECTS.items():
@@ -275,7 +410,7 @@ def run(case, work):
         rows = list(csv.DictReader(f))
     rng = random.Random(seed)
     for art in arts:
-        {**ARTEFACTS, **NULL_ONLY, **READINGS}[art](rows, rng)
+        {**ARTEFACTS, **NULL_ONLY, **READINGS, **LOGGING}[art](rows, rng)
     with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, list(rows[0].keys()))
         w.writeheader()

@@ -99,8 +99,10 @@ pub fn read_data_quietly(path: &str, motor: &Motor, plausible: &PlausibleRanges)
     }
     let bytes = std::fs::read(p).with_context(|| format!("cannot read measurement file '{path}'"))?;
     // MeasurementError's message names the file, line and column; show it unchanged.
-    let m = parse_measurements_with(&bytes, path, plausible).map_err(|e| anyhow!("{e}"))?;
+    let mut m = parse_measurements_with(&bytes, path, plausible).map_err(|e| anyhow!("{e}"))?;
     let bench = observations(&m, motor);
+    // (the conversion's warnings, such as rows dropped as repeats, go with the reader's)
+    m.warnings.extend(bench.warnings.iter().map(|w| format!("{path}: {w}")));
     Ok((m, bench))
 }
 

@@ -279,6 +279,37 @@ fn an_unexplained_verdict_names_what_explains_part_of_the_gap() {
 }
 
 /// One diagnosis of a no-effect campaign: JSON fields and values, the report, the summary.
+/// A null campaign whose every row the logger wrote twice: the repeats are counted once,
+/// with a warning naming them, and the diagnosis is the file's once (it was `unexplained`
+/// while the repeats' zero differences halved the noise levels estimated from the data).
+#[test]
+fn rows_logged_twice_are_one_reading_each() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let data = synth(d, "pt.csv", &["--campaign", "preload-torque", "--noise", "1", "--seed", "9111"]);
+    let once_text = std::fs::read_to_string(&data).expect("data");
+    let mut lines = once_text.lines();
+    let header = lines.next().expect("header");
+    let twice_text: String =
+        std::iter::once(header).chain(lines.flat_map(|l| [l, l])).map(|l| format!("{l}\n")).collect();
+    let twice = path(d, "twice.csv");
+    std::fs::write(&twice, twice_text).expect("write");
+    let (j1, j2) = (path(d, "once.json"), path(d, "twice.json"));
+    ok(&["diagnose", "--motor", MOTOR, "--data", &data, "--json", &j1, "-q"]);
+    let o = trum(&["diagnose", "--motor", MOTOR, "--data", &twice, "--json", &j2, "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(err.contains("rows repeat an earlier row in every column (line 3 repeats line 2"), "{err}");
+    let read = |p: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).expect("json")).expect("JSON")
+    };
+    let (a, b) = (read(&j1), read(&j2));
+    assert_eq!(b["verdict"], "none", "{}", b["verdict"]);
+    for k in ["verdict", "complete", "ranking", "gap", "n_rows"] {
+        assert_eq!(a[k], b[k], "{k}");
+    }
+}
+
 #[test]
 fn diagnose_without_effect_says_none() {
     let dir = tempfile::tempdir().expect("tempdir");

@@ -5,11 +5,11 @@
 use crate::{detached, input_err, PyMotor};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use trum_core::bench::observations;
+use trum_core::bench::{observations, BenchData};
 use trum_core::calibrate::{rescale_uncertainties, Calibration, FitOptions};
 use trum_core::diagnose::json::{to_json, Provenance};
 use trum_core::diagnose::{diagnose, stated_noise_from_texts, DiagnoseOptions};
-use trum_core::measurements::{parse_measurements_with, PlausibleRanges};
+use trum_core::measurements::{parse_measurements_with, Measurements, PlausibleRanges};
 
 /// Diagnoses the measurement CSV `data` (its bytes; `source` names it in messages) against
 /// `motor`. Returns the JSON document as text and the reader's warnings. Bad files raise
@@ -49,9 +49,15 @@ pub fn diagnose_csv(
         let d =
             diagnose(&m, &bench.rows, &bench.groups, &opts).map_err(|e| format!("cannot diagnose '{source}': {e}"))?;
         let src = Provenance { motor_name: &m.name, motor_source: &motor_source, data: &source, lines: &bench.lines };
-        Ok((to_json(&d, &src).to_string(), meas.warnings.clone()))
+        Ok((to_json(&d, &src).to_string(), reader_warnings(&meas, &bench, &source)))
     })?;
     out.map_err(|e| input_err(py, e))
+}
+
+/// The reader's warnings, then the conversion's (rows dropped as repeats), each naming
+/// `source`.
+fn reader_warnings(meas: &Measurements, bench: &BenchData, source: &str) -> Vec<String> {
+    meas.warnings.iter().cloned().chain(bench.warnings.iter().map(|w| format!("{source}: {w}"))).collect()
 }
 
 /// The plausible ranges in force: the defaults, then the `[plausible]` table of the TOML
@@ -127,7 +133,7 @@ pub fn calibrate_csv<'py>(
             .run()
             .map_err(|e| format!("{source}: {e}"))?;
         rescale_uncertainties(&mut cal, &bench.rows);
-        Ok((cal, bench.rows.len(), meas.warnings.clone()))
+        Ok((cal, bench.rows.len(), reader_warnings(&meas, &bench, &source)))
     })?;
     let (cal, n_rows, notes) = out.map_err(|e| input_err(py, e))?;
     let d = PyDict::new(py);

@@ -117,6 +117,20 @@ def test_ignored_columns_are_warned_about(tmp_path):
     assert d["verdict"] == "eccentricity"
 
 
+def test_rows_logged_twice_are_counted_once_with_a_warning(tmp_path):
+    lines = DATA.read_text().splitlines()
+    twice = tmp_path / "twice.csv"
+    twice.write_text("\n".join(lines + lines[1:]) + "\n")
+    with pytest.warns(UserWarning, match=r"8 of 16 rows repeat an earlier row .*line 10 repeats line 2"):
+        d = trum.diagnose(RING, twice)
+    once = trum.diagnose(RING, DATA)
+    for k in ("verdict", "ranking", "gap"):
+        assert d[k] == once[k]
+    with pytest.warns(UserWarning, match="8 of 16 rows repeat"):
+        cal = trum.calibrate(RING, twice)
+    assert cal.n_rows == 8
+
+
 def test_calibrate_fits_the_baseline_and_reads_every_data_form():
     c = trum.calibrate(RING, DATA)
     # the eccentric bench is fitted about as well as its noise allows by the baseline alone
