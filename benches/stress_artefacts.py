@@ -305,6 +305,9 @@ LOGGING = {
     "stale_power": stale("input_power_w", 0.3),
     "stale_speed": stale("speed_rpm", 0.2),
 }
+# Seven readings in ten of one instrument carried over, null cases of their own: they led
+# to leaving stale readings out (diagnose::bench::drop_stale_readings).
+STALE_70 = {f"stale_70_{c}": stale(c, 0.7) for c in ("input_power_w", "speed_rpm", "current_a", "temperature_c")}
 
 EFFECTS = {
     "radial_friction": "radial_friction=2",
@@ -388,6 +391,14 @@ def cases():
             arts = draw.sample(sorted(a for a in LOGGING if a != "warm_start_5K"), 2)
             out.append((f"{effect}_logging_{campaign}", effect, arts, campaign, seed, arg, 1,
                         ["--artefacts", DEV_ARTEFACTS]))
+    # most readings of one instrument carried over (an instrument that updates at a third
+    # of the logging rate), null cases only
+    seed = 9700
+    for column in ("input_power_w", "speed_rpm", "current_a", "temperature_c"):
+        for campaign in ("warm-up", "combined", "preload-torque"):
+            seed += 1
+            out.append((f"null_stale_70_{column}_{campaign}", "none", [f"stale_70_{column}"], campaign, seed, None, 1,
+                        ["--artefacts", DEV_ARTEFACTS]))
     rng = random.Random(11)
     seed = 8100
     for effect, arg in EFFECTS.items():
@@ -410,7 +421,7 @@ def run(case, work):
         rows = list(csv.DictReader(f))
     rng = random.Random(seed)
     for art in arts:
-        {**ARTEFACTS, **NULL_ONLY, **READINGS, **LOGGING}[art](rows, rng)
+        {**ARTEFACTS, **NULL_ONLY, **READINGS, **LOGGING, **STALE_70}[art](rows, rng)
     with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, list(rows[0].keys()))
         w.writeheader()

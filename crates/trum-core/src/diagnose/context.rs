@@ -62,7 +62,8 @@ impl<'a> Context<'a> {
         // The sensors' noise levels where the user states them, the defaults elsewhere.
         let stated = with_stated_noise(rows, &opts.stated_noise)?;
         // The bench model first: set points read back with noise are taken at their run's
-        // mean, quantised readings carry their rounding error (`bench`).
+        // mean, stale readings are left out, quantised readings carry their rounding error
+        // (`bench`).
         let (unscaled, mut bench_notes) = bench_model(&stated, groups);
         // (a large file's rows are held by the caller and once here, not once per stage)
         drop(stated);
@@ -288,12 +289,13 @@ pub(super) fn scales(rows: &[ObservedRow]) -> BTreeMap<Observable, f64> {
 }
 
 /// The rows as the diagnosis fits them, after the bench model (`bench`): set points read
-/// back with noise at their run's mean, quantised readings with their rounding error; and
-/// the notes saying what was done.
+/// back with noise at their run's mean, stale readings left out, quantised readings with
+/// their rounding error; and the notes saying what was done.
 pub(super) fn bench_model(rows: &[ObservedRow], groups: &[String]) -> (Vec<ObservedRow>, Vec<String>) {
     let (snapped, snap_note) = bench::snap_set_points(rows, groups);
-    let (out, quantum_note) = bench::account_for_quantisation(snapped);
-    (out, snap_note.into_iter().chain(quantum_note).collect())
+    let (fresh, stale_note) = bench::drop_stale_readings(snapped, groups);
+    let (out, quantum_note) = bench::account_for_quantisation(fresh);
+    (out, snap_note.into_iter().chain(stale_note).chain(quantum_note).collect())
 }
 
 /// `rows` with the σ of every reading of a quantity in `stated` set to its stated level,
