@@ -292,8 +292,20 @@ pub(super) fn decide(
     // held-out measure, at least a third of what the single leaves beyond noise gone
     // in one of them, and that gain above zero at the bootstrap 5 % bound. (Parsimony:
     // a second effect that only polishes the first one's form error is not an effect.)
+    // (the evidence of each single effect, supported or not, for the pairs that nest it)
+    let single_evidence: BTreeMap<String, f64> =
+        ranking.iter().filter(|r| !r.effect.contains('+')).map(|r| (r.effect.clone(), r.evidence)).collect();
     let pair_beats_single = |bp: &RankEntry| -> bool {
         if !supported(bp) {
+            return false;
+        }
+        // A pair nests each of its two single effects, so its second effect must pay for
+        // its parameters in the whole data over either (½ΔBIC > 5), whether or not that
+        // single is supported on held-out data: a pair that the evidence ranks below one
+        // of its own singles has a second effect the data do not ask for, however its
+        // held-out figures come out on a few readings.
+        let nested = bp.effect.split('+').map(|n| single_evidence.get(n).copied().unwrap_or(f64::NEG_INFINITY));
+        if nested.into_iter().any(|e| bp.evidence <= e + 5.0) {
             return false;
         }
         // (without a supported single, a supported pair; the callers ask whether it closes
@@ -787,6 +799,34 @@ mod tests {
         let sliver_pair = entry("radial_friction+thermal_drift", 200.0, 0.05, 8.0);
         let v = decide(&ctx, &tests, &mut [sliver_pair.clone()], &none_preds(), None, false, &[sliver_pair], &none);
         assert_eq!(v.verdict, "unexplained");
+
+        // no supported single, and a supported pair that closes the gap but ranks below one
+        // of its own singles in evidence (unsupported on held-out data): its second effect
+        // does not pay for itself in the whole data, so no pair; with the pair 5 ahead of
+        // both its singles, the pair
+        let unsupported = RankEntry {
+            shrink_interval: (-0.06, 0.27),
+            z2_shrink_interval: (-0.01, 0.04),
+            ..entry("tangential_compliance", 38.6, 0.1, 2.6)
+        };
+        assert!(!GapTests::supported(&unsupported));
+        let below = entry("tangential_compliance+voltage_sag", 36.7, 0.8, 1.5);
+        let other = entry("voltage_sag", 2.0, 0.0, 9.0);
+        let v = decide(
+            &ctx,
+            &tests,
+            &mut [unsupported.clone(), below.clone(), other.clone()],
+            &none_preds(),
+            None,
+            false,
+            &[below],
+            &none,
+        );
+        assert_eq!(v.verdict, "unexplained");
+        let ahead = entry("tangential_compliance+voltage_sag", 43.7, 0.8, 1.5);
+        let v =
+            decide(&ctx, &tests, &mut [ahead.clone(), unsupported, other], &none_preds(), None, false, &[ahead], &none);
+        assert_eq!((v.verdict.as_str(), v.complete), ("tangential_compliance+voltage_sag", true));
 
         // no supported entry (evidence below 5): unexplained without a partial effect
         let weak = entry("eccentricity", 4.0, 0.8, 1.5);
