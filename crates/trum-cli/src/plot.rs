@@ -35,7 +35,8 @@ pub enum Kind {
     PowerTorque,
     /// No-load speed against drive frequency, one curve per voltage.
     SpeedFrequency,
-    /// Heat map of efficiency over load torque × preload.
+    /// Efficiency map over the load torque × speed plane of a torque × preload grid (as
+    /// motor makers draw them), with iso-efficiency contours and the stall boundary.
     EfficiencyMap,
     /// Heat map of speed over load torque × preload.
     SpeedMap,
