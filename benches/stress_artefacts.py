@@ -59,6 +59,14 @@ def alter(rows, column, fn):
             row[column] = repr(fn(float(row[column])))
 
 
+def quantised(column, step):
+    return lambda rows, rng: alter(rows, column, lambda v: round(v / step) * step)
+
+
+def offset(column, delta):
+    return lambda rows, rng: alter(rows, column, lambda v: v + delta)
+
+
 def heavy_tail(rows, rng):
     # Student-t noise with 3 degrees of freedom, 0.7 rpm scale, added to the speed
     def noisy(v):
@@ -82,8 +90,8 @@ ARTEFACTS = {
     "feedback_gain": scale("feedback_v", 0.95),
     "preload_readback": jitter("preload_n", 0.01),
     "freq_readback": jitter("frequency_hz", 0.0003),
-    "torque_quant": lambda rows, rng: alter(rows, "torque_nm", lambda v: round(v / 0.01) * 0.01),
-    "temp_offset": lambda rows, rng: alter(rows, "temperature_c", lambda v: v + 1.5),
+    "torque_quant": quantised("torque_nm", 0.01),
+    "temp_offset": offset("temperature_c", 1.5),
     "heavy_tail": heavy_tail,
     "missing": missing,
 }
@@ -93,7 +101,7 @@ ARTEFACTS = {
 # stay as they were: the preload load cell's zero 10 N high, a current probe 5 % high, the
 # drive voltage read 3 % high.
 READINGS = {
-    "preload_offset": lambda rows, rng: alter(rows, "preload_n", lambda v: v + 10.0),
+    "preload_offset": offset("preload_n", 10.0),
     "current_gain": scale("current_a", 1.05),
     "voltage_gain": scale("voltage_v", 1.03),
 }
@@ -295,13 +303,13 @@ LOGGING = {
     "speed_gain_drift": drift("speed_rpm", 0.02),
     "preload_drift": drift("preload_n", 0.03),
     "torque_lag": lagged("torque_nm", 0.2),
-    "speed_quant_2rpm": lambda rows, rng: alter(rows, "speed_rpm", lambda v: round(v / 2.0) * 2.0),
-    "freq_offset": lambda rows, rng: alter(rows, "frequency_hz", lambda v: v + 100.0),
+    "speed_quant_2rpm": quantised("speed_rpm", 2.0),
+    "freq_offset": offset("frequency_hz", 100.0),
     "logged_twice": logged_twice,
     "shuffled_rows": shuffled,
     "efficiency_2dp": lambda rows, rng: alter(rows, "efficiency", lambda v: round(v, 2)),
     "current_range_switch": range_switch("current_a", 1.02),
-    "power_offset": lambda rows, rng: alter(rows, "input_power_w", lambda v: v + 0.3),
+    "power_offset": offset("input_power_w", 0.3),
     "stale_power": stale("input_power_w", 0.3),
     "stale_speed": stale("speed_rpm", 0.2),
 }

@@ -75,22 +75,30 @@ pub fn observations(m: &Measurements, motor: &Motor) -> BenchData {
 
 /// Rows equal to an earlier row in every column of the layout: (row, the first row it
 /// repeats), in file order. Cells compare by their values' bits (a file's text "1.50" and
-/// "1.5" are one value); an empty cell equals only an empty cell.
+/// "1.5" are one value); an empty cell equals only an empty cell. One hash a row is kept
+/// (16 bytes a row, not the row's cells: a file of 10^6 rows adds tens of megabytes), and a
+/// row whose hash was seen is compared with that row's cells, so a collision of two different
+/// rows never drops one (it can only leave a later repeat of the second one undetected).
 fn repeated_rows(m: &Measurements) -> Vec<(usize, usize)> {
-    let key = |i: usize| -> (Vec<Option<u64>>, Option<&str>) {
-        let cells = Column::ALL
-            .into_iter()
-            .filter(|&c| c != Column::RunId && m.has(c))
-            .map(|c| m.value(c, i).map(f64::to_bits))
-            .collect();
-        (cells, m.run_id_at(i))
+    use std::hash::{Hash, Hasher};
+    let columns: Vec<Column> = Column::ALL.into_iter().filter(|&c| c != Column::RunId && m.has(c)).collect();
+    let cells = |i: usize| columns.iter().map(move |&c| m.value(c, i).map(f64::to_bits));
+    let same = |i: usize, j: usize| m.run_id_at(i) == m.run_id_at(j) && cells(i).eq(cells(j));
+    let hash = |i: usize| {
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        cells(i).for_each(|x| x.hash(&mut h));
+        m.run_id_at(i).hash(&mut h);
+        h.finish()
     };
-    let mut first: std::collections::HashMap<(Vec<Option<u64>>, Option<&str>), usize> =
-        std::collections::HashMap::with_capacity(m.len());
+    let mut first: std::collections::HashMap<u64, usize> = std::collections::HashMap::with_capacity(m.len());
     let mut out = Vec::new();
     for i in 0..m.len() {
-        match first.entry(key(i)) {
-            std::collections::hash_map::Entry::Occupied(e) => out.push((i, *e.get())),
+        match first.entry(hash(i)) {
+            std::collections::hash_map::Entry::Occupied(e) => {
+                if same(i, *e.get()) {
+                    out.push((i, *e.get()));
+                }
+            }
             std::collections::hash_map::Entry::Vacant(e) => {
                 e.insert(i);
             }
