@@ -37,6 +37,30 @@ macro_rules! quantities {
     };
 }
 
+/// Index of `stall_torque_nm` in [`QUANTITIES`]: the one quantity a solve may leave
+/// uncomputed (NaN), which the finiteness check of every solved point skips then.
+pub(crate) const STALL_TORQUE_INDEX: usize = index_of("stall_torque_nm");
+
+/// The index of the quantity `name` in [`QUANTITIES`], at compile time (a name that is not
+/// there stops the build).
+const fn index_of(name: &str) -> usize {
+    let mut i = 0;
+    while i < QUANTITIES.len() {
+        let (a, b) = (QUANTITIES[i].name.as_bytes(), name.as_bytes());
+        if a.len() == b.len() {
+            let mut k = 0;
+            while k < a.len() && a[k] == b[k] {
+                k += 1;
+            }
+            if k == a.len() {
+                return i;
+            }
+        }
+        i += 1;
+    }
+    panic!("no such quantity")
+}
+
 quantities! {
     (speed_rpm, "rpm", "rotor speed"),
     (speed_rad_s, "rad/s", "rotor speed"),

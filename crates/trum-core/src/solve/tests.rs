@@ -1217,3 +1217,33 @@ fn passes_that_swing_across_a_jump_stop_early_and_still_find_the_stall() {
     assert!((s.electrode_voltage_v - 152.15097061063776).abs() < 1e-7, "{s:?}");
     assert!(work < 30_000, "work {work}");
 }
+
+/// The finiteness check of every solved point: a NaN or an infinity in any quantity fails
+/// it, except a stall torque that a solve without the stall torque leaves NaN (and only
+/// there: where the solve computes it, a NaN stall torque fails too).
+#[test]
+fn the_finiteness_check_skips_only_an_uncomputed_stall_torque() {
+    use crate::quantities::{QUANTITIES, STALL_TORQUE_INDEX};
+    assert_eq!(QUANTITIES[STALL_TORQUE_INDEX].name, "stall_torque_nm");
+    let m = crate::presets::frozen("trum60a").expect("preset");
+    let (full, lean) = (Prepared::new(&m), Prepared::new(&m).without_stall_torque());
+    let s = solve_prepared(&full, &m, &OperatingPoint::new(250.0, 0.3, 200.0, 43e3), None);
+    assert!(full.all_finite(&s) && lean.all_finite(&s));
+    let no_stall = Solution { stall_torque_nm: f64::NAN, ..s.clone() };
+    assert!(lean.all_finite(&no_stall) && !full.all_finite(&no_stall));
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let inf_stall = Solution { stall_torque_nm: bad, ..s.clone() };
+        assert_eq!(lean.all_finite(&inf_stall), bad.is_nan(), "stall torque {bad}");
+        let others = [
+            Solution { speed_rpm: bad, ..no_stall.clone() },
+            Solution { efficiency: bad, ..no_stall.clone() },
+            Solution { input_power_w: bad, ..no_stall.clone() },
+            Solution { feedback_v: bad, ..no_stall.clone() },
+            Solution { amplitude_m: bad, ..no_stall.clone() },
+            Solution { friction_loss_w: bad, ..no_stall.clone() },
+        ];
+        for t in &others {
+            assert!(!lean.all_finite(t) && !full.all_finite(t), "{bad} in {t:?}");
+        }
+    }
+}
