@@ -236,36 +236,33 @@ def drift(column, rel):
     return apply
 
 
+def successive_readings(rows, column):
+    """(previous, current) pairs of the rows that have a reading of `column`, run by run in
+    row order."""
+    for run in by_run(rows).values():
+        present = [row for row in run if row.get(column, "") != ""]
+        yield from zip(present, present[1:])
+
+
 def lagged(column, share):
     """A slow instrument: each reading carries `share` of the previous row's true value."""
 
     def apply(rows, rng):
-        for run in by_run(rows).values():
-            prev = None
-            for row in run:
-                if row.get(column, "") == "":
-                    continue
-                v = float(row[column])
-                if prev is not None:
-                    row[column] = repr((1.0 - share) * v + share * prev)
-                prev = v
+        # last pair first, so that each previous reading is still the true one
+        for prev, row in reversed(list(successive_readings(rows, column))):
+            row[column] = repr((1.0 - share) * float(row[column]) + share * float(prev[column]))
 
     return apply
 
 
 def stale(column, share):
     """An instrument polled faster than it updates: a `share` of rows carries the previous
-    row's reading of `column`."""
+    row's reading of `column` (as logged, so a value can be carried over several rows)."""
 
     def apply(rows, rng):
-        for run in by_run(rows).values():
-            prev = None
-            for row in run:
-                if row.get(column, "") == "":
-                    continue
-                if prev is not None and rng.random() < share:
-                    row[column] = prev
-                prev = row[column]
+        for prev, row in successive_readings(rows, column):
+            if rng.random() < share:
+                row[column] = prev[column]
 
     return apply
 
