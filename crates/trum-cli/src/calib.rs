@@ -80,6 +80,7 @@ pub fn run(a: &CalibrateArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         .tolerances(&tolerances)
         .options(&FitOptions::default())
         .refit_bounds(true)
+        .search_starts(true)
         .max_rows(a.fit_rows)
         .run();
     let mut cal = cal.map_err(|e| anyhow!("{data}: {e}"));
@@ -150,6 +151,7 @@ fn run_fleet(a: &CalibrateArgs, files: &[String], out: &mut dyn Write, err: &mut
             .tolerances(&tolerances)
             .options(&FitOptions::default())
             .refit_bounds(true)
+            .search_starts(true)
             .run()
             .map_err(|e| anyhow!("{file}: {e}"))?;
         rescale_uncertainties(&mut cal, &bench.rows);

@@ -130,6 +130,7 @@ pub fn calibrate_csv<'py>(
             .options(&FitOptions::default())
             .tolerances(&tolerances)
             .refit_bounds(true)
+            .search_starts(true)
             .run()
             .map_err(|e| format!("{source}: {e}"))?;
         rescale_uncertainties(&mut cal, &bench.rows);

@@ -58,7 +58,7 @@ pub(super) fn calibrate(ctx: &Context, from: &Motor) -> Result<Calibration, Trum
     // (`Calibrate::refit_bounds`). (1000-row benchmark, seeds 31-38: every single fit,
     // started from the baseline left on the damping bound, first refitted the baseline
     // whatever its effect.)
-    Calibration::builder(&start0, rows).params(&bparams).options(&opts.fit).refit_bounds(true).run()
+    Calibration::builder(&start0, rows).params(&bparams).options(&opts.fit).refit_bounds(true).search_starts(true).run()
 }
 
 /// A start for the baseline that the candidates' fits found: the fit of the candidate with
