@@ -45,6 +45,7 @@ mod tests {
             shrink: 0.35,
             shrink_interval: (0.2, 0.5),
             z2_shrink_interval: (0.2, 0.5),
+            lone_row_shares: (1.0, 1.0),
             params: vec![],
             signature_match: None,
             linear_chi2_drop: None,

@@ -184,6 +184,7 @@ impl<'a> Scorer<'a> {
                 shrink: 0.0,
                 shrink_interval: (0.0, 0.0),
                 z2_shrink_interval: (0.0, 0.0),
+                lone_row_shares: (0.0, 0.0),
                 params: Vec::new(),
                 signature_match: None,
                 linear_chi2_drop: None,
@@ -506,7 +507,13 @@ impl<'a> Scorer<'a> {
         let (after, chi2_after, e2, z2s) = errors(rows, &preds, sc);
         let shrink = 1.0 - after / base_nrmse.max(1e-300);
         let interval = bootstrap_shrink(base_e2, &e2, opts.bootstrap, opts.seed);
-        let z2_interval = bootstrap_shrink(&base.z2s, &super::baseline::clipped(&z2s), opts.bootstrap, opts.seed);
+        let z2_after = super::baseline::clipped(&z2s);
+        let z2_interval = bootstrap_shrink(&base.z2s, &z2_after, opts.bootstrap, opts.seed);
+        let lone_row_share = |before: &[f64], after: &[f64]| {
+            let (b, a) = without_top_row(rows, before, after);
+            lone_share(shrink_of(before, after), shrink_of(&b, &a))
+        };
+        let lone_row_shares = (lone_row_share(base_e2, &e2), lone_row_share(&base.z2s, &z2_after));
         let entry = RankEntry {
             effect: name,
             evidence,
@@ -515,6 +522,7 @@ impl<'a> Scorer<'a> {
             shrink,
             shrink_interval: interval,
             z2_shrink_interval: z2_interval,
+            lone_row_shares,
             params: fitted.into_iter().filter(|p| p.name.starts_with("effects.")).map(|p| (p.name, p.value)).collect(),
             signature_match: single_sig(effects).map(|s| s.matched),
             linear_chi2_drop: single_sig(effects).map(|s| s.linear_chi2_drop),
@@ -716,6 +724,37 @@ pub(super) fn sort_ranking(r: &mut [RankEntry]) {
 
 /// Percentile bootstrap (5 %, 95 %) of 1 − sqrt(mean e2_after)/sqrt(mean e2_before) over
 /// readings resampled in pairs.
+/// The shrink 1 − √(Σafter/Σbefore) of per-reading terms.
+fn shrink_of(before: &[f64], after: &[f64]) -> f64 {
+    1.0 - (after.iter().sum::<f64>() / before.iter().sum::<f64>().max(1e-300)).sqrt()
+}
+
+/// The part of a held-out gain (`shrink`) that stays without the row that gains most
+/// (where the shrink is `without`): 1 when that row carries none of it, 0 or less when it
+/// carries all.
+fn lone_share(shrink: f64, without: f64) -> f64 {
+    if shrink > 0.0 {
+        without / shrink
+    } else {
+        0.0
+    }
+}
+
+/// The per-reading terms `before` and `after` (aligned with the readings of `rows`) without
+/// those of the row whose readings gain most (the largest Σbefore − Σafter).
+pub(super) fn without_top_row(rows: &[ObservedRow], before: &[f64], after: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let mut spans = Vec::with_capacity(rows.len());
+    let mut at = 0;
+    for r in rows {
+        spans.push(at..(at + r.readings.len()).min(before.len()).min(after.len()));
+        at += r.readings.len();
+    }
+    let gain = |s: &std::ops::Range<usize>| s.clone().map(|i| before[i] - after[i]).sum::<f64>();
+    let top = spans.iter().max_by(|a, b| gain(a).total_cmp(&gain(b))).cloned().unwrap_or(0..0);
+    let keep = |v: &[f64]| v.iter().enumerate().filter(|(i, _)| !top.contains(i)).map(|(_, x)| *x).collect();
+    (keep(before), keep(after))
+}
+
 pub(super) fn bootstrap_shrink(before: &[f64], after: &[f64], n: usize, seed: u64) -> (f64, f64) {
     use rand::{RngExt, SeedableRng};
     let m = before.len().min(after.len());
@@ -744,6 +783,30 @@ mod tests {
     use super::super::tests::{quick, sag_data};
     use super::super::DiagnoseOptions;
     use super::*;
+
+    /// The row left out is the one whose readings gain most together, not the reading
+    /// that gains most alone; its readings go from both sides, and the rest keep their
+    /// order. Its share is what stays of the shrink: 1 when it gains nothing, below zero
+    /// when the rest lose.
+    #[test]
+    fn the_row_that_gains_most_is_left_out_whole() {
+        let row = |n: usize| ObservedRow {
+            op: crate::solve::OperatingPoint::new(100.0, 0.1, 200.0, 43_000.0),
+            readings: vec![(Observable::SpeedRpm, 1.0, 1.0); n],
+            ambient_c: 20.0,
+            speed_std_clipped: false,
+        };
+        let rows = vec![row(2), row(1), row(2)];
+        // row 0 gains 3 + 3, row 1 gains 5 alone, row 2 gains 1 + 1
+        let before = [4.0, 4.0, 6.0, 2.0, 2.0];
+        let after = [1.0, 1.0, 1.0, 1.0, 1.0];
+        let (b, a) = without_top_row(&rows, &before, &after);
+        assert_eq!((b, a), (vec![6.0, 2.0, 2.0], vec![1.0, 1.0, 1.0]));
+        assert!((shrink_of(&before, &after) - (1.0 - (5.0f64 / 18.0).sqrt())).abs() < 1e-12);
+        assert_eq!(lone_share(0.5, 0.5), 1.0);
+        assert_eq!(lone_share(0.5, -0.1), -0.2);
+        assert_eq!(lone_share(-0.1, 0.2), 0.0);
+    }
 
     /// A strength the fit ended on at its own bound is released threefold, within the
     /// documented range; a strength inside its bounds, a shape, an effect the fit does not

@@ -165,6 +165,7 @@ impl Bytes<'_> {
             shrink,
             shrink_interval: self.interval(shrink),
             z2_shrink_interval: self.interval(z2_shrink),
+            lone_row_shares: (1.0, 1.0),
             params: Vec::new(),
             signature_match: None,
             linear_chi2_drop: None,

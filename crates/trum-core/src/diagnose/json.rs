@@ -138,6 +138,7 @@ pub fn to_json(d: &Diagnosis, src: &Provenance<'_>) -> Value {
             "shrink": num(r.shrink),
             "shrink_interval": [num(r.shrink_interval.0), num(r.shrink_interval.1)],
             "z2_shrink_interval": [num(r.z2_shrink_interval.0), num(r.z2_shrink_interval.1)],
+            "lone_row_shares": [num(r.lone_row_shares.0), num(r.lone_row_shares.1)],
             "params": pairs(&r.params),
             "signature_match": r.signature_match.map(num),
             "linear_chi2_drop": r.linear_chi2_drop.map(num),

@@ -198,6 +198,11 @@ pub struct RankEntry {
     /// each quantity by its spread, so a few readings of a quantity with a small spread can
     /// carry most of it and make its interval wide where the gain in σ is certain.
     pub z2_shrink_interval: (f64, f64),
+    /// The part of each held-out shrink (NRMSE, σ) that stays with the one row that gains
+    /// most left out: 1 when that row carries none of the gain, 0 or less when it carries
+    /// all. A gain that a single operating point carries (a reading at the edge of a
+    /// stall, an outlier) is no evidence of an effect.
+    pub lone_row_shares: (f64, f64),
     /// Fitted effect parameters on the full data (name, value).
     pub params: Vec<(String, f64)>,
     /// Score test at the calibrated baseline (single effects): cos of the angle between

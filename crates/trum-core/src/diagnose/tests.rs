@@ -79,12 +79,18 @@ fn an_overshooting_fold_step_is_damped_not_dropped() {
     let moved = gap(&right, &in_sample);
     assert!(moved > 0.3, "the held-out blocks do not move the fit: {moved} σ");
     assert!(gap(&damped, &right) < 0.2 * moved, "damped {} vs held-out shift {moved}", gap(&damped, &right));
-    // 64 times too long: even a quarter of it overshoots, the folds keep the full-data
-    // fit and say so
+    // 64 times too long: even a quarter of it overshoots, and the stuck folds are
+    // refitted on their training rows, which predicts their blocks held out (as the right
+    // steps do), not in-sample
     short.lin.jacobian *= 1.0 / 16.0;
     let stuck = approx_cv(&short, &rows, &folds, 4, &fit);
-    assert_eq!(stuck.in_sample, 4);
-    assert!(gap(&stuck.preds, &in_sample) < 1e-9, "{}", gap(&stuck.preds, &in_sample));
+    assert_eq!(stuck.in_sample, 0);
+    assert!(gap(&stuck.preds, &in_sample) > 0.5 * moved, "{} vs {moved}", gap(&stuck.preds, &in_sample));
+    assert!(
+        gap(&stuck.preds, &right) < 0.2 * moved,
+        "refitted {} vs held-out shift {moved}",
+        gap(&stuck.preds, &right)
+    );
 }
 
 /// The residual moments of a reading clipped at zero, against direct integration over
@@ -390,7 +396,9 @@ fn a_strong_radial_friction_that_stalls_the_rotor_is_found() {
     assert_eq!(d.verdict, "radial_friction");
     let rf = d.ranking.iter().find(|r| r.effect == "radial_friction").expect("ranked");
     let rho = rf.params.first().map(|p| p.1).unwrap_or(0.0);
-    assert!((rho / 3.0 - 1.0).abs() < 0.05 && rf.shrink > 0.9, "{rf:?}");
+    // (the stalled rows make the held-out blocks hard to predict: refitting every fold
+    // exactly gives a shrink of 0.63 on this seed)
+    assert!((rho / 3.0 - 1.0).abs() < 0.05 && rf.shrink > 0.6, "{rf:?}");
     // thermal_drift without a time series is still untestable: not fitted
     let td = d.ranking.iter().find(|r| r.effect == "thermal_drift").expect("ranked");
     assert!(td.params.is_empty(), "{td:?}");
@@ -513,6 +521,7 @@ pub(super) fn ranked(effect: &str, chi2: f64, nrmse: f64) -> RankEntry {
         shrink: 0.5,
         shrink_interval: (0.4, 0.6),
         z2_shrink_interval: (0.4, 0.6),
+        lone_row_shares: (1.0, 1.0),
         params: Vec::new(),
         signature_match: None,
         linear_chi2_drop: None,

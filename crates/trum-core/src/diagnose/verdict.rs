@@ -16,6 +16,13 @@ use std::collections::BTreeMap;
 /// weak effects whose baseline is at the noise.
 pub(super) const CERTAIN_Z2_GAIN: f64 = 0.1;
 
+/// The part of a candidate's held-out shrink that must stay when the one row that gains
+/// most is left out ([`GapTests::supported`]): half. A gain more than half of which one
+/// operating point carries rests on that point alone — on a null campaign of a motor run
+/// near clamping, a single row predicted at rest by the baseline's held-out fit but
+/// turning in the data carried 97 % of an effect's 0.53 shrink.
+pub(super) const LONE_ROW_SHARE: f64 = 0.5;
+
 /// The part of the baseline's held-out NRMSE whose removal is material wherever the gap
 /// stands ([`GapTests::material`]): a fifth.
 pub(super) const MATERIAL_SHRINK: f64 = 0.2;
@@ -43,14 +50,19 @@ pub(super) struct GapTests {
 impl GapTests {
     /// A candidate is supported when the full-data evidence is very strong (½ΔBIC > 5)
     /// and its held-out improvement is real (the shrink positive, and the bootstrap 5 %
-    /// bound of the shrink above zero in NRMSE or in σ: [`RankEntry::z2_shrink_interval`]).
-    /// (It closes the gap, [`GapTests::closes`], when the held-out residual is
+    /// bound of the shrink above zero in NRMSE or in σ: [`RankEntry::z2_shrink_interval`]),
+    /// and at least [`LONE_ROW_SHARE`] of that measure's shrink stays without the row
+    /// that gains most ([`RankEntry::lone_row_shares`]): a gain one operating point
+    /// carries is no evidence of an effect. (It closes the gap, [`GapTests::closes`], when the held-out residual is
     /// back near the noise, or at least half of the held-out NRMSE is gone, or at least
     /// half of the part of it beyond the noise, √(NRMSE² − noise²): the truth may differ in
     /// form from the candidate and leave a remainder, and a gap only a little above the
     /// noise can never lose half of its total NRMSE.)
     pub(super) fn supported(r: &RankEntry) -> bool {
-        r.evidence > 5.0 && r.shrink > 0.0 && (r.shrink_interval.0 > 0.0 || r.z2_shrink_interval.0 > 0.0)
+        r.evidence > 5.0
+            && r.shrink > 0.0
+            && ((r.shrink_interval.0 > 0.0 && r.lone_row_shares.0 >= LONE_ROW_SHARE)
+                || (r.z2_shrink_interval.0 > 0.0 && r.lone_row_shares.1 >= LONE_ROW_SHARE))
     }
 
     /// x beyond the noise, √(x² − noise²) (0 below the noise).
@@ -907,6 +919,26 @@ mod tests {
         assert!(!GapTests::supported(&worse));
         let weak = RankEntry { evidence: 4.0, ..wide };
         assert!(!GapTests::supported(&weak));
+    }
+
+    /// A held-out gain that one row carries supports nothing: with the row that gains most
+    /// left out, less than half of the shrink stays in the measure whose interval is above
+    /// zero. A gain spread over the rows, or one whose other measure is certain and spread,
+    /// still supports the effect.
+    #[test]
+    fn a_gain_that_one_row_carries_supports_no_effect() {
+        let spread = RankEntry { evidence: 7.9, shrink: 0.53, ..ranked("radial_friction", 1.5, 0.13) };
+        let spread = RankEntry { shrink_interval: (0.01, 0.67), z2_shrink_interval: (-0.006, 0.07), ..spread };
+        assert!(GapTests::supported(&spread));
+        let lone = RankEntry { lone_row_shares: (0.027, 1.0), ..spread.clone() };
+        assert!(!GapTests::supported(&lone));
+        let at_half = RankEntry { lone_row_shares: (LONE_ROW_SHARE, 0.0), ..spread.clone() };
+        assert!(GapTests::supported(&at_half));
+        // certain and spread in σ, carried by one row in NRMSE
+        let in_sigma = RankEntry { z2_shrink_interval: (0.05, 0.2), lone_row_shares: (0.027, 0.8), ..spread };
+        assert!(GapTests::supported(&in_sigma));
+        let neither = RankEntry { lone_row_shares: (0.027, 0.3), ..in_sigma };
+        assert!(!GapTests::supported(&neither));
     }
 
     /// Vuong's statistic: the evidence gap over the standard error of the summed
