@@ -72,8 +72,8 @@ pub(super) struct CvResult {
     /// held-out predictions aligned with rows/readings
     pub(super) preds: Vec<Vec<f64>>,
     /// folds whose fit could not be moved off the full-data fit (approximate CV: even the
-    /// damped first step raised the training χ²), so their held-out blocks were predicted
-    /// in-sample
+    /// damped first step raised the training χ², and a refit on the training rows did not
+    /// lower it), so their held-out blocks were predicted in-sample
     pub(super) in_sample: usize,
 }
 
@@ -283,7 +283,7 @@ pub(super) fn in_sample_note(base_in_sample: usize, ranking: &[RankEntry], k: us
         return None;
     }
     Some(format!(
-        "held-out blocks predicted in-sample, so these held-out figures are optimistic: {} folds (the fold's fit could not be moved off the full-data fit: even a quarter of the first-order step raised the training χ², as where a row changes between moving and clamped)",
+        "held-out blocks predicted in-sample, so these held-out figures are optimistic: {} folds (the fold's fit could not be moved off the full-data fit: even a quarter of the first-order step raised the training χ², as where a row changes between moving and clamped, and a refit on the fold's training rows did not lower it)",
         stuck.join(", ")
     ))
 }

@@ -213,8 +213,8 @@ pub struct RankEntry {
     pub linear_chi2_drop: Option<f64>,
     /// |cos| between this effect's signature and the verdict's (1: the data see one shape).
     pub signature_overlap: Option<f64>,
-    /// Cross-validation folds whose refit could not be moved off this fit's full-data
-    /// optimum, so their held-out blocks were predicted in-sample (the held-out figures are
+    /// Cross-validation folds whose training fit could not be moved off this fit's
+    /// full-data optimum (neither by the approximate steps nor by a refit), so their held-out blocks were predicted in-sample (the held-out figures are
     /// then optimistic; 0 with exact CV, and for an entry its nested model stands in for).
     pub heldout_in_sample_folds: usize,
 }
