@@ -722,8 +722,6 @@ pub(super) fn sort_ranking(r: &mut [RankEntry]) {
     r.sort_by(|a, b| b.evidence.total_cmp(&a.evidence).then(a.heldout_nrmse_after.total_cmp(&b.heldout_nrmse_after)));
 }
 
-/// Percentile bootstrap (5 %, 95 %) of 1 − sqrt(mean e2_after)/sqrt(mean e2_before) over
-/// readings resampled in pairs.
 /// The shrink 1 − √(Σafter/Σbefore) of per-reading terms.
 fn shrink_of(before: &[f64], after: &[f64]) -> f64 {
     1.0 - (after.iter().sum::<f64>() / before.iter().sum::<f64>().max(1e-300)).sqrt()
@@ -755,6 +753,8 @@ pub(super) fn without_top_row(rows: &[ObservedRow], before: &[f64], after: &[f64
     (keep(before), keep(after))
 }
 
+/// Percentile bootstrap (5 %, 95 %) of 1 − sqrt(mean e2_after)/sqrt(mean e2_before) over
+/// readings resampled in pairs.
 pub(super) fn bootstrap_shrink(before: &[f64], after: &[f64], n: usize, seed: u64) -> (f64, f64) {
     use rand::{RngExt, SeedableRng};
     let m = before.len().min(after.len());

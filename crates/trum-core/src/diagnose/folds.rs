@@ -164,8 +164,9 @@ pub(super) fn approx_cv(
         let fitted = if moved > 0.3 || stuck {
             // A stuck fold is refitted too: predicted with the full-data fit, its held-out
             // block would be scored in-sample, which flatters this model against one whose
-            // folds moved (on a null campaign, an effect whose steps stuck on three folds
-            // of four out-scored the baseline on held-out data it had been fitted to).
+            // folds moved. Where the refit cannot lower the training χ² either, the
+            // full-data fit is the best training fit found, and the fold counts as
+            // predicted in-sample.
             let stepped = lin.motor_at(&best.0);
             let refit = Calibration::builder(&stepped, &train_rows)
                 .params(&lin.params)
