@@ -344,6 +344,14 @@ fn diagnose_without_effect_says_none() {
         assert!(after >= 0.0);
         assert!((shrink - (1.0 - after / before)).abs() < 1e-9, "{r}");
         assert_eq!(r["shrink_interval"].as_array().map(Vec::len), Some(2));
+        // what stays of each shrink without the row that gains most: 0 where the shrink
+        // is not positive
+        let shares: Vec<f64> =
+            r["lone_row_shares"].as_array().expect("shares").iter().filter_map(|x| x.as_f64()).collect();
+        assert_eq!(shares.len(), 2, "{r}");
+        if shrink <= 0.0 {
+            assert_eq!(shares[0], 0.0, "{r}");
+        }
         // score test at the calibrated baseline: every single effect that moves a
         // prediction has one (thermal_drift does not without a time series), a cosine and a
         // non-negative χ² drop; a pair has none
