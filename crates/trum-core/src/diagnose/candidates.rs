@@ -723,14 +723,14 @@ pub(super) fn sort_ranking(r: &mut [RankEntry]) {
 }
 
 /// The shrink 1 − √(Σafter/Σbefore) of per-reading terms.
-fn shrink_of(before: &[f64], after: &[f64]) -> f64 {
+pub(super) fn shrink_of(before: &[f64], after: &[f64]) -> f64 {
     1.0 - (after.iter().sum::<f64>() / before.iter().sum::<f64>().max(1e-300)).sqrt()
 }
 
 /// The part of a held-out gain (`shrink`) that stays without the row that gains most
 /// (where the shrink is `without`): 1 when that row carries none of it, 0 or less when it
 /// carries all.
-fn lone_share(shrink: f64, without: f64) -> f64 {
+pub(super) fn lone_share(shrink: f64, without: f64) -> f64 {
     if shrink > 0.0 {
         without / shrink
     } else {
