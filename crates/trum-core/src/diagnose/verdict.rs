@@ -590,6 +590,14 @@ mod tests {
         rows.iter().enumerate().map(row).collect()
     }
 
+    /// The gap tests of a baseline whose held-out predictions miss every reading by 4 σ
+    /// (alternating in sign), against noise of 1 σ.
+    fn gap_of_four_sigma(ctx: &Context, rows: &[ObservedRow]) -> GapTests {
+        let off = |k: f64| predictions_off(ctx, rows, &|_| k);
+        let (base_nrmse, base_z2, _, _) = errors(rows, &off(4.0), &ctx.sc);
+        GapTests { base_nrmse, gap_noise: errors(rows, &off(1.0), &ctx.sc).0, base_z2, n_read: ctx.n_read }
+    }
+
     /// The entry of `effect` whose held-out predictions are `preds`, against a baseline
     /// held-out NRMSE `base_nrmse`, with bootstrap intervals about its shrink.
     fn entry_predicting(
@@ -669,9 +677,8 @@ mod tests {
         let ctx = Context::new(&motor, &rows, &groups, &quick(false)).unwrap();
         // held-out predictions k σ off every reading, alternating in sign
         let off = |k: f64| predictions_off(&ctx, &rows, &|_| k);
-        let (base_nrmse, base_z2, _, _) = errors(&rows, &off(4.0), &ctx.sc);
-        let tests =
-            GapTests { base_nrmse, gap_noise: errors(&rows, &off(1.0), &ctx.sc).0, base_z2, n_read: ctx.n_read };
+        let tests = gap_of_four_sigma(&ctx, &rows);
+        let base_nrmse = tests.base_nrmse;
         let mut cv_preds = BTreeMap::new();
         let mut fitted = |effect: &str, evidence: f64, k: f64| {
             let preds = off(k);
@@ -711,9 +718,8 @@ mod tests {
         let (rows, groups) = data(&motor, 1.0, 3);
         let ctx = Context::new(&motor, &rows, &groups, &quick(false)).unwrap();
         let off = |k: f64| predictions_off(&ctx, &rows, &|_| k);
-        let (base_nrmse, base_z2, _, _) = errors(&rows, &off(4.0), &ctx.sc);
-        let tests =
-            GapTests { base_nrmse, gap_noise: errors(&rows, &off(1.0), &ctx.sc).0, base_z2, n_read: ctx.n_read };
+        let tests = gap_of_four_sigma(&ctx, &rows);
+        let base_nrmse = tests.base_nrmse;
         let at_row = |k: f64| {
             let mut p = off(1.0);
             p[7] = rows[7].readings.iter().map(|&(_, v, s)| v + k * s).collect();
@@ -749,9 +755,8 @@ mod tests {
             rows.iter().flat_map(|r| r.readings.iter().map(|&(o, _, s)| s / ctx.sc[&o])).collect();
         ratios.sort_by(f64::total_cmp);
         let median = ratios[ratios.len() / 2];
-        let (base_nrmse, base_z2, _, _) = errors(&rows, &off(&|_| 4.0), &ctx.sc);
-        let gap_noise = errors(&rows, &off(&|_| 1.0), &ctx.sc).0;
-        let tests = GapTests { base_nrmse, gap_noise, base_z2, n_read: ctx.n_read };
+        let tests = gap_of_four_sigma(&ctx, &rows);
+        let base_nrmse = tests.base_nrmse;
         let mut cv_preds = BTreeMap::new();
         let mut fitted = |effect: &str, evidence: f64, k: &dyn Fn(f64) -> f64| {
             let preds = off(k);
@@ -779,7 +784,7 @@ mod tests {
         // the gap tests' noise, nothing in σ
         use super::super::pairs::{held_out_need, pair_need};
         let need = pair_need(&tests, &single, ctx.n_read, ctx.noise_weights);
-        assert_eq!(need, (0.0, held_out_need(&single, ctx.n_read, gap_noise).1));
+        assert_eq!(need, (0.0, held_out_need(&single, ctx.n_read, tests.gap_noise).1));
         assert!(need.1 > 0.0);
         // a single that leaves a gap in both measures: a third of either is enough
         let both = RankEntry { heldout_chi2_after: 2.5, ..single };
