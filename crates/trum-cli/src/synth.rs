@@ -77,7 +77,7 @@ pub struct SynthArgs {
     /// Bench artefacts besides the reading noise, as `name=value,...` (docs/SYNTH.md):
     /// readback_rel (voltage read back around its set point), speed_std_floor_rpm,
     /// torque_offset_nm, speed_quantum_rpm, outlier_fraction, temperature_offset_k,
-    /// temperature_lag_s, preload_offset_n, current_gain_rel.
+    /// temperature_lag_s, preload_offset_n, current_gain_rel, power_phase_rad.
     #[arg(long, value_name = "name=value,...")]
     artefacts: Option<String>,
     /// Output CSV file (`-` for stdout). Written to a temporary file and renamed at the end.

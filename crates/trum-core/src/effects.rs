@@ -456,6 +456,16 @@ pub struct Instrument {
     /// current times (1 + this). A current probe or shunt amplifier is good to 1-3 % of its
     /// reading.
     pub current_gain_rel: f64,
+    /// Phase error of the power reading [rad]: the meter's current channel lags its voltage
+    /// channel by this angle (a probe's delay τ is an angle ω·τ), so it shows
+    /// P·cos δ + Q·sin δ of the active power P and the reactive power Q. A piezoelectric
+    /// stator is a capacitive load of low power factor (0.05-0.6), so a degree of phase
+    /// error, which an unmatched current probe shows at tens of kilohertz, moves the power
+    /// reading by a large part of itself; at one drive setting it is nearly a constant zero
+    /// offset. The model keeps the clamped capacitance's part of Q
+    /// ([`Instrument::power_reading_w`]). The efficiency reading, computed from the same
+    /// meter, follows it.
+    pub power_phase_rad: f64,
 }
 
 impl Instrument {
@@ -471,6 +481,42 @@ impl Instrument {
             torque_nm: (op.torque_nm - self.torque_offset_nm).max(0.0),
             preload_n: op.preload_n - self.preload_offset_n,
             ..*op
+        }
+    }
+
+    /// What the power meter shows of the input power of solution `s` [W]: a current channel
+    /// lagging by δ = [`Instrument::power_phase_rad`] reads V·I·cos(φ − δ) = P·cos δ + Q·sin δ
+    /// of the active power P and the reactive power Q of both phases (Q > 0 for a leading,
+    /// capacitive current). Of Q the model keeps the clamped capacitance's part Q_c = ω·C0·V²
+    /// ([`crate::Solution::capacitive_reactive_power_var`]) and leaves out the motional
+    /// branch's, δ·Q_m: at one drive setting Q_c is the constant offset that a phase error
+    /// puts on the power reading, while δ·Q_m, which follows the amplitude and the detuning,
+    /// is a second power term that a fit can trade against the loss tangent (δ and tan δ move
+    /// Q_c's and the dielectric loss's shares alike) to follow what an effect does to the
+    /// input power. Where the motional branch cancels much of Q_c (a stator driven just
+    /// above its resonance) the fitted δ is an equivalent angle, δ·Q/Q_c of the meter's
+    /// (docs/DIAGNOSIS.md, "The bench model"). P itself at δ = 0; valid for |δ| up to a
+    /// few degrees.
+    pub fn power_reading_w(&self, s: &crate::Solution) -> f64 {
+        if self.power_phase_rad == 0.0 {
+            return s.input_power_w;
+        }
+        let (sin, cos) = self.power_phase_rad.sin_cos();
+        s.input_power_w * cos + s.capacitive_reactive_power_var() * sin
+    }
+
+    /// What the bench's efficiency reading shows for solution `s`: the output power over
+    /// the power meter's reading ([`Instrument::power_reading_w`]), within [0, 1] as the
+    /// model's own efficiency; that efficiency itself at δ = 0.
+    pub fn efficiency_reading(&self, s: &crate::Solution) -> f64 {
+        if self.power_phase_rad == 0.0 {
+            return s.efficiency;
+        }
+        let p = self.power_reading_w(s);
+        if p > 0.0 {
+            (s.output_power_w / p).clamp(0.0, 1.0)
+        } else {
+            0.0
         }
     }
 
@@ -847,6 +893,35 @@ fn _accepts_integers(n: Num) -> f64 {
 #[allow(clippy::unwrap_used)] // tests: a panic is the failure report
 mod tests {
     use super::*;
+
+    /// The power meter's reading is V·|I|·cos(φ − δ) from the phase current's magnitude and
+    /// phase (an independent route through the current's polar form) less the motional
+    /// branch's δ-term the model leaves out, is the model's input power at δ = 0, and the
+    /// efficiency reading is the output power over it.
+    #[test]
+    fn the_power_meters_reading_is_the_power_at_its_phase_error() {
+        let m = crate::calibrate::tests::reference_motor();
+        for (f, t) in [(150.0, 0.0), (250.0, 0.3), (350.0, 0.6)] {
+            let s = crate::solve(&m, &crate::OperatingPoint::new(f, t, 200.0, 43e3));
+            assert_eq!(Instrument::default().power_reading_w(&s), s.input_power_w);
+            assert_eq!(Instrument::default().efficiency_reading(&s), s.efficiency);
+            // the clamped capacitance's current, ω·C0·V at 43 kHz and 200 V
+            let ic = 2.0 * std::f64::consts::PI * 43e3 * m.electrical.clamped_capacitance_f * 200.0;
+            assert!((s.capacitive_current_a / ic - 1.0).abs() < 1e-12);
+            let phi = s.current_quadrature_a.atan2(s.current_in_phase_a);
+            let motional_var = s.electrode_voltage_v * (s.current_quadrature_a - s.capacitive_current_a);
+            for delta in [-0.05, 0.01, 0.2] {
+                let meter = Instrument { power_phase_rad: delta, ..Default::default() };
+                let polar = s.electrode_voltage_v * s.current_a * (phi - delta).cos() - motional_var * delta.sin();
+                let got = meter.power_reading_w(&s);
+                assert!((got / polar - 1.0).abs() < 1e-12, "{got} vs {polar}");
+                // a capacitive load: a lagging current channel reads high
+                assert_eq!(got > s.input_power_w, delta > 0.0);
+                let eff = meter.efficiency_reading(&s);
+                assert!((eff - (s.output_power_w / got).clamp(0.0, 1.0)).abs() < 1e-15);
+            }
+        }
+    }
 
     #[test]
     fn names_match_the_spec() {

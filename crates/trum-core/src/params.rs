@@ -290,8 +290,9 @@ pub fn plausible_from_toml_str(
 /// temperature reading's offset `bench.temperature_offset_k` (in K; 0: no offset), the
 /// temperature sensor's lag `bench.temperature_lag_s` (the standard deviation of its
 /// logarithm; 0: no lag), the preload reading's offset `bench.preload_offset_n` (in N; 0:
-/// no offset) and the current reading's gain error `bench.current_gain_rel` (relative; 0:
-/// exact). Empty
+/// no offset), the current reading's gain error `bench.current_gain_rel` (relative; 0:
+/// exact) and the power reading's phase error `bench.power_phase_rad` (in rad; 0: exact).
+/// Empty
 /// without a table; errors name
 /// the file, line and key.
 pub fn tolerances_from_toml_str(
@@ -340,7 +341,8 @@ pub fn tolerances_from_toml_str(
 /// The keys a `[tolerances]` table accepts: the parameters calibration fits
 /// ([`crate::tolerances::TOLERANCES`]) by dotted motor key, then the bench's
 /// `bench.speed_std_floor_rpm`, `bench.torque_offset_nm`, `bench.temperature_offset_k`,
-/// `bench.temperature_lag_s`, `bench.preload_offset_n` and `bench.current_gain_rel`.
+/// `bench.temperature_lag_s`, `bench.preload_offset_n`, `bench.current_gain_rel` and
+/// `bench.power_phase_rad`.
 pub fn tolerance_keys() -> Vec<String> {
     crate::tolerances::TOLERANCES
         .iter()
@@ -353,6 +355,7 @@ pub fn tolerance_keys() -> Vec<String> {
                 "bench.temperature_lag_s",
                 "bench.preload_offset_n",
                 "bench.current_gain_rel",
+                "bench.power_phase_rad",
             ]
             .map(String::from),
         )

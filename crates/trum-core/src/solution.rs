@@ -108,6 +108,9 @@ pub struct Solution {
     pub current_in_phase_a: f64,
     /// Part of the phase current in quadrature (leading) [A].
     pub current_quadrature_a: f64,
+    /// Of which the clamped capacitance's current ω·C0·V [A] (the rest is the motional
+    /// branch's).
+    pub capacitive_current_a: f64,
     /// Voltage at the electrodes, zero-to-peak [V] (below the set voltage with `voltage_sag`).
     pub electrode_voltage_v: f64,
     /// Phase lag ψ of the wave behind the drive [rad].
@@ -132,6 +135,21 @@ pub struct Solution {
 }
 
 impl Solution {
+    /// Reactive power of both phases [var]: V·I_q, the electrode voltage amplitude times the
+    /// quadrature (leading) part of the phase current amplitude, as the input power is
+    /// V·I_p (two phases of ½·V·I each). Positive for the capacitive current of a
+    /// piezoelectric stator.
+    pub fn reactive_power_var(&self) -> f64 {
+        self.electrode_voltage_v * self.current_quadrature_a
+    }
+
+    /// The clamped capacitance's part of [`Solution::reactive_power_var`] [var]:
+    /// V·ω·C0·V, both phases. Used by the bench's power-meter model
+    /// ([`crate::effects::Instrument::power_reading_w`]).
+    pub fn capacitive_reactive_power_var(&self) -> f64 {
+        self.electrode_voltage_v * self.capacitive_current_a
+    }
+
     /// Sum of all losses [W].
     pub fn total_loss_w(&self) -> f64 {
         self.dielectric_loss_w + self.damping_loss_w + self.friction_loss_w + self.rotor_loss_w
@@ -168,6 +186,7 @@ impl Solution {
             current_a: n,
             current_in_phase_a: n,
             current_quadrature_a: n,
+            capacitive_current_a: n,
             electrode_voltage_v: n,
             phase_lag_rad: n,
             modal_stiffness_n_per_m: n,

@@ -127,11 +127,16 @@ pub struct Artefacts {
     /// Relative gain error of the current reading (-): it shows the phase current times
     /// (1 + this), before its noise.
     pub current_gain_rel: f64,
+    /// Phase error of the power meter [rad]: the power reading shows P·cos δ + Q·sin δ of
+    /// the whole reactive power Q ([`meter_power_w`]; the diagnosis' bench model keeps
+    /// only its clamped capacitance's part) and the efficiency reading the output power
+    /// over it, before their noise.
+    pub power_phase_rad: f64,
 }
 
 impl Artefacts {
     /// Names of the artefacts as written in `name=value` lists.
-    pub const NAMES: [&'static str; 9] = [
+    pub const NAMES: [&'static str; 10] = [
         "readback_rel",
         "speed_std_floor_rpm",
         "torque_offset_nm",
@@ -141,6 +146,7 @@ impl Artefacts {
         "temperature_lag_s",
         "preload_offset_n",
         "current_gain_rel",
+        "power_phase_rad",
     ];
 
     /// Parses `name=value,...` (e.g. `readback_rel=0.005,speed_std_floor_rpm=0.3`); the
@@ -168,6 +174,7 @@ impl Artefacts {
                 "temperature_lag_s" => &mut a.temperature_lag_s,
                 "preload_offset_n" => &mut a.preload_offset_n,
                 "current_gain_rel" => &mut a.current_gain_rel,
+                "power_phase_rad" => &mut a.power_phase_rad,
                 other => {
                     return Err(TrumError::input(format!(
                         "unknown bench artefact '{other}'; valid names are: {}",
@@ -192,6 +199,9 @@ impl Artefacts {
         }
         if !(-0.5..0.5).contains(&a.current_gain_rel) {
             return bad("current_gain_rel", "must be in (-0.5, 0.5)");
+        }
+        if !(-0.5..0.5).contains(&a.power_phase_rad) {
+            return bad("power_phase_rad", "must be in (-0.5, 0.5) rad");
         }
         Ok(a)
     }
@@ -300,6 +310,17 @@ impl Noise {
     }
 }
 
+/// What a power meter whose current channel lags its voltage channel by `phase_rad` shows
+/// of the input power of `s` [W]: V·I·cos(φ − δ) = P·cos δ + Q·sin δ with the whole
+/// reactive power Q of both phases, motional branch included.
+pub fn meter_power_w(s: &crate::Solution, phase_rad: f64) -> f64 {
+    if phase_rad == 0.0 {
+        return s.input_power_w;
+    }
+    let (sin, cos) = phase_rad.sin_cos();
+    s.input_power_w * cos + s.reactive_power_var() * sin
+}
+
 /// Bench noise per column: standard deviation of a reading of value `v` at noise level 1
 /// (docs/SYNTH.md).
 pub fn reading_noise(o: Observable, v: f64) -> f64 {
@@ -403,7 +424,18 @@ pub fn synthesize(motor: &Motor, cfg: &SynthConfig) -> Result<Vec<SynthRow>, Tru
             let readings = obs
                 .iter()
                 .map(|&o| {
-                    let mut v = o.predict(&s, ambient);
+                    let mut v = match o {
+                        Observable::InputPowerW => meter_power_w(&s, art.power_phase_rad),
+                        Observable::Efficiency if art.power_phase_rad != 0.0 => {
+                            let p = meter_power_w(&s, art.power_phase_rad);
+                            if p > 0.0 {
+                                (s.output_power_w / p).clamp(0.0, 1.0)
+                            } else {
+                                0.0
+                            }
+                        }
+                        _ => o.predict(&s, ambient),
+                    };
                     if o == Observable::SpeedStdRpm && art.speed_std_floor_rpm > 0.0 {
                         v = v.hypot(art.speed_std_floor_rpm);
                     }

@@ -112,6 +112,7 @@ fn finish_unchecked(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, sta
         current_a: ire.hypot(iim),
         current_in_phase_a: ire,
         current_quadrature_a: iim,
+        capacitive_current_a: d.v * omega * p.c0,
         electrode_voltage_v: d.v,
         phase_lag_rad: if clamped { 0.5 * PI } else { t.z.1.atan2(t.z.0) },
         modal_stiffness_n_per_m: t.k_eff,

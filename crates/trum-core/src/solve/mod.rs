@@ -152,6 +152,7 @@ pub(crate) fn map_solution(a: &Solution, b: Option<&Solution>, f: impl Fn(f64, f
         current_a,
         current_in_phase_a,
         current_quadrature_a,
+        capacitive_current_a,
         electrode_voltage_v,
         phase_lag_rad,
         modal_stiffness_n_per_m,
