@@ -512,12 +512,7 @@ impl Instrument {
         if self.power_phase_rad == 0.0 {
             return s.efficiency;
         }
-        let p = self.power_reading_w(s);
-        if p > 0.0 {
-            (s.output_power_w / p).clamp(0.0, 1.0)
-        } else {
-            0.0
-        }
+        crate::losses::efficiency(s.output_power_w, self.power_reading_w(s))
     }
 
     /// What the instrument shows of quantity `o` when the motor's value is `model`.

@@ -18,6 +18,19 @@ pub fn dielectric_loss_w(omega_rad_s: f64, capacitance_f: f64, loss_tangent: f64
     omega_rad_s * capacitance_f * voltage_v * voltage_v * loss_tangent
 }
 
+/// Efficiency η = P_out / P_in [-] of the mechanical output over the electrical input,
+/// clamped to [0, 1], and 0 where the input power is not positive. The solver's, the
+/// averaged and linearised solutions' and the bench's efficiency readings all use it.
+/// Valid for any finite powers.
+#[inline]
+pub fn efficiency(output_power_w: f64, input_power_w: f64) -> f64 {
+    if input_power_w > 0.0 {
+        (output_power_w / input_power_w).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
 /// Structural damping loss of the stator, two modes of amplitude W: P = 2·½·c·ω²·W² =
 /// c·ω²·W² [W]. (Sun et al. 2021 eq. 17 gives the same loss per cycle from the composite
 /// beam's bending energy; [`composite_modal_damping_ns_per_m`] converts one into the

@@ -114,8 +114,7 @@ impl Linear {
             // −0.002 rpm where the whole solve stalls). Solve it whole.
             return None;
         }
-        out.efficiency =
-            if out.input_power_w > 0.0 { (out.output_power_w / out.input_power_w).clamp(0.0, 1.0) } else { 0.0 };
+        out.efficiency = crate::losses::efficiency(out.output_power_w, out.input_power_w);
         Some(out)
     }
 }

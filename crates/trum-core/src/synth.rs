@@ -427,12 +427,7 @@ pub fn synthesize(motor: &Motor, cfg: &SynthConfig) -> Result<Vec<SynthRow>, Tru
                     let mut v = match o {
                         Observable::InputPowerW => meter_power_w(&s, art.power_phase_rad),
                         Observable::Efficiency if art.power_phase_rad != 0.0 => {
-                            let p = meter_power_w(&s, art.power_phase_rad);
-                            if p > 0.0 {
-                                (s.output_power_w / p).clamp(0.0, 1.0)
-                            } else {
-                                0.0
-                            }
+                            crate::losses::efficiency(s.output_power_w, meter_power_w(&s, art.power_phase_rad))
                         }
                         _ => o.predict(&s, ambient),
                     };

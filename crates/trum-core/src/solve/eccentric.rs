@@ -86,8 +86,7 @@ pub(crate) fn eccentric_average_with(
     let var: f64 = speeds.iter().filter(|s| s.1 > 0.0).map(|&(w, n)| n * (w - mean).powi(2) / w).sum::<f64>() / tsum;
     out.speed_std_rpm = var.sqrt() * RAD_S_TO_RPM;
     out.status = Status::Ok;
-    out.efficiency =
-        if out.input_power_w > 0.0 { (out.output_power_w / out.input_power_w).clamp(0.0, 1.0) } else { 0.0 };
+    out.efficiency = crate::losses::efficiency(out.output_power_w, out.input_power_w);
     out.torque_nm = op.torque_nm;
     out.iterations = prev.iterations;
     out

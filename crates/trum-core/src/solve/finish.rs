@@ -79,7 +79,7 @@ fn finish_unchecked(p: &Prepared, d: &Drive, op: &OperatingPoint, t: &Trial, sta
     };
     let input = d.v * ire;
     let losses = dielectric + damping + friction + rotor;
-    let efficiency = if input > 0.0 { (output / input).clamp(0.0, 1.0) } else { 0.0 };
+    let efficiency = crate::losses::efficiency(output, input);
     let rise_ss = losses / p.alpha_s;
     let rise_t = rise_ss * (1.0 - (-p.alpha_s * op.elapsed_s / p.heat_cap).exp());
     let xc = contact::contact_angle_deg(ct.half_angle_rad, p.n);
