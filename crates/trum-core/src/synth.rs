@@ -506,6 +506,37 @@ mod tests {
         assert!(r.iter().all(|x| x.abs() < 1e-9), "max {:?}", r.iter().fold(0.0f64, |a, b| a.max(b.abs())));
     }
 
+    /// A power meter's phase error reads the power as P·cos δ + Q·sin δ of the whole
+    /// reactive power (the same rows solved by hand) and the efficiency as the output over
+    /// it; at δ = 0 the readings are the model's. Out of (−0.5, 0.5) rad it is refused,
+    /// naming the artefact.
+    #[test]
+    fn a_power_meters_phase_error_reads_power_and_efficiency_through_the_whole_reactive_power() {
+        let m = crate::calibrate::tests::reference_motor();
+        let delta: f64 = 0.05;
+        let art = Artefacts::parse(&format!("power_phase_rad={delta}")).unwrap();
+        let base =
+            SynthConfig { campaign: Campaign::PreloadTorque, noise: 0.0, perturbation: 0.0, ..SynthConfig::default() };
+        let rows = synthesize(&m, &SynthConfig { artefacts: art, ..base.clone() }).unwrap();
+        let plain = synthesize(&m, &base).unwrap();
+        let mut checked = 0;
+        for (r, p) in rows.iter().zip(&plain) {
+            let s = crate::solve(&m, &r.op);
+            let read = |rows: &[(Observable, f64)], o| rows.iter().find(|x| x.0 == o).map(|x| x.1);
+            let whole = s.input_power_w * delta.cos() + s.reactive_power_var() * delta.sin();
+            let power = read(&r.readings, Observable::InputPowerW).unwrap();
+            assert!((power - whole.max(0.0)).abs() <= 1e-9 * whole.abs().max(1.0), "{power} vs {whole}");
+            assert_eq!(read(&p.readings, Observable::InputPowerW), Some(s.input_power_w.max(0.0)));
+            if let Some(eff) = read(&r.readings, Observable::Efficiency) {
+                assert!((eff - crate::losses::efficiency(s.output_power_w, whole)).abs() < 1e-12);
+                checked += 1;
+            }
+        }
+        assert!(checked > 10, "{checked} efficiency readings");
+        let err = Artefacts::parse("power_phase_rad=0.6").unwrap_err().to_string();
+        assert!(err.contains("power_phase_rad"), "{err}");
+    }
+
     #[test]
     fn campaigns_have_the_expected_shape() {
         let m = crate::calibrate::tests::reference_motor();
